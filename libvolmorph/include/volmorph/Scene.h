@@ -1,0 +1,169 @@
+// The scene: a validated, in-memory description of one morph sequence, parsed from a TOML file
+// that users write by hand. Every key, its unit and its default is documented in scenes/README.md.
+//
+// Units: lengths are world units unless a name says Voxels; angles are degrees in the file and
+// radians in code (only Camera::fovDegrees keeps degrees, as vdb_render's flag does, and says so).
+#pragma once
+
+#include <volmorph/Diagnostics.h>
+
+#include <openvdb/math/Mat4.h>
+#include <openvdb/math/Vec3.h>
+
+#include <filesystem>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <vector>
+
+namespace volmorph {
+
+using Vec3d = openvdb::math::Vec3d;
+using Mat4d = openvdb::math::Mat4d;
+
+/// Object-to-world placement of a mesh: scale, then rotate about X, then Y, then Z, then translate.
+struct ObjectTransform {
+    Vec3d translate{0.0, 0.0, 0.0};   ///< world units
+    Vec3d rotateRadians{0.0, 0.0, 0.0};
+    Vec3d scale{1.0, 1.0, 1.0};       ///< uniform or per axis; every component > 0
+
+    /// Column-vector convention p' = M p (OpenVDB stores it transposed: use transform() to apply).
+    Mat4d matrix() const;
+    Vec3d apply(const Vec3d& p) const;
+    bool isIdentity() const;
+};
+
+/// One side of the morph: a mesh file and how it is placed.
+struct ObjectSpec {
+    std::filesystem::path mesh;          ///< resolved against the scene file's folder
+    SourceLocation meshWhere;            ///< where `mesh` was written, for errors found on import
+    ObjectTransform transform;
+    std::optional<Vec3d> color;          ///< linear RGB; when absent, the mesh's vertex colours or grey
+};
+
+/// Voxel grid settings: exactly one of voxelSize and resolution is set by the file.
+struct VolumeSpec {
+    std::optional<double> voxelSize;     ///< world units
+    std::optional<int> resolution;       ///< voxels across the longest side of the larger object
+};
+
+enum class FeatureType { Point, Segment, Rectangle, Box };
+const char* toString(FeatureType type);
+
+/// One feature element (Lerios et al. 1995): an origin, an orthonormal frame and scales.
+/// The type only chooses the distance function; a segment is scale.x long along xAxis, a rectangle
+/// scale.x by scale.y in the xAxis-yAxis plane, a box scale.x by scale.y by scale.z; all centred on
+/// origin.
+struct FeatureElement {
+    Vec3d origin{0.0, 0.0, 0.0};         ///< world units
+    Vec3d xAxis{1.0, 0.0, 0.0};          ///< unit length; the frame is orthonormal and right-handed
+    Vec3d yAxis{0.0, 1.0, 0.0};
+    Vec3d zAxis{0.0, 0.0, 1.0};
+    Vec3d scale{1.0, 1.0, 1.0};          ///< world units, every component > 0
+};
+
+struct FeaturePairSpec {
+    FeatureType type = FeatureType::Point;
+    FeatureElement source;
+    FeatureElement target;
+    SourceLocation where;                ///< the [[pair]] header
+};
+
+enum class Weighting { InverseSquare, BeierNeely };
+
+struct WarpSpec {
+    double epsilon = 0.01;               ///< world units; w = (d + epsilon)^-2
+    double toleranceVoxels = 0.25;       ///< approximation error bound; 0 = exact warp
+    Weighting weighting = Weighting::InverseSquare;
+    /// Beier-Neely weights w = (len^p / (a + d))^b, used only with Weighting::BeierNeely.
+    double a = 0.01, b = 2.0, p = 0.0;
+};
+
+/// tau(t) for one attribute. Points are (t, tau) pairs sorted by t, interpolated linearly.
+struct ScheduleSpec {
+    enum class Kind { Linear, Smoothstep, Sigmoid, Curve };
+    Kind kind = Kind::Linear;
+    double k = 8.0;                      ///< sigmoid steepness
+    std::vector<std::pair<double, double>> points;
+
+    double evaluate(double t) const;     ///< t in [0, 1]
+    std::string str() const;
+};
+
+enum class BlendMode { Density, Sdf };
+
+struct BlendSpec {
+    BlendMode mode = BlendMode::Density;
+    ScheduleSpec density;
+    ScheduleSpec color;
+    ScheduleSpec sdf;
+};
+
+enum class Projection { Perspective, Orthographic };
+
+struct CameraSpec {
+    Projection projection = Projection::Perspective;
+    Vec3d eye{0.0, 0.0, 5.0};
+    Vec3d lookat{0.0, 0.0, 0.0};
+    Vec3d up{0.0, 1.0, 0.0};
+    double fovDegrees = 40.0;            ///< horizontal, perspective only
+    double orthoWidth = 2.0;             ///< world units, orthographic only
+};
+
+enum class LightType { Directional, Point };
+
+struct LightSpec {
+    LightType type = LightType::Directional;
+    Vec3d direction{0.0, -1.0, 0.0};     ///< directional: the way light travels (unit length)
+    Vec3d position{0.0, 0.0, 0.0};       ///< point: world units
+    Vec3d color{1.0, 1.0, 1.0};
+    double intensity = 1.0;
+};
+
+struct RenderSpec {
+    int width = 960, height = 540;       ///< pixels
+    int samples = 4;                     ///< jittered samples per pixel
+    double stepVoxels = 0.5;             ///< ray-march step
+    double extinction = 40.0;            ///< per world unit at density 1
+    double albedo = 0.8;                 ///< single-scattering albedo, 0..1
+    double anisotropy = 0.0;             ///< Henyey-Greenstein g, -1 < g < 1
+    unsigned seed = 0;
+    CameraSpec camera;
+    std::vector<LightSpec> lights;       ///< default: one directional light from above-front
+};
+
+/// The frames of the sequence. Frame f has t = (f - first) / (last - first); a single-frame
+/// range has t = 0. Picking frames on the command line never changes their t.
+struct FramesSpec {
+    int first = 1, last = 1;
+    std::string output = "out/frame.####.exr"; ///< relative to the scene folder; #### or %04d pads
+    SourceLocation outputWhere;
+
+    int count() const { return last - first + 1; }
+    double t(int frame) const;
+};
+
+struct Scene {
+    std::filesystem::path file;          ///< the scene file as given
+    std::filesystem::path folder;        ///< paths in the file are relative to this
+    ObjectSpec source, target;
+    VolumeSpec volume;
+    std::vector<FeaturePairSpec> pairs;
+    WarpSpec warp;
+    BlendSpec blend;
+    RenderSpec render;
+    FramesSpec frames;
+};
+
+/// Reads, parses and validates a scene file. Throws UserError listing every problem found, each
+/// with file:line:col; checks that mesh files exist (it does not import them).
+Scene loadScene(const std::filesystem::path& file);
+
+/// Parses scene text; `file` names it in diagnostics and anchors relative paths.
+Scene parseScene(std::string_view text, const std::filesystem::path& file);
+
+/// Parses a frame range "FIRST-LAST" or "N" (negative frame numbers allowed, as "-5--1").
+/// Returns false when the text is not such a range or FIRST > LAST.
+bool parseFrameRange(std::string_view text, int& first, int& last);
+
+} // namespace volmorph

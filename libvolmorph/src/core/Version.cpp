@@ -1,0 +1,7 @@
+#include <volmorph/Version.h>
+
+namespace volmorph {
+
+const char* versionString() { return VOLMORPH_VERSION_STRING; }
+
+} // namespace volmorph
