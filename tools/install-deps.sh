@@ -7,7 +7,7 @@ set -eu
 PACKAGES="build-essential cmake ninja-build pkg-config ccache
 libopenvdb-dev libboost-iostreams-dev libembree-dev libopenimageio-dev openimageio-tools
 libopenexr-dev libtbb-dev libassimp-dev libtomlplusplus-dev libcli11-dev
-libgtest-dev libgmock-dev libbenchmark-dev libopenvdb-tools"
+libgtest-dev libgmock-dev libbenchmark-dev libopenvdb-tools python3-openvdb"
 
 missing=""
 for p in $PACKAGES; do

@@ -2,15 +2,21 @@
 //
 // Exit status: 0 success, 1 a user error (each problem on stderr as FILE:LINE:COL: message),
 // 2 bad command-line usage (CLI11), 70 an internal error.
+#include <volmorph/Interrupter.h>
 #include <volmorph/Mesh.h>
 #include <volmorph/Scene.h>
 #include <volmorph/Version.h>
+#include <volmorph/Voxelize.h>
 
 #include <CLI/CLI.hpp>
 
+#include <chrono>
 #include <cmath>
+#include <csignal>
+#include <unistd.h>
 #include <cstdio>
 #include <iostream>
+#include <optional>
 #include <sstream>
 
 namespace {
@@ -20,6 +26,38 @@ using namespace volmorph;
 constexpr int kExitUserError = 1;
 constexpr int kExitUsage = 2;
 constexpr int kExitInternal = 70;
+constexpr int kExitInterrupted = 130; // as a shell reports a SIGINT
+
+/// The interrupter SIGINT and SIGTERM stop; set while a long operation runs.
+volmorph::Interrupter* gInterrupter = nullptr;
+
+extern "C" void onStopSignal(int)
+{
+    if (gInterrupter) gInterrupter->requestStop();
+}
+
+/// Routes SIGINT and SIGTERM to `interrupter` for the lifetime of this object.
+class StopSignals {
+public:
+    explicit StopSignals(volmorph::Interrupter& interrupter)
+    {
+        gInterrupter = &interrupter;
+        struct sigaction action {};
+        action.sa_handler = onStopSignal;
+        sigemptyset(&action.sa_mask);
+        sigaction(SIGINT, &action, &mOldInt);
+        sigaction(SIGTERM, &action, &mOldTerm);
+    }
+    ~StopSignals()
+    {
+        sigaction(SIGINT, &mOldInt, nullptr);
+        sigaction(SIGTERM, &mOldTerm, nullptr);
+        gInterrupter = nullptr;
+    }
+
+private:
+    struct sigaction mOldInt {}, mOldTerm {};
+};
 
 std::string fmt(double v)
 {
@@ -88,33 +126,23 @@ void warnFarFeatures(const Scene& scene, const Mesh& source, const Mesh& target)
 int runCheck(const std::string& scenePath)
 {
     const Scene scene = loadScene(scenePath);
-    // Import both meshes before reporting, so that both are checked even when one fails.
-    std::vector<Diagnostic> problems;
-    Mesh meshes[2];
-    const ObjectSpec* specs[2] = {&scene.source, &scene.target};
-    for (int i = 0; i < 2; ++i) {
-        try {
-            meshes[i] = importMesh(specs[i]->mesh, specs[i]->transform, specs[i]->meshWhere);
-        } catch (const UserError& e) {
-            problems.insert(problems.end(), e.diagnostics().begin(), e.diagnostics().end());
-        }
-    }
-    if (!problems.empty()) throw UserError(problems);
-
+    const SceneMeshes meshes = importSceneMeshes(scene);
     std::printf("scene   %s\n", scenePath.c_str());
-    printMesh("source", scene.source, meshes[0]);
-    printMesh("target", scene.target, meshes[1]);
+    printMesh("source", scene.source, meshes.source);
+    printMesh("target", scene.target, meshes.target);
 
-    auto [slo, shi] = meshes[0].bounds();
-    auto [tlo, thi] = meshes[1].bounds();
-    Vec3d lo = minComponent(slo, tlo), hi = maxComponent(shi, thi);
-    const Vec3d extent = hi - lo;
-    const double longest = std::max({extent.x(), extent.y(), extent.z()});
-    const double voxel = scene.volume.voxelSize ? *scene.volume.voxelSize
-                                                : longest / double(*scene.volume.resolution);
+    auto [slo, shi] = meshes.source.bounds();
+    auto [tlo, thi] = meshes.target.bounds();
+    const Vec3d extent = maxComponent(shi, thi) - minComponent(slo, tlo);
+    const double voxel = sceneVoxelSize(scene.volume, meshes.source, meshes.target);
     std::printf("volume  voxel size %s world units; both meshes span %.0f x %.0f x %.0f voxels\n",
                 fmt(voxel).c_str(), std::ceil(extent.x() / voxel), std::ceil(extent.y() / voxel),
                 std::ceil(extent.z() / voxel));
+    const double gib = double(1ull << 30);
+    std::printf("        voxelizing needs about %.2f + %.2f GiB (limit %.1f GiB, half the memory)\n",
+                double(estimateVoxelizeBytes(meshes.source, voxel, 3.0f)) / gib,
+                double(estimateVoxelizeBytes(meshes.target, voxel, 3.0f)) / gib,
+                double(defaultMemoryLimitBytes()) / gib);
 
     std::printf("pairs   %zu\n", scene.pairs.size());
     for (size_t i = 0; i < scene.pairs.size(); ++i) {
@@ -166,7 +194,62 @@ int runCheck(const std::string& scenePath)
         if (k % kPerLine == kPerLine - 1 || frame == f.last) std::printf("\n");
     }
     std::fflush(stdout);
-    warnFarFeatures(scene, meshes[0], meshes[1]);
+    warnFarFeatures(scene, meshes.source, meshes.target);
+    return 0;
+}
+
+struct VoxelizeArgs {
+    std::string mesh, output, sign = "auto";
+    std::optional<double> voxelSize;
+    std::optional<int> resolution;
+    float halfWidth = 3.0f;
+    std::vector<float> color;
+    double memoryLimitGiB = 0.0;
+    bool quiet = false;
+};
+
+int runVoxelize(const VoxelizeArgs& args)
+{
+    const Mesh mesh = importMesh(args.mesh);
+    VoxelizeOptions options;
+    options.voxelSize = args.voxelSize;
+    if (args.resolution) options.resolution = *args.resolution;
+    options.halfWidthVoxels = args.halfWidth;
+    if (!args.color.empty()) options.color = Vec3f(args.color[0], args.color[1], args.color[2]);
+    options.memoryLimitBytes = uint64_t(args.memoryLimitGiB * double(1ull << 30));
+    options.sign = args.sign == "winding"     ? VoxelizeOptions::Sign::WindingNumber
+                   : args.sign == "floodfill" ? VoxelizeOptions::Sign::FloodFill
+                                              : VoxelizeOptions::Sign::Auto;
+    const std::filesystem::path output(args.output);
+    const std::filesystem::path folder = output.has_parent_path() ? output.parent_path() : ".";
+    std::error_code ec;
+    if (!std::filesystem::is_directory(folder, ec))
+        throw UserError(SourceLocation{args.output}, "the output folder does not exist");
+
+    Interrupter interrupter(!args.quiet && isatty(fileno(stderr)));
+    StopSignals signals(interrupter);
+    VoxelizeStats stats;
+    const auto start = std::chrono::steady_clock::now();
+    const VolumeSet volumes = voxelize(mesh, options, &interrupter, &stats);
+    const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    if (interrupter.stopRequested()) throw Interrupted();
+    std::ostringstream voxel;
+    voxel << stats.voxelSize;
+    writeVolumeSet(volumes, output,
+                   {{"volmorph_source", std::filesystem::absolute(args.mesh).string()},
+                    {"volmorph_voxel_size", voxel.str()},
+                    {"volmorph_sign", stats.usedWindingNumber ? "winding number" : "flood fill"},
+                    {"volmorph_version", versionString()}});
+    if (!args.quiet) {
+        std::printf("%s: %zu triangles, %s\n", args.mesh.c_str(), mesh.triangles.size(),
+                    describeTopology(mesh.report).c_str());
+        std::printf("voxel size %s world units; inside/outside by %s\n", voxel.str().c_str(),
+                    stats.usedWindingNumber ? "winding number" : "flood fill (watertight, one shell)");
+        std::printf("sdf %llu active voxels, density %llu active voxels, %.2f s\n",
+                    (unsigned long long)stats.sdfActiveVoxels, (unsigned long long)stats.densityActiveVoxels,
+                    seconds);
+        std::printf("wrote %s (grids sdf, density, Cd)\n", args.output.c_str());
+    }
     return 0;
 }
 
@@ -182,6 +265,27 @@ int main(int argc, char** argv)
     CLI::App* check = app.add_subcommand("check", "Validate a scene file and summarise it");
     check->add_option("SCENE", scenePath, "scene file (TOML)")->required();
 
+    VoxelizeArgs vox;
+    CLI::App* voxelizeCmd = app.add_subcommand("voxelize", "Voxelize a mesh into sdf, density and Cd grids");
+    voxelizeCmd->add_option("MESH", vox.mesh, "mesh file (OBJ, PLY, STL, OFF, glTF, ...)")->required();
+    voxelizeCmd->add_option("-o,--output", vox.output, "output .vdb file")->required();
+    auto* sizeOpt = voxelizeCmd->add_option("--voxel-size", vox.voxelSize, "voxel edge in world units")
+                        ->check(CLI::PositiveNumber);
+    voxelizeCmd->add_option("--resolution", vox.resolution, "voxels across the longest side (default 128)")
+        ->check(CLI::Range(8, 16384))
+        ->excludes(sizeOpt);
+    voxelizeCmd->add_option("--half-width", vox.halfWidth, "narrow band half width in voxels (>= 3)")
+        ->check(CLI::Range(3.0f, 64.0f));
+    voxelizeCmd->add_option("--color", vox.color, "constant linear RGB colour R,G,B")
+        ->delimiter(',')
+        ->expected(3);
+    voxelizeCmd->add_option("--memory-limit", vox.memoryLimitGiB,
+                            "refuse above this estimate, in GiB (default: half the machine's memory)")
+        ->check(CLI::PositiveNumber);
+    voxelizeCmd->add_option("--sign", vox.sign, "inside/outside: auto, floodfill or winding")
+        ->check(CLI::IsMember({"auto", "floodfill", "winding"}));
+    voxelizeCmd->add_flag("-q,--quiet", vox.quiet, "print nothing on success");
+
     try {
         app.parse(argc, argv);
     } catch (const CLI::ParseError& e) {
@@ -191,6 +295,10 @@ int main(int argc, char** argv)
 
     try {
         if (*check) return runCheck(scenePath);
+        if (*voxelizeCmd) return runVoxelize(vox);
+    } catch (const volmorph::Interrupted&) {
+        std::fprintf(stderr, "volmorph: interrupted; no output written\n");
+        return kExitInterrupted;
     } catch (const volmorph::UserError& e) {
         for (const volmorph::Diagnostic& d : e.diagnostics())
             std::fprintf(stderr, "%s\n", d.str().c_str());

@@ -53,6 +53,15 @@ Mesh importMesh(const std::filesystem::path& file,
                 const ObjectTransform& transform = {},
                 const SourceLocation& where = {});
 
+/// A scene's two meshes, imported with their transforms.
+struct SceneMeshes {
+    Mesh source, target;
+};
+
+/// Imports both meshes of `scene`; problems with either are all reported in one UserError, each
+/// at the scene's `mesh` key.
+SceneMeshes importSceneMeshes(const Scene& scene);
+
 /// Recomputes the topology part of the report (edges, orientation, components) for `mesh`.
 void analyzeTopology(Mesh& mesh);
 

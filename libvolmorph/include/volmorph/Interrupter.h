@@ -1,0 +1,38 @@
+// Progress and cancellation for long operations, in OpenVDB's interrupter form (start, end,
+// wasInterrupted(percent)) so the same object drives OpenVDB's tools and volmorph's own loops.
+#pragma once
+
+#include <openvdb/util/NullInterrupter.h>
+
+#include <atomic>
+#include <string>
+
+namespace volmorph {
+
+/// Cancels when requestStop() is called (e.g. from a SIGINT handler: it is async-signal-safe)
+/// and optionally prints progress to stderr.
+class Interrupter : public openvdb::util::NullInterrupter {
+public:
+    explicit Interrupter(bool reportProgress = false) : mReport(reportProgress) {}
+
+    void start(const char* name = nullptr) override;
+    void end() override;
+    bool wasInterrupted(int percent = -1) override;
+
+    /// Async-signal-safe: only stores to a lock-free atomic.
+    void requestStop() { mStop.store(true, std::memory_order_relaxed); }
+    bool stopRequested() const { return mStop.load(std::memory_order_relaxed); }
+
+private:
+    bool mReport;
+    std::string mName;
+    std::atomic<int> mLastPercent{-1};
+    std::atomic<bool> mStop{false};
+};
+
+/// Thrown by volmorph's own code when an Interrupter asked to stop.
+struct Interrupted : std::exception {
+    const char* what() const noexcept override { return "interrupted"; }
+};
+
+} // namespace volmorph

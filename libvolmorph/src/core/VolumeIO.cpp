@@ -1,0 +1,74 @@
+#include <volmorph/Diagnostics.h>
+#include <volmorph/VolumeSet.h>
+
+#include <openvdb/io/File.h>
+
+#include <unistd.h>
+
+#include <cstdio>
+#include <mutex>
+
+namespace volmorph {
+namespace {
+
+void initializeOpenVdb()
+{
+    static std::once_flag once;
+    std::call_once(once, [] { openvdb::initialize(); });
+}
+
+} // namespace
+
+void writeVolumeSet(const VolumeSet& volumes, const std::filesystem::path& path,
+                    const std::map<std::string, std::string>& metadata)
+{
+    initializeOpenVdb();
+    openvdb::GridPtrVec grids;
+    for (openvdb::GridBase::Ptr g : {openvdb::GridBase::Ptr(volumes.sdf), openvdb::GridBase::Ptr(volumes.density),
+                                     openvdb::GridBase::Ptr(volumes.color)}) {
+        if (!g) continue;
+        for (const auto& [key, value] : metadata) g->insertMeta(key, openvdb::StringMetadata(value));
+        grids.push_back(g);
+    }
+    // Write beside the final name, then rename: a reader never sees a partial file at `path`.
+    const std::filesystem::path temporary =
+        path.string() + ".partial-" + std::to_string(long(getpid()));
+    try {
+        openvdb::io::File file(temporary.string());
+        file.setCompression(openvdb::io::COMPRESS_BLOSC | openvdb::io::COMPRESS_ACTIVE_MASK);
+        file.write(grids);
+        file.close();
+    } catch (const std::exception& e) {
+        std::error_code ec;
+        std::filesystem::remove(temporary, ec);
+        throw UserError(SourceLocation{path.string()}, std::string("cannot write volume file (") + e.what() + ")");
+    }
+    std::error_code ec;
+    std::filesystem::rename(temporary, path, ec);
+    if (ec) {
+        std::filesystem::remove(temporary, ec);
+        throw UserError(SourceLocation{path.string()}, "cannot write volume file (" + ec.message() + ")");
+    }
+}
+
+VolumeSet readVolumeSet(const std::filesystem::path& path)
+{
+    initializeOpenVdb();
+    VolumeSet out;
+    try {
+        openvdb::io::File file(path.string());
+        file.open();
+        for (auto it = file.beginName(); it != file.endName(); ++it) {
+            const std::string name = it.gridName();
+            if (name == kSdfGridName) out.sdf = openvdb::gridPtrCast<openvdb::FloatGrid>(file.readGrid(name));
+            else if (name == kDensityGridName) out.density = openvdb::gridPtrCast<openvdb::FloatGrid>(file.readGrid(name));
+            else if (name == kColorGridName) out.color = openvdb::gridPtrCast<openvdb::Vec3SGrid>(file.readGrid(name));
+        }
+        file.close();
+    } catch (const std::exception& e) {
+        throw UserError(SourceLocation{path.string()}, std::string("cannot read volume file (") + e.what() + ")");
+    }
+    return out;
+}
+
+} // namespace volmorph

@@ -1,0 +1,39 @@
+#!/usr/bin/env python3
+"""Reads Google Benchmark JSON (with --benchmark_repetitions and aggregates) and prints, per
+case, the median times of an anchor and of volmorph and their ratio, as a Markdown table.
+
+usage: ratios.py RESULT.json ANCHOR_PREFIX VOLMORPH_PREFIX
+"""
+import json
+import sys
+
+
+def medians(path):
+    with open(path) as f:
+        data = json.load(f)
+    out = {}
+    for b in data["benchmarks"]:
+        if b.get("aggregate_name") != "median":
+            continue
+        name, _, args = b["run_name"].partition("/")
+        out[(name, args.replace("/real_time", ""))] = b
+    return out
+
+
+def main():
+    path, anchor, ours = sys.argv[1:4]
+    m = medians(path)
+    print("| case | %s (ms) | %s (ms) | ratio | active voxels (anchor / volmorph density) |" % (anchor, ours))
+    print("|---|---:|---:|---:|---|")
+    for (name, args), b in sorted(m.items(), key=lambda kv: kv[0][1]):
+        if name != anchor or (ours, args) not in m:
+            continue
+        o = m[(ours, args)]
+        label = b.get("label", "") + " " + args.split("/")[-1] + " across"
+        print("| %s | %.1f | %.1f | %.2f | %d / %d |" % (
+            label, b["real_time"], o["real_time"], o["real_time"] / b["real_time"],
+            b.get("density_active", 0), o.get("density_active", 0)))
+
+
+if __name__ == "__main__":
+    main()
