@@ -1,0 +1,62 @@
+// Morpher: (source VolumeSet, target VolumeSet, feature pairs, t) -> the in-between VolumeSet.
+//
+// At each t the output domain is found sparsely, each output voxel is warped back into source and
+// target (the approximated warp of src/warp/AdaptiveWarp.h, or the exact one), both are resampled
+// with OpenVDB's samplers, and blended: density by the density schedule, colour density-weighted
+// by the colour schedule (so no colour leaks in from the side that is empty there).
+#pragma once
+
+#include <volmorph/Interrupter.h>
+#include <volmorph/Scene.h>
+#include <volmorph/VolumeSet.h>
+
+#include <openvdb/math/Coord.h>
+
+namespace volmorph {
+
+struct MorphOptions {
+    enum class Sampling { Trilinear, Triquadratic };
+    Sampling sampling = Sampling::Trilinear;
+};
+
+struct MorphStats {
+    double maxWarpErrorVoxels = 0.0;   ///< largest error measured where the warp was interpolated
+    uint64_t exactEvaluations = 0;     ///< exact warp evaluations (a pair of points each)
+    uint64_t candidateLeaves = 0;      ///< output leaves evaluated
+    uint64_t outputLeaves = 0;         ///< output leaves kept (non-empty)
+    uint64_t activeVoxels = 0;         ///< of the density grid, tiles included
+};
+
+class Morpher {
+public:
+    /// Source and target must share one transform (voxelizeScene() makes them so).
+    Morpher(VolumeSet source, VolumeSet target, std::vector<FeaturePairSpec> pairs, WarpSpec warp,
+            BlendSpec blend, MorphOptions options = {});
+
+    /// The in-between at t in [0, 1]: grids `density` and `Cd` on the shared transform.
+    VolumeSet frame(double t, MorphStats* stats = nullptr, Interrupter* interrupter = nullptr) const;
+
+    /// The same, evaluated at every voxel of `box` (output index space) with no domain pruning and
+    /// the given tolerance: the reference that tests compare frame() against.
+    VolumeSet frameOverBox(double t, const openvdb::CoordBBox& box, double toleranceVoxels,
+                           MorphStats* stats = nullptr) const;
+
+    /// The index-space box the output at t can occupy: the active bounds of source and target,
+    /// mapped by every pair's affine map (each pair alone is affine), all together, plus a margin.
+    openvdb::CoordBBox candidateBounds(double t) const;
+
+    const VolumeSet& source() const { return mSource; }
+    const VolumeSet& target() const { return mTarget; }
+
+private:
+    VolumeSet run(double t, const openvdb::CoordBBox& box, bool prune, double tolerance, MorphStats* stats,
+                  Interrupter* interrupter) const;
+
+    VolumeSet mSource, mTarget;
+    std::vector<FeaturePairSpec> mPairs;
+    WarpSpec mWarp;
+    BlendSpec mBlend;
+    MorphOptions mOptions;
+};
+
+} // namespace volmorph

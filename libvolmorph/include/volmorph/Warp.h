@@ -1,0 +1,52 @@
+// The inverse warp of feature-based volume morphing.
+//
+// For an output point p' and pair i with interpolated element e'_i: u = R'^T (p' - c') / s', and the
+// pair maps p' to p_i = c + R (u * s) on each side (an affine map). The warped point is
+// sum w_i p_i / sum w_i with w_i = (d(p', e'_i) + epsilon)^-2, or Beier-Neely's
+// (length^p / (a + d))^b. With no pairs the warp is the identity; at t = 0 the source side is the
+// identity, at t = 1 the target side.
+#pragma once
+
+#include <volmorph/Feature.h>
+
+#include <vector>
+
+namespace volmorph {
+
+class InverseWarp {
+public:
+    /// Pairs at time t. `unit` scales lengths: 1 for world units, 1 / voxel size for index space
+    /// (the normalized weights do not depend on it; epsilon and a are scaled with it).
+    InverseWarp(const std::vector<FeaturePairSpec>& pairs, const WarpSpec& spec, double t, double unit = 1.0);
+
+    /// The exact warp: p' -> (source point, target point).
+    void map(const Vec3d& p, Vec3d& source, Vec3d& target) const;
+
+    size_t pairCount() const { return mPairs.size(); }
+    const Feature& interpolated(size_t i) const { return mPairs[i].element; }
+
+    /// The affine map of pair i on each side, as p -> M p + b, for bounding the output domain.
+    struct Affine {
+        Vec3d col[3];  ///< columns of M
+        Vec3d offset;  ///< b
+        Vec3d apply(const Vec3d& p) const { return col[0] * p.x() + col[1] * p.y() + col[2] * p.z() + offset; }
+    };
+    Affine sourceAffine(size_t i) const;
+    Affine targetAffine(size_t i) const;
+
+private:
+    struct Pair {
+        Feature element;      ///< interpolated at t
+        Vec3d toSource[3];    ///< R_S diag(s_S / s') as columns: p_S = c_S + toSource * q
+        Vec3d toTarget[3];
+        Vec3d sourceOrigin, targetOrigin;
+        double lengthPow = 1; ///< length^p, Beier-Neely only
+    };
+    double weight(const Pair& pair, double distance) const;
+
+    std::vector<Pair> mPairs;
+    Weighting mWeighting;
+    double mEpsilon, mA, mB;
+};
+
+} // namespace volmorph

@@ -1,0 +1,188 @@
+// Domain, warp, resample, blend. One of the few translation units with OpenVDB's tools headers.
+#include <volmorph/Morph.h>
+#include <volmorph/Warp.h>
+
+#include "warp/AdaptiveWarp.h"
+
+#include <openvdb/tools/Interpolation.h>
+#include <openvdb/tools/Prune.h>
+
+#include <memory>
+#include <mutex>
+
+namespace volmorph {
+namespace {
+
+using openvdb::Coord;
+using openvdb::CoordBBox;
+using openvdb::FloatTree;
+using openvdb::Vec3STree;
+
+/// Densities at or below this are empty (a trilinear sample at the edge of a fog's support).
+constexpr float kEmpty = 1e-6f;
+
+CoordBBox boundsOf(const VolumeSet& v) { return detail::Occupancy(v.density->tree()).bounds(); }
+
+/// The box of the 8 corners of `box` under p -> M^-1 (p - b), M and b of `a`.
+CoordBBox inverseImage(const InverseWarp::Affine& a, const CoordBBox& box)
+{
+    const openvdb::math::Mat3d m(a.col[0], a.col[1], a.col[2], /*rows=*/false);
+    const openvdb::math::Mat3d inv = m.inverse();
+    Vec3d lo(std::numeric_limits<double>::max()), hi(-std::numeric_limits<double>::max());
+    for (int k = 0; k < 8; ++k) {
+        const Vec3d p((k & 1) ? box.max().x() : box.min().x(), (k & 2) ? box.max().y() : box.min().y(),
+                      (k & 4) ? box.max().z() : box.min().z());
+        const Vec3d d = p - a.offset;
+        const Vec3d q(inv(0, 0) * d.x() + inv(0, 1) * d.y() + inv(0, 2) * d.z(),
+                      inv(1, 0) * d.x() + inv(1, 1) * d.y() + inv(1, 2) * d.z(),
+                      inv(2, 0) * d.x() + inv(2, 1) * d.y() + inv(2, 2) * d.z());
+        lo = minComponent(lo, q);
+        hi = maxComponent(hi, q);
+    }
+    auto clampInt = [](double v) { return int(std::clamp(v, -1.0e8, 1.0e8)); };
+    return CoordBBox(Coord(clampInt(std::floor(lo.x())), clampInt(std::floor(lo.y())), clampInt(std::floor(lo.z()))),
+                     Coord(clampInt(std::ceil(hi.x())), clampInt(std::ceil(hi.y())), clampInt(std::ceil(hi.z()))));
+}
+
+template <typename Sampler>
+struct Resampler {
+    const VolumeSet& source;
+    const VolumeSet& target;
+    float tauDensity, tauColor;
+    Vec3f background;
+
+    /// Fills one output leaf pair; returns false when every voxel is empty.
+    bool operator()(const detail::WarpLeaf& w, FloatTree::LeafNodeType& density, Vec3STree::LeafNodeType& color) const
+    {
+        auto ds = source.density->getConstAccessor();
+        auto dt = target.density->getConstAccessor();
+        auto cs = source.color->getConstAccessor();
+        auto ct = target.color->getConstAccessor();
+        bool any = false;
+        for (openvdb::Index n = 0; n < 512; ++n) {
+            const openvdb::Vec3R ps(w.source[n]), pt(w.target[n]);
+            const float a = Sampler::sample(ds, ps);
+            const float b = Sampler::sample(dt, pt);
+            const float d = (1.0f - tauDensity) * a + tauDensity * b;
+            if (!(d > kEmpty)) continue;
+            // Colour weighted by each side's density, so an empty side contributes no colour.
+            const float wa = (1.0f - tauColor) * std::max(a, 0.0f), wb = tauColor * std::max(b, 0.0f);
+            Vec3f c = background;
+            if (wa + wb > 0.0f) {
+                const Vec3f ca = wa > 0.0f ? Sampler::sample(cs, ps) : Vec3f(0.0f);
+                const Vec3f cb = wb > 0.0f ? Sampler::sample(ct, pt) : Vec3f(0.0f);
+                c = (wa * ca + wb * cb) / (wa + wb);
+            }
+            density.setValueOn(n, d);
+            color.setValueOn(n, c);
+            any = true;
+        }
+        return any;
+    }
+};
+
+} // namespace
+
+Morpher::Morpher(VolumeSet source, VolumeSet target, std::vector<FeaturePairSpec> pairs, WarpSpec warp,
+                 BlendSpec blend, MorphOptions options)
+    : mSource(std::move(source)), mTarget(std::move(target)), mPairs(std::move(pairs)), mWarp(warp),
+      mBlend(std::move(blend)), mOptions(options)
+{
+    if (!mSource.density || !mTarget.density || !mSource.color || !mTarget.color)
+        throw std::invalid_argument("Morpher: source and target need density and Cd grids");
+    if (!(mSource.density->transform() == mTarget.density->transform()))
+        throw std::invalid_argument("Morpher: source and target must share one transform");
+}
+
+CoordBBox Morpher::candidateBounds(double t) const
+{
+    const CoordBBox s = boundsOf(mSource), d = boundsOf(mTarget);
+    CoordBBox box;
+    if (!s.empty()) box.expand(s);
+    if (!d.empty()) box.expand(d);
+    const InverseWarp warp(mPairs, mWarp, t, 1.0 / mSource.voxelSize());
+    for (size_t i = 0; i < warp.pairCount(); ++i) {
+        if (!s.empty()) box.expand(inverseImage(warp.sourceAffine(i), s));
+        if (!d.empty()) box.expand(inverseImage(warp.targetAffine(i), d));
+    }
+    if (box.empty()) return box;
+    // The blend of several affine maps can reach a little past each one's image.
+    const Coord dim = box.dim();
+    const Coord margin(16 + dim.x() / 8, 16 + dim.y() / 8, 16 + dim.z() / 8);
+    return CoordBBox(box.min() - margin, box.max() + margin);
+}
+
+VolumeSet Morpher::frame(double t, MorphStats* stats, Interrupter* interrupter) const
+{
+    return run(t, candidateBounds(t), true, mWarp.toleranceVoxels, stats, interrupter);
+}
+
+VolumeSet Morpher::frameOverBox(double t, const CoordBBox& box, double tolerance, MorphStats* stats) const
+{
+    return run(t, box, false, tolerance, stats, nullptr);
+}
+
+VolumeSet Morpher::run(double t, const CoordBBox& box, bool prune, double tolerance, MorphStats* stats,
+                       Interrupter* interrupter) const
+{
+    const InverseWarp warp(mPairs, mWarp, t, 1.0 / mSource.voxelSize());
+    const detail::AdaptiveWarp adaptive(warp, tolerance);
+    // The occupancies do not depend on t; they are cheap next to a frame (one pass over leaves).
+    std::unique_ptr<detail::Occupancy> occS, occT;
+    if (prune) {
+        occS = std::make_unique<detail::Occupancy>(mSource.density->tree());
+        occT = std::make_unique<detail::Occupancy>(mTarget.density->tree());
+    }
+    const float tauD = float(mBlend.density.evaluate(t)), tauC = float(mBlend.color.evaluate(t));
+    const Vec3f background = (1.0f - tauC) * mSource.color->background() + tauC * mTarget.color->background();
+
+    std::mutex collect;
+    std::vector<std::pair<FloatTree::LeafNodeType*, Vec3STree::LeafNodeType*>> leaves;
+    auto each = [&](auto resampler) {
+        return [&, resampler](const detail::WarpLeaf& w) {
+            auto density = std::make_unique<FloatTree::LeafNodeType>(w.origin, 0.0f, false);
+            auto color = std::make_unique<Vec3STree::LeafNodeType>(w.origin, background, false);
+            if (!resampler(w, *density, *color)) return;
+            std::lock_guard<std::mutex> lock(collect);
+            leaves.emplace_back(density.release(), color.release());
+        };
+    };
+    detail::AdaptiveWarpStats warpStats;
+    if (mOptions.sampling == MorphOptions::Sampling::Triquadratic)
+        adaptive.forEachLeaf(box, occS.get(), occT.get(),
+                             each(Resampler<openvdb::tools::QuadraticSampler>{mSource, mTarget, tauD, tauC, background}),
+                             &warpStats, interrupter);
+    else
+        adaptive.forEachLeaf(box, occS.get(), occT.get(),
+                             each(Resampler<openvdb::tools::BoxSampler>{mSource, mTarget, tauD, tauC, background}),
+                             &warpStats, interrupter);
+
+    VolumeSet out;
+    out.density = openvdb::FloatGrid::create(0.0f);
+    out.color = openvdb::Vec3SGrid::create(background);
+    for (auto& [density, color] : leaves) {
+        out.density->tree().addLeaf(density);
+        out.color->tree().addLeaf(color);
+    }
+    // Leaves of constant interior collapse back into tiles.
+    openvdb::tools::prune(out.density->tree());
+    openvdb::tools::prune(out.color->tree());
+    for (openvdb::GridBase* g : {static_cast<openvdb::GridBase*>(out.density.get()),
+                                 static_cast<openvdb::GridBase*>(out.color.get())})
+        g->setTransform(mSource.density->transform().copy());
+    out.density->setName(kDensityGridName);
+    out.density->setGridClass(openvdb::GRID_FOG_VOLUME);
+    out.color->setName(kColorGridName);
+    out.color->setVectorType(openvdb::VEC_INVARIANT);
+
+    if (stats) {
+        stats->maxWarpErrorVoxels = warpStats.maxErrorVoxels;
+        stats->exactEvaluations = warpStats.exactEvaluations;
+        stats->candidateLeaves = warpStats.leaves;
+        stats->outputLeaves = leaves.size();
+        stats->activeVoxels = out.density->activeVoxelCount();
+    }
+    return out;
+}
+
+} // namespace volmorph

@@ -1,0 +1,109 @@
+#include <volmorph/Warp.h>
+
+#include <cmath>
+#include <limits>
+
+namespace volmorph {
+namespace {
+
+/// Below this, d + epsilon counts as zero: the point lies on an element and that pair alone
+/// decides (with several such pairs, their mean). Keeps every weight finite when epsilon = 0.
+constexpr double kOnElement = 1e-12;
+
+} // namespace
+
+InverseWarp::InverseWarp(const std::vector<FeaturePairSpec>& pairs, const WarpSpec& spec, double t, double unit)
+    : mWeighting(spec.weighting), mEpsilon(spec.epsilon * unit), mA(spec.a * unit), mB(spec.b)
+{
+    mPairs.reserve(pairs.size());
+    for (const FeaturePairSpec& spec_ : pairs) {
+        const Feature s = Feature::fromElement(spec_.source, spec_.type).scaled(unit);
+        const Feature d = Feature::fromElement(spec_.target, spec_.type).scaled(unit);
+        Pair p;
+        p.element = interpolate(s, d, t);
+        const Vec3d& e = p.element.scale;
+        for (int k = 0; k < 3; ++k) {
+            const Vec3d& sAxis = k == 0 ? s.x : k == 1 ? s.y : s.z;
+            const Vec3d& tAxis = k == 0 ? d.x : k == 1 ? d.y : d.z;
+            p.toSource[k] = sAxis * (s.scale[k] / e[k]);
+            p.toTarget[k] = tAxis * (d.scale[k] / e[k]);
+        }
+        p.sourceOrigin = s.origin;
+        p.targetOrigin = d.origin;
+        p.lengthPow = std::pow(p.element.length(), spec.p);
+        mPairs.push_back(p);
+    }
+}
+
+double InverseWarp::weight(const Pair& pair, double distance) const
+{
+    if (mWeighting == Weighting::InverseSquare) {
+        const double r = distance + mEpsilon;
+        return 1.0 / (r * r);
+    }
+    return std::pow(pair.lengthPow / (mA + distance), mB);
+}
+
+void InverseWarp::map(const Vec3d& p, Vec3d& source, Vec3d& target) const
+{
+    if (mPairs.empty()) {
+        source = target = p;
+        return;
+    }
+    Vec3d sumS(0.0), sumT(0.0);
+    double sumW = 0.0;
+    Vec3d hitS(0.0), hitT(0.0);
+    int hits = 0;
+    for (const Pair& pair : mPairs) {
+        const Vec3d q = pair.element.frameCoordinates(p);
+        const Vec3d ps = pair.sourceOrigin + pair.toSource[0] * q.x() + pair.toSource[1] * q.y() + pair.toSource[2] * q.z();
+        const Vec3d pt = pair.targetOrigin + pair.toTarget[0] * q.x() + pair.toTarget[1] * q.y() + pair.toTarget[2] * q.z();
+        const double d = pair.element.distanceInFrame(q);
+        if (mWeighting == Weighting::InverseSquare && d + mEpsilon < kOnElement) {
+            hitS += ps;
+            hitT += pt;
+            ++hits;
+            continue;
+        }
+        const double w = weight(pair, d);
+        sumS += w * ps;
+        sumT += w * pt;
+        sumW += w;
+    }
+    if (hits > 0) {
+        source = hitS / double(hits);
+        target = hitT / double(hits);
+    } else {
+        source = sumS / sumW;
+        target = sumT / sumW;
+    }
+}
+
+namespace {
+
+/// p_side = c_side + T (R'^T (p - c')) as p -> M p + b: M = T R'^T, b = c_side - M c'.
+InverseWarp::Affine affineOf(const Feature& e, const Vec3d toSide[3], const Vec3d& sideOrigin)
+{
+    InverseWarp::Affine a;
+    for (int c = 0; c < 3; ++c) {
+        const Vec3d q(e.x[c], e.y[c], e.z[c]); // R'^T times the unit vector along axis c
+        a.col[c] = toSide[0] * q.x() + toSide[1] * q.y() + toSide[2] * q.z();
+    }
+    a.offset = Vec3d(0.0);
+    a.offset = sideOrigin - a.apply(e.origin);
+    return a;
+}
+
+} // namespace
+
+InverseWarp::Affine InverseWarp::sourceAffine(size_t i) const
+{
+    return affineOf(mPairs[i].element, mPairs[i].toSource, mPairs[i].sourceOrigin);
+}
+
+InverseWarp::Affine InverseWarp::targetAffine(size_t i) const
+{
+    return affineOf(mPairs[i].element, mPairs[i].toTarget, mPairs[i].targetOrigin);
+}
+
+} // namespace volmorph

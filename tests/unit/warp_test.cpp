@@ -1,0 +1,385 @@
+#include <volmorph/Feature.h>
+#include <volmorph/Morph.h>
+#include <volmorph/Voxelize.h>
+#include <volmorph/Warp.h>
+
+#include "warp/AdaptiveWarp.h" // private to the library; tested directly
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+#include <mutex>
+#include <random>
+
+using namespace volmorph;
+
+namespace {
+
+const std::filesystem::path kMeshes = std::filesystem::path(VOLMORPH_SOURCE_DIR) / "scenes" / "meshes";
+
+FeatureElement element(const Vec3d& origin, const Vec3d& x = Vec3d(1, 0, 0), const Vec3d& y = Vec3d(0, 1, 0),
+                       const Vec3d& scale = Vec3d(1.0))
+{
+    FeatureElement e;
+    e.origin = origin;
+    e.xAxis = x.unit();
+    e.yAxis = y.unit();
+    e.zAxis = e.xAxis.cross(e.yAxis);
+    e.scale = scale;
+    return e;
+}
+
+FeaturePairSpec pair(FeatureType type, const FeatureElement& s, const FeatureElement& t)
+{
+    FeaturePairSpec p;
+    p.type = type;
+    p.source = s;
+    p.target = t;
+    return p;
+}
+
+VolumeSet voxelized(const std::string& mesh, double voxelSize, const ObjectTransform& xf = {})
+{
+    VoxelizeOptions o;
+    o.voxelSize = voxelSize;
+    return voxelize(importMesh(kMeshes / mesh, xf), o);
+}
+
+struct Moments {
+    double mass = 0.0;
+    Vec3d centroid{0.0};
+    double ixx = 0, iyy = 0, ixy = 0; ///< central second moments in the xy plane
+};
+
+Moments moments(const openvdb::FloatGrid& density)
+{
+    Moments m;
+    std::vector<std::pair<Vec3d, double>> samples;
+    for (auto it = density.cbeginValueOn(); it; ++it) {
+        const openvdb::CoordBBox b = it.getBoundingBox();
+        if (it.isVoxelValue()) {
+            samples.emplace_back(density.indexToWorld(it.getCoord()), double(*it));
+        } else {
+            for (auto c = b.begin(); c; ++c) samples.emplace_back(density.indexToWorld(*c), double(*it));
+        }
+    }
+    for (const auto& [p, w] : samples) {
+        m.mass += w;
+        m.centroid += w * p;
+    }
+    m.centroid /= m.mass;
+    for (const auto& [p, w] : samples) {
+        const Vec3d d = p - m.centroid;
+        m.ixx += w * d.x() * d.x();
+        m.iyy += w * d.y() * d.y();
+        m.ixy += w * d.x() * d.y();
+    }
+    return m;
+}
+
+/// Largest |a - b| of two density grids over the union of their active voxels.
+double maxDifference(const openvdb::FloatGrid& a, const openvdb::FloatGrid& b)
+{
+    double worst = 0.0;
+    auto ba = b.getConstAccessor();
+    for (auto it = a.cbeginValueOn(); it; ++it)
+        for (auto c = it.getBoundingBox().begin(); c; ++c)
+            worst = std::max(worst, double(std::abs(a.tree().getValue(*c) - ba.getValue(*c))));
+    auto aa = a.getConstAccessor();
+    for (auto it = b.cbeginValueOn(); it; ++it)
+        for (auto c = it.getBoundingBox().begin(); c; ++c)
+            worst = std::max(worst, double(std::abs(aa.getValue(*c) - b.tree().getValue(*c))));
+    return worst;
+}
+
+/// Rodrigues' rotation of v about the unit axis k by angle (radians).
+Vec3d rotate(const Vec3d& v, const Vec3d& k, double angle)
+{
+    return v * std::cos(angle) + k.cross(v) * std::sin(angle) + k * (k.dot(v) * (1.0 - std::cos(angle)));
+}
+
+/// A random configuration of n pairs of random types inside a cube of `extent` units, made the way
+/// a user makes them: each target element is its source element moved by up to a quarter of the
+/// extent, scaled by 0.6 to 1.6 per axis and turned by up to 60 degrees.
+std::vector<FeaturePairSpec> randomPairs(std::mt19937& random, int n, double extent)
+{
+    std::uniform_real_distribution<double> u(0.0, 1.0);
+    auto vec = [&] { return Vec3d(u(random), u(random), u(random)); };
+    auto direction = [&] {
+        Vec3d d = vec() - Vec3d(0.5);
+        while (d.length() < 0.1) d = vec() - Vec3d(0.5);
+        return d.unit();
+    };
+    std::vector<FeaturePairSpec> pairs;
+    for (int i = 0; i < n; ++i) {
+        FeaturePairSpec p;
+        p.type = FeatureType(random() % 4);
+        FeatureElement& s = p.source;
+        s.origin = vec() * extent;
+        s.xAxis = direction();
+        s.yAxis = s.xAxis.cross(direction()).unit();
+        s.zAxis = s.xAxis.cross(s.yAxis);
+        s.scale = (Vec3d(0.1) + vec()) * (extent / 4);
+        FeatureElement& t = p.target;
+        t.origin = s.origin + (vec() - Vec3d(0.5)) * (extent / 2);
+        const Vec3d axis = direction();
+        const double angle = (u(random) - 0.5) * (2.0 * M_PI / 3.0);
+        t.xAxis = rotate(s.xAxis, axis, angle);
+        t.yAxis = rotate(s.yAxis, axis, angle);
+        t.zAxis = t.xAxis.cross(t.yAxis);
+        const Vec3d factor = Vec3d(0.6) + vec();
+        t.scale = Vec3d(s.scale.x() * factor.x(), s.scale.y() * factor.y(), s.scale.z() * factor.z());
+        pairs.push_back(p);
+    }
+    return pairs;
+}
+
+} // namespace
+
+TEST(Feature, DistancePerType)
+{
+    Feature f;
+    f.scale = Vec3d(2, 1, 0.5);
+    f.type = FeatureType::Point;
+    EXPECT_DOUBLE_EQ(f.distance(Vec3d(3, 4, 0)), 5.0);
+    f.type = FeatureType::Segment; // x in [-1, 1]
+    EXPECT_DOUBLE_EQ(f.distance(Vec3d(0.5, 3, 4)), 5.0);
+    EXPECT_DOUBLE_EQ(f.distance(Vec3d(4, 0, 0)), 3.0);
+    f.type = FeatureType::Rectangle; // x in [-1, 1], y in [-0.5, 0.5], z = 0
+    EXPECT_DOUBLE_EQ(f.distance(Vec3d(0.5, 0.25, -2)), 2.0);
+    EXPECT_DOUBLE_EQ(f.distance(Vec3d(4, 4.5, 0)), 5.0);
+    f.type = FeatureType::Box; // z in [-0.25, 0.25] too
+    EXPECT_DOUBLE_EQ(f.distance(Vec3d(0.5, 0.25, 0.1)), 0.0);
+    EXPECT_DOUBLE_EQ(f.distance(Vec3d(0, 0, 2.25)), 2.0);
+}
+
+TEST(Feature, LocalCoordinatesRoundTrip)
+{
+    Feature f = Feature::fromElement(element(Vec3d(1, 2, 3), Vec3d(0, 0, 1), Vec3d(0, 1, 0), Vec3d(2, 3, 4)),
+                                     FeatureType::Box);
+    const Vec3d p(0.3, -1.2, 7.0);
+    EXPECT_NEAR((f.fromLocal(f.toLocal(p)) - p).length(), 0.0, 1e-12);
+    EXPECT_NEAR((f.toLocal(Vec3d(1, 2, 5)) - Vec3d(1.0, 0.0, 0.0)).length(), 0.0, 1e-12); // 2 along x = +z
+}
+
+TEST(Feature, SlerpTakesTheShorterArc)
+{
+    const Feature a = Feature::fromElement(element(Vec3d(0.0)), FeatureType::Box);
+    // b is rotated 90 degrees about z: x -> y.
+    const Feature b = Feature::fromElement(element(Vec3d(2, 0, 0), Vec3d(0, 1, 0), Vec3d(-1, 0, 0), Vec3d(3.0)),
+                                           FeatureType::Box);
+    const Feature m = interpolate(a, b, 0.5);
+    EXPECT_NEAR((m.x - Vec3d(std::sqrt(0.5), std::sqrt(0.5), 0)).length(), 0.0, 1e-9);
+    EXPECT_NEAR((m.z - Vec3d(0, 0, 1)).length(), 0.0, 1e-9);
+    EXPECT_NEAR((m.origin - Vec3d(1, 0, 0)).length(), 0.0, 1e-12);
+    EXPECT_NEAR((m.scale - Vec3d(2.0)).length(), 0.0, 1e-12);
+    // 270 degrees one way is 90 the other: the interpolant turns by -45 degrees, not +135.
+    const Feature c = Feature::fromElement(element(Vec3d(0.0), Vec3d(0, -1, 0), Vec3d(1, 0, 0)), FeatureType::Box);
+    const Feature h = interpolate(a, c, 0.5);
+    EXPECT_NEAR((h.x - Vec3d(std::sqrt(0.5), -std::sqrt(0.5), 0)).length(), 0.0, 1e-9);
+    EXPECT_NEAR(interpolate(a, c, 0.0).x.x(), 1.0, 1e-12);
+    EXPECT_NEAR((interpolate(a, c, 1.0).x - Vec3d(0, -1, 0)).length(), 0.0, 1e-12);
+}
+
+TEST(InverseWarp, NoPairsIsTheIdentity)
+{
+    const InverseWarp w({}, WarpSpec{}, 0.3);
+    Vec3d s, t;
+    w.map(Vec3d(1, 2, 3), s, t);
+    EXPECT_EQ(s, Vec3d(1, 2, 3));
+    EXPECT_EQ(t, Vec3d(1, 2, 3));
+}
+
+TEST(InverseWarp, OnePairIsAnAffineMap)
+{
+    // Source: a box at the origin along x. Target: scaled by 2 and rotated 90 degrees about z.
+    const auto p = pair(FeatureType::Box, element(Vec3d(0.0)),
+                        element(Vec3d(5, 0, 0), Vec3d(0, 1, 0), Vec3d(-1, 0, 0), Vec3d(2.0)));
+    const InverseWarp w({p}, WarpSpec{}, 1.0);
+    Vec3d s, t;
+    w.map(Vec3d(5, 2, 0), s, t); // at t = 1 the output is target space: the target side is the identity
+    EXPECT_NEAR((t - Vec3d(5, 2, 0)).length(), 0.0, 1e-12);
+    EXPECT_NEAR((s - Vec3d(1, 0, 0)).length(), 0.0, 1e-12); // 2 along target x (= +y) is 1 along source x
+    const InverseWarp w0({p}, WarpSpec{}, 0.0);
+    w0.map(Vec3d(0.5, 0.5, 0.5), s, t);
+    EXPECT_NEAR((s - Vec3d(0.5)).length(), 0.0, 1e-12);
+}
+
+TEST(InverseWarp, WeightsFollowTheInverseSquareLaw)
+{
+    // Two point pairs translating by +1 and -1 in x; halfway between them the two cancel.
+    const auto a = pair(FeatureType::Point, element(Vec3d(-1, 0, 0)), element(Vec3d(0, 0, 0)));
+    const auto b = pair(FeatureType::Point, element(Vec3d(1, 0, 0)), element(Vec3d(0, 0, 0)));
+    WarpSpec spec;
+    spec.epsilon = 0.0;
+    const InverseWarp w({a, b}, spec, 1.0);
+    Vec3d s, t;
+    w.map(Vec3d(0, 3, 0), s, t);
+    EXPECT_NEAR(s.x(), 0.0, 1e-12);
+    // At distance 1 from pair a's interpolated element and 3 from b's... both are at the origin at
+    // t = 1, so move off-centre: weights 1/d^2 are equal; use t = 0.5 with elements at -0.5 and 0.5.
+    const InverseWarp h({a, b}, spec, 0.5);
+    h.map(Vec3d(1.5, 0, 0), s, t); // d_a = 2, d_b = 1: w = 1/4 and 1
+    // pair a maps p -> p - 0.5, pair b maps p -> p + 0.5 on the source side.
+    EXPECT_NEAR(s.x(), (0.25 * 1.0 + 1.0 * 2.0) / 1.25, 1e-12);
+}
+
+TEST(InverseWarp, DegenerateInputsStayFinite)
+{
+    WarpSpec spec;
+    spec.epsilon = 0.0;
+    // Coincident features with different targets, and a point exactly on them with epsilon = 0.
+    const auto a = pair(FeatureType::Segment, element(Vec3d(0.0)), element(Vec3d(1, 0, 0)));
+    const auto b = pair(FeatureType::Segment, element(Vec3d(0.0)), element(Vec3d(-1, 0, 0)));
+    const auto c = pair(FeatureType::Point, element(Vec3d(2, 2, 2)), element(Vec3d(2, 2, 3)));
+    for (double t : {0.0, 0.5, 1.0}) {
+        const InverseWarp w({a, b, c}, spec, t);
+        for (const Vec3d& p : {Vec3d(0.0), Vec3d(0.2, 0, 0), Vec3d(2, 2, 2 + t), Vec3d(1e6, -1e6, 3)}) {
+            Vec3d s, d;
+            w.map(p, s, d);
+            for (int k = 0; k < 3; ++k) {
+                EXPECT_TRUE(std::isfinite(s[k]) && std::isfinite(d[k])) << p << " at t " << t;
+            }
+        }
+    }
+}
+
+TEST(AdaptiveWarp, WithinToleranceOfTheExactWarpOnRandomConfigurations)
+{
+    std::mt19937 random(2024);
+    for (int n : {1, 2, 4, 8, 16, 32, 64}) {
+        for (int trial = 0; trial < 2; ++trial) {
+            const auto pairs = randomPairs(random, n, 96.0);
+            WarpSpec spec;
+            spec.epsilon = 2.0; // index units here (unit = 1)
+            const double t = 0.25 + 0.5 * trial;
+            const InverseWarp warp(pairs, spec, t);
+            const double tolerance = 0.25;
+            const detail::AdaptiveWarp adaptive(warp, tolerance);
+            std::mutex m;
+            double worst = 0.0;
+            detail::AdaptiveWarpStats stats;
+            adaptive.forEachLeaf(openvdb::CoordBBox(openvdb::Coord(0), openvdb::Coord(95)), nullptr, nullptr,
+                                 [&](const detail::WarpLeaf& leaf) {
+                                     double local = 0.0;
+                                     Vec3d s, d;
+                                     for (int i = 0; i < 512; i += 7) { // a stride keeps the test quick
+                                         const openvdb::Coord c = leaf.origin.offsetBy(i >> 6, (i >> 3) & 7, i & 7);
+                                         warp.map(c.asVec3d(), s, d);
+                                         local = std::max({local, (Vec3d(leaf.source[i]) - s).length(),
+                                                           (Vec3d(leaf.target[i]) - d).length()});
+                                     }
+                                     std::lock_guard<std::mutex> lock(m);
+                                     worst = std::max(worst, local);
+                                 },
+                                 &stats);
+            EXPECT_LE(worst, tolerance) << n << " pairs, trial " << trial;
+            EXPECT_LE(stats.maxErrorVoxels, tolerance);
+            EXPECT_EQ(stats.leaves, 12u * 12u * 12u);
+        }
+    }
+}
+
+TEST(Morph, PointPairTranslatesTheSphereLinearly)
+{
+    const double voxel = 0.04;
+    ObjectTransform moved;
+    moved.translate = Vec3d(1, 0, 0);
+    const VolumeSet s = voxelized("sphere.obj", voxel), d = voxelized("sphere.obj", voxel, moved);
+    const Morpher morpher(s, d, {pair(FeatureType::Point, element(Vec3d(0.0)), element(Vec3d(1, 0, 0)))}, WarpSpec{},
+                          BlendSpec{});
+    const double c0 = moments(*s.density).centroid.x();
+    for (double t : {0.0, 0.25, 0.5, 0.75, 1.0}) {
+        const Moments m = moments(*morpher.frame(t).density);
+        EXPECT_NEAR(m.centroid.x() - c0, t, 0.1 * voxel) << "t " << t;
+        EXPECT_NEAR(m.centroid.y(), 0.0, 1e-3);
+    }
+}
+
+TEST(Morph, BoxPairRotatesThePrincipalAxis)
+{
+    // A bar along x becomes the same bar along y; halfway, it lies at 45 degrees.
+    const double voxel = 0.02;
+    ObjectTransform bar, turned;
+    bar.scale = Vec3d(1.0, 0.3, 0.3);
+    turned.scale = Vec3d(1.0, 0.3, 0.3);
+    turned.rotateRadians = Vec3d(0, 0, M_PI / 2);
+    const VolumeSet s = voxelized("cube.obj", voxel, bar), d = voxelized("cube.obj", voxel, turned);
+    const auto p = pair(FeatureType::Box, element(Vec3d(0.0), Vec3d(1, 0, 0), Vec3d(0, 1, 0), Vec3d(1, 0.3, 0.3)),
+                        element(Vec3d(0.0), Vec3d(0, 1, 0), Vec3d(-1, 0, 0), Vec3d(1, 0.3, 0.3)));
+    const Morpher morpher(s, d, {p}, WarpSpec{}, BlendSpec{});
+    const Moments m = moments(*morpher.frame(0.5).density);
+    const double angle = 0.5 * std::atan2(2.0 * m.ixy, m.ixx - m.iyy);
+    EXPECT_NEAR(angle * 180.0 / M_PI, 45.0, 0.5);
+    EXPECT_NEAR(m.mass * std::pow(voxel, 3), 0.09, 0.09 * 0.02); // the bar's volume (1 x 0.3 x 0.3) is kept
+}
+
+TEST(Morph, ScalingPairScalesTheVolumeCubically)
+{
+    const double voxel = 0.02;
+    ObjectTransform twice;
+    twice.scale = Vec3d(2.0);
+    const VolumeSet s = voxelized("sphere.obj", voxel), d = voxelized("sphere.obj", voxel, twice);
+    const auto p = pair(FeatureType::Box, element(Vec3d(0.0)), element(Vec3d(0.0), Vec3d(1, 0, 0), Vec3d(0, 1, 0), Vec3d(2.0)));
+    const Morpher morpher(s, d, {p}, WarpSpec{}, BlendSpec{});
+    const double v0 = moments(*s.density).mass;
+    for (double t : {0.25, 0.5, 0.75}) {
+        const double scale = 1.0 + t;
+        EXPECT_NEAR(moments(*morpher.frame(t).density).mass / v0, scale * scale * scale, 0.02 * scale * scale * scale)
+            << "t " << t;
+    }
+}
+
+TEST(Morph, IdenticalSidesGiveTheSourceAtEveryFrame)
+{
+    const VolumeSet s = voxelized("bunny.obj", 0.3); // the scan is 10 units tall: ~33 voxels
+    std::mt19937 random(5);
+    auto pairs = randomPairs(random, 6, 10.0);
+    for (auto& p : pairs) p.target = p.source;
+    const Morpher morpher(s, s, pairs, WarpSpec{}, BlendSpec{});
+    for (double t : {0.0, 0.3, 0.7, 1.0}) EXPECT_LT(maxDifference(*morpher.frame(t).density, *s.density), 1e-5) << t;
+}
+
+TEST(Morph, EndsAreSourceAndTarget)
+{
+    ObjectTransform xf;
+    xf.scale = Vec3d(0.1);
+    const double voxel = 0.02;
+    const VolumeSet s = voxelized("bunny.obj", voxel, xf);
+    ObjectTransform up;
+    up.translate = Vec3d(0, 0.5, 0);
+    const VolumeSet d = voxelized("knot1.off", voxel, up);
+    const Scene scene = loadScene(std::filesystem::path(VOLMORPH_SOURCE_DIR) / "scenes" / "bunny-to-knot.toml");
+    const Morpher morpher(s, d, scene.pairs, scene.warp, scene.blend);
+    EXPECT_LT(maxDifference(*morpher.frame(0.0).density, *s.density), 1e-4);
+    EXPECT_LT(maxDifference(*morpher.frame(1.0).density, *d.density), 1e-4);
+}
+
+TEST(Morph, SparseDomainLosesNothing)
+{
+    const double voxel = 0.05;
+    const VolumeSet s = voxelized("sphere.obj", voxel);
+    ObjectTransform xf;
+    xf.translate = Vec3d(0.8, 0.2, 0);
+    xf.scale = Vec3d(0.7);
+    const VolumeSet d = voxelized("cube.obj", voxel, xf);
+    std::mt19937 random(11);
+    for (int trial = 0; trial < 6; ++trial) {
+        auto pairs = randomPairs(random, 1 + trial * 3, 1.0);
+        for (auto& p : pairs) { // world units here: origins and scales inside the objects' region
+            for (FeatureElement* e : {&p.source, &p.target}) e->origin -= Vec3d(0.3);
+        }
+        WarpSpec spec;
+        spec.epsilon = 0.05;
+        const Morpher morpher(s, d, pairs, spec, BlendSpec{});
+        const double t = (trial % 3 + 1) * 0.25;
+        MorphStats sparseStats, denseStats;
+        const VolumeSet sparse = morpher.frame(t, &sparseStats);
+        openvdb::CoordBBox big = morpher.candidateBounds(t);
+        big.expand(big.dim().x() / 4); // well past the candidate box
+        const VolumeSet dense = morpher.frameOverBox(t, big, spec.toleranceVoxels, &denseStats);
+        EXPECT_EQ(maxDifference(*sparse.density, *dense.density), 0.0) << "trial " << trial;
+        EXPECT_LT(sparseStats.candidateLeaves, denseStats.candidateLeaves);
+    }
+}
