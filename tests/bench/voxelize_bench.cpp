@@ -81,12 +81,3 @@ void arguments(benchmark::internal::Benchmark* b)
 
 BENCHMARK(openvdbLevelSetAndFog)->Apply(arguments);
 BENCHMARK(volmorphVoxelize)->Apply(arguments);
-
-int main(int argc, char** argv)
-{
-    openvdb::initialize();
-    benchmark::Initialize(&argc, argv);
-    benchmark::RunSpecifiedBenchmarks();
-    benchmark::Shutdown();
-    return 0;
-}

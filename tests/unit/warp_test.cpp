@@ -256,7 +256,7 @@ TEST(AdaptiveWarp, WithinToleranceOfTheExactWarpOnRandomConfigurations)
             const double t = 0.25 + 0.5 * trial;
             const InverseWarp warp(pairs, spec, t);
             const double tolerance = 0.25;
-            const detail::AdaptiveWarp adaptive(warp, tolerance);
+            const detail::AdaptiveWarp adaptive(warp, tolerance, spec.epsilon);
             std::mutex m;
             double worst = 0.0;
             detail::AdaptiveWarpStats stats;

@@ -125,8 +125,9 @@ VolumeSet Morpher::frameOverBox(double t, const CoordBBox& box, double tolerance
 VolumeSet Morpher::run(double t, const CoordBBox& box, bool prune, double tolerance, MorphStats* stats,
                        Interrupter* interrupter) const
 {
-    const InverseWarp warp(mPairs, mWarp, t, 1.0 / mSource.voxelSize());
-    const detail::AdaptiveWarp adaptive(warp, tolerance);
+    const double voxel = mSource.voxelSize();
+    const InverseWarp warp(mPairs, mWarp, t, 1.0 / voxel);
+    const detail::AdaptiveWarp adaptive(warp, tolerance, mWarp.epsilon / voxel);
     // The occupancies do not depend on t; they are cheap next to a frame (one pass over leaves).
     std::unique_ptr<detail::Occupancy> occS, occT;
     if (prune) {

@@ -3,6 +3,7 @@
 // The parser keeps going after a problem so that every error in a file is reported at once, each at
 // the line and column of the offending key or value (toml++ records both for every node). A TOML
 // syntax error stops parsing: after one, toml++ has no tree to check.
+#include <volmorph/Frames.h>
 #include <volmorph/Scene.h>
 
 #include <toml++/toml.h>
@@ -696,6 +697,8 @@ private:
         if (f.count() > 1 && !hasPlaceholder)
             r.error(where, "frames.output: \"" + f.output + "\" has no frame number placeholder "
                            "(#### or %04d) for a range of " + std::to_string(f.count()) + " frames");
+        if (const std::string why = checkFramePattern(f.output); !why.empty())
+            r.error(where, "frames.output: \"" + f.output + "\": " + why);
         if (std::filesystem::path(f.output).extension() != ".exr")
             r.error(where, "frames.output: expected a file name ending in .exr, got \"" + f.output + "\"");
     }

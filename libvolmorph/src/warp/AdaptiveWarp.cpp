@@ -20,6 +20,9 @@ using openvdb::CoordBBox;
 /// measure every voxel against the exact warp).
 constexpr double kSafety = 0.5;
 
+/// A cell may be interpolated only when size <= kKappa * (d_min + epsilon) for every element.
+constexpr double kKappa = 0.5;
+
 /// Floor division by 8 (block coordinates), correct for negative coordinates.
 inline int block(int v) { return v >= 0 ? v / 8 : -((-v + 7) / 8); }
 
@@ -96,9 +99,32 @@ struct AdaptiveWarp::Context {
     };
 };
 
-AdaptiveWarp::AdaptiveWarp(const InverseWarp& warp, double toleranceVoxels)
-    : mWarp(warp), mTolerance(toleranceVoxels)
+AdaptiveWarp::AdaptiveWarp(const InverseWarp& warp, double toleranceVoxels, double epsilonVoxels)
+    : mWarp(warp), mTolerance(toleranceVoxels), mEpsilon(epsilonVoxels)
 {
+}
+
+bool AdaptiveWarp::nearElement(const Coord& origin, int size) const
+{
+    if (mWarp.pairCount() < 2) return false; // one pair: the warp is its affine map, exactly trilinear
+    const double half = 0.5 * size;
+    const Vec3d centre(origin.x() + half, origin.y() + half, origin.z() + half);
+    const double reach = half * std::sqrt(3.0); // the distance is 1-Lipschitz: it changes by at most this
+    for (size_t i = 0; i < mWarp.pairCount(); ++i) {
+        const Feature& e = mWarp.interpolated(i);
+        const double dMin = std::max(0.0, e.distance(centre) - reach);
+        if (double(size) <= kKappa * (dMin + mEpsilon)) continue;
+        if (e.type == FeatureType::Box) {
+            // Wholly inside the box (convex: all corners inside), d = 0 and the weight is constant.
+            bool inside = true;
+            for (int k = 0; k < 8 && inside; ++k)
+                inside = e.distance(Vec3d(origin.x() + (k & 1) * size, origin.y() + ((k >> 1) & 1) * size,
+                                          origin.z() + ((k >> 2) & 1) * size)) == 0.0;
+            if (inside) continue;
+        }
+        return true;
+    }
+    return false;
 }
 
 namespace {
@@ -175,7 +201,7 @@ void AdaptiveWarp::cell(Context& ctx, const Coord& origin, int size, const Corne
                           (ctx.target && ctx.target->anyIn(imageBox(l.t, margin)));
         if (!keep) return;
     }
-    const bool lock = locked || (mTolerance > 0.0 && error <= kSafety * mTolerance);
+    const bool lock = locked || (mTolerance > 0.0 && error <= kSafety * mTolerance && !nearElement(origin, size));
     if (lock && !locked) ctx.maxError = std::max(ctx.maxError, error);
 
     if (size > 8) {
@@ -192,63 +218,67 @@ void AdaptiveWarp::cell(Context& ctx, const Coord& origin, int size, const Corne
     ctx.leaf.origin = origin;
     ++ctx.leaves;
     if (mTolerance == 0.0) {
-        // Exact: every voxel on its own.
-        Vec3d s, t;
-        for (int i = 0; i < 8; ++i)
-            for (int j = 0; j < 8; ++j)
-                for (int k = 0; k < 8; ++k) {
-                    mWarp.map(Vec3d(origin.x() + i, origin.y() + j, origin.z() + k), s, t);
-                    ctx.leaf.source[(i * 8 + j) * 8 + k] = Vec3f(s);
-                    ctx.leaf.target[(i * 8 + j) * 8 + k] = Vec3f(t);
-                }
-        ctx.evaluations += 512;
+        exactBlock(ctx, origin, 8);
+    } else if (lock) {
+        fillTrilinear(ctx, origin, 8, corners);
     } else {
-        leafWithin(ctx, origin, 8, corners, lock);
+        // The leaf's lattice is already known: its 8 children of 4^3 take their corners from it.
+        Corners child;
+        for (int cz = 0; cz < 2; ++cz)
+            for (int cy = 0; cy < 2; ++cy)
+                for (int cx = 0; cx < 2; ++cx) {
+                    childCorners(l.s, l.t, cx, cy, cz, child.s, child.t);
+                    quarter(ctx, origin.offsetBy(cx * 4, cy * 4, cz * 4), child);
+                }
     }
     (*ctx.fn)(ctx.leaf);
 }
 
-void AdaptiveWarp::leafWithin(Context& ctx, const Coord& origin, int size, const Corners& corners, bool accept) const
+void AdaptiveWarp::exactBlock(Context& ctx, const Coord& origin, int size) const
 {
     const Coord local = origin - ctx.leaf.origin;
-    if (accept) {
-        const double step = 1.0 / double(size);
-        for (int i = 0; i < size; ++i)
-            for (int j = 0; j < size; ++j)
-                for (int k = 0; k < size; ++k) {
-                    const int n = ((local.x() + i) * 8 + local.y() + j) * 8 + local.z() + k;
-                    ctx.leaf.source[n] = Vec3f(trilinear(corners.s, i * step, j * step, k * step));
-                    ctx.leaf.target[n] = Vec3f(trilinear(corners.t, i * step, j * step, k * step));
-                }
+    Vec3d s, t;
+    for (int i = 0; i < size; ++i)
+        for (int j = 0; j < size; ++j)
+            for (int k = 0; k < size; ++k) {
+                mWarp.map(Vec3d(origin.x() + i, origin.y() + j, origin.z() + k), s, t);
+                const int n = ((local.x() + i) * 8 + local.y() + j) * 8 + local.z() + k;
+                ctx.leaf.source[n] = Vec3f(s);
+                ctx.leaf.target[n] = Vec3f(t);
+            }
+    ctx.evaluations += uint64_t(size) * size * size;
+}
+
+void AdaptiveWarp::fillTrilinear(Context& ctx, const Coord& origin, int size, const Corners& corners) const
+{
+    const Coord local = origin - ctx.leaf.origin;
+    const double step = 1.0 / double(size);
+    for (int i = 0; i < size; ++i)
+        for (int j = 0; j < size; ++j)
+            for (int k = 0; k < size; ++k) {
+                const int n = ((local.x() + i) * 8 + local.y() + j) * 8 + local.z() + k;
+                ctx.leaf.source[n] = Vec3f(trilinear(corners.s, i * step, j * step, k * step));
+                ctx.leaf.target[n] = Vec3f(trilinear(corners.t, i * step, j * step, k * step));
+            }
+}
+
+void AdaptiveWarp::quarter(Context& ctx, const Coord& origin, const Corners& corners) const
+{
+    // A 4^3 cell: interpolated when its lattice check passes, else exact voxel by voxel (64
+    // evaluations, fewer than the 8 x 19 that splitting it into 2^3 cells would cost).
+    if (nearElement(origin, 4)) {
+        exactBlock(ctx, origin, 4);
         return;
     }
     auto map = [this](const Vec3d& p, Vec3d& s, Vec3d& t) { mWarp.map(p, s, t); };
     Context::Lattice l;
-    const double error = evaluateLattice(map, origin, size, corners.s, corners.t, false, l.s, l.t, ctx.evaluations);
-    if (size == 2) {
-        // Every voxel of a 2^3 cell is a lattice point: exact.
-        for (int i = 0; i < 2; ++i)
-            for (int j = 0; j < 2; ++j)
-                for (int k = 0; k < 2; ++k) {
-                    const int n = ((local.x() + i) * 8 + local.y() + j) * 8 + local.z() + k;
-                    ctx.leaf.source[n] = Vec3f(l.s[latticeIndex(i, j, k)]);
-                    ctx.leaf.target[n] = Vec3f(l.t[latticeIndex(i, j, k)]);
-                }
-        return;
-    }
+    const double error = evaluateLattice(map, origin, 4, corners.s, corners.t, false, l.s, l.t, ctx.evaluations);
     if (error <= kSafety * mTolerance) {
         ctx.maxError = std::max(ctx.maxError, error);
-        leafWithin(ctx, origin, size, corners, true);
-        return;
+        fillTrilinear(ctx, origin, 4, corners);
+    } else {
+        exactBlock(ctx, origin, 4);
     }
-    const int half = size / 2;
-    Corners child;
-    for (int cz = 0; cz < 2; ++cz)
-        for (int cy = 0; cy < 2; ++cy)
-            for (int cx = 0; cx < 2; ++cx) {
-                childCorners(l.s, l.t, cx, cy, cz, child.s, child.t);
-                leafWithin(ctx, origin.offsetBy(cx * half, cy * half, cz * half), half, child, false);
-            }
 }
 
 void AdaptiveWarp::forEachLeaf(const CoordBBox& box, const Occupancy* source, const Occupancy* target,

@@ -6,8 +6,15 @@
 // value and the corners' trilinear interpolation there is the cell's measured error, in voxels.
 // A cell whose error is within the tolerance is locked: every voxel inside it is interpolated from
 // its corners (Lerios et al. 1995, with a power-of-two octree instead of their adaptive grid).
-// Otherwise it is split into 8 and each child reuses 8 of the 27 points as its corners; at 2
-// voxels every lattice point is a voxel, so the warp there is exact.
+// Otherwise it is split into 8 and each child reuses 8 of the 27 points as its corners, down to
+// 4^3 cells; a 4^3 cell that fails is evaluated exactly, voxel by voxel.
+//
+// The lattice check cannot see what is smaller than its spacing: the weights (d + epsilon)^-2 bend
+// the warp on the scale of d + epsilon around each element, and the distance d has a kink on the
+// element's boundary. So a cell is only interpolated when it is small next to its distance to
+// every element: size <= kappa * (d_min + epsilon), d_min a lower bound of the distance from the
+// cell to the element (cells wholly inside a box element, where d = 0 and the weight is constant,
+// are exempt).
 //
 // The same points bound the domain: a cell is dropped when the bounding box of its images on the
 // source side, widened by twice its error and by the sampler's reach, touches no block of the
@@ -60,7 +67,8 @@ class AdaptiveWarp {
 public:
     /// `warp` must map output index space to source and target index space. Tolerance 0 means
     /// exact: every voxel is evaluated.
-    AdaptiveWarp(const InverseWarp& warp, double toleranceVoxels);
+    /// `epsilonVoxels` is the warp's epsilon in index space.
+    AdaptiveWarp(const InverseWarp& warp, double toleranceVoxels, double epsilonVoxels);
 
     using LeafFunction = std::function<void(const WarpLeaf&)>;
 
@@ -80,10 +88,16 @@ private:
     };
     struct Context;
     void cell(Context& ctx, const openvdb::Coord& origin, int size, const Corners& corners, bool locked) const;
-    void leafWithin(Context& ctx, const openvdb::Coord& origin, int size, const Corners& corners, bool locked) const;
+    void quarter(Context& ctx, const openvdb::Coord& origin, const Corners& corners) const;
+    void exactBlock(Context& ctx, const openvdb::Coord& origin, int size) const;
+    void fillTrilinear(Context& ctx, const openvdb::Coord& origin, int size, const Corners& corners) const;
+    /// True when the cell is too large next to some element to be interpolated, whatever the
+    /// lattice check says.
+    bool nearElement(const openvdb::Coord& origin, int size) const;
 
     const InverseWarp& mWarp;
     double mTolerance;
+    double mEpsilon;   ///< the warp's epsilon, index space
 };
 
 } // namespace volmorph::detail

@@ -1,0 +1,186 @@
+// The warp and the morph frame, each beside its anchor in one process:
+//  - exact vs approximated warp (tolerance 0.25 voxel) over the output domain of the default scene
+//    at 256 voxels across, for 1, 4, 16 and 64 pairs (the scene's 4, plus hand-like random ones);
+//    counter max_error_voxels is measured against the exact warp on every 3rd voxel;
+//  - a whole frame (domain, warp, resample, blend) vs its lower bound: resampling source and target
+//    once per output voxel of the same frame with the identity warp;
+//  - frames at 128, 256 and 512 voxels across: time per active voxel.
+// Run: build-bench/tests/bench/volmorph_bench_warp --benchmark_repetitions=5 --benchmark_report_aggregates_only=true
+#include <volmorph/Morph.h>
+#include <volmorph/Voxelize.h>
+#include <volmorph/Warp.h>
+
+#include "warp/AdaptiveWarp.h"
+
+#include <benchmark/benchmark.h>
+#include <openvdb/tools/Interpolation.h>
+#include <openvdb/tree/LeafManager.h>
+
+#include <filesystem>
+#include <map>
+#include <mutex>
+#include <random>
+
+using namespace volmorph;
+
+namespace {
+
+const std::filesystem::path kScene = std::filesystem::path(VOLMORPH_SOURCE_DIR) / "scenes" / "bunny-to-knot.toml";
+
+Vec3d rotate(const Vec3d& v, const Vec3d& k, double angle)
+{
+    return v * std::cos(angle) + k.cross(v) * std::sin(angle) + k * (k.dot(v) * (1.0 - std::cos(angle)));
+}
+
+/// The default scene's pairs, cut to n or extended with random pairs of the kind a user places:
+/// inside the bunny's bounds, moved by at most 0.15, turned by at most 45 degrees, scaled 0.7-1.4.
+std::vector<FeaturePairSpec> pairsFor(const Scene& scene, int n)
+{
+    std::vector<FeaturePairSpec> pairs(scene.pairs.begin(), scene.pairs.begin() + std::min<size_t>(n, scene.pairs.size()));
+    std::mt19937 random(1995);
+    std::uniform_real_distribution<double> u(0.0, 1.0);
+    auto vec = [&] { return Vec3d(u(random), u(random), u(random)); };
+    while (int(pairs.size()) < n) {
+        FeaturePairSpec p;
+        p.type = FeatureType(random() % 4);
+        p.source.origin = Vec3d(-0.4, 0.05, -0.3) + Vec3d(0.8 * u(random), 0.85 * u(random), 0.6 * u(random));
+        p.source.xAxis = (vec() - Vec3d(0.5)).unit();
+        p.source.yAxis = p.source.xAxis.cross((vec() - Vec3d(0.5)).unit()).unit();
+        p.source.zAxis = p.source.xAxis.cross(p.source.yAxis);
+        p.source.scale = Vec3d(0.05) + vec() * 0.2;
+        p.target = p.source;
+        p.target.origin += (vec() - Vec3d(0.5)) * 0.3;
+        const Vec3d axis = (vec() - Vec3d(0.5)).unit();
+        const double angle = (u(random) - 0.5) * M_PI / 2;
+        p.target.xAxis = rotate(p.source.xAxis, axis, angle);
+        p.target.yAxis = rotate(p.source.yAxis, axis, angle);
+        p.target.zAxis = p.target.xAxis.cross(p.target.yAxis);
+        const Vec3d f = Vec3d(0.7) + vec() * 0.7;
+        p.target.scale = Vec3d(p.source.scale.x() * f.x(), p.source.scale.y() * f.y(), p.source.scale.z() * f.z());
+        pairs.push_back(p);
+    }
+    return pairs;
+}
+
+struct Setup {
+    Scene scene;
+    SceneVolumes volumes;
+};
+
+const Setup& setup(int across)
+{
+    static std::map<int, Setup> cache;
+    auto it = cache.find(across);
+    if (it == cache.end()) {
+        Setup s;
+        s.scene = loadScene(kScene);
+        s.scene.volume.voxelSize.reset();
+        s.scene.volume.resolution = across;
+        s.volumes = voxelizeScene(s.scene);
+        it = cache.emplace(across, std::move(s)).first;
+    }
+    return it->second;
+}
+
+/// The warp alone over the frame's candidate domain: positions are computed and consumed.
+void warpOnly(benchmark::State& state, double tolerance)
+{
+    const Setup& s = setup(256);
+    const auto pairs = pairsFor(s.scene, int(state.range(0)));
+    const double t = 0.5, voxel = s.volumes.source.voxelSize();
+    const Morpher morpher(s.volumes.source, s.volumes.target, pairs, s.scene.warp, s.scene.blend);
+    const openvdb::CoordBBox box = morpher.candidateBounds(t);
+    const InverseWarp warp(pairs, s.scene.warp, t, 1.0 / voxel);
+    const detail::Occupancy occS(s.volumes.source.density->tree()), occT(s.volumes.target.density->tree());
+    const detail::AdaptiveWarp adaptive(warp, tolerance, s.scene.warp.epsilon / voxel);
+    detail::AdaptiveWarpStats stats;
+    std::atomic<uint64_t> sink{0};
+    for (auto _ : state) {
+        stats = {};
+        adaptive.forEachLeaf(box, &occS, &occT,
+                             [&](const detail::WarpLeaf& leaf) {
+                                 float sum = 0.0f;
+                                 for (int i = 0; i < 512; ++i) sum += leaf.source[i].x() + leaf.target[i].y();
+                                 sink += uint64_t(sum != 0.0f);
+                             },
+                             &stats);
+    }
+    state.counters["leaves"] = double(stats.leaves);
+    state.counters["exact_evals"] = double(stats.exactEvaluations);
+    if (tolerance > 0.0) {
+        // The error actually made, against the exact warp, on every 3rd voxel of the domain.
+        std::mutex m;
+        double worst = 0.0;
+        adaptive.forEachLeaf(box, &occS, &occT, [&](const detail::WarpLeaf& leaf) {
+            double local = 0.0;
+            Vec3d ps, pt;
+            for (int i = 0; i < 512; i += 3) {
+                warp.map(leaf.origin.offsetBy(i >> 6, (i >> 3) & 7, i & 7).asVec3d(), ps, pt);
+                local = std::max({local, (Vec3d(leaf.source[i]) - ps).length(), (Vec3d(leaf.target[i]) - pt).length()});
+            }
+            std::lock_guard<std::mutex> lock(m);
+            worst = std::max(worst, local);
+        });
+        state.counters["max_error_voxels"] = worst;
+        state.counters["measured_error_voxels"] = stats.maxErrorVoxels;
+    }
+}
+
+void exactWarp(benchmark::State& state) { warpOnly(state, 0.0); }
+void approximatedWarp(benchmark::State& state) { warpOnly(state, 0.25); }
+
+/// One whole frame at t = 0.5 with the scene's 4 pairs.
+void morphFrame(benchmark::State& state)
+{
+    const Setup& s = setup(int(state.range(0)));
+    const Morpher morpher(s.volumes.source, s.volumes.target, s.scene.pairs, s.scene.warp, s.scene.blend);
+    MorphStats stats;
+    for (auto _ : state) {
+        VolumeSet v = morpher.frame(0.5, &stats);
+        benchmark::DoNotOptimize(v);
+    }
+    state.counters["active_voxels"] = double(stats.activeVoxels);
+    state.counters["ns_per_active_voxel"] =
+        benchmark::Counter(double(stats.activeVoxels) * 1e-9, benchmark::Counter::kIsIterationInvariantRate |
+                                                                benchmark::Counter::kInvert);
+}
+
+/// The lower bound of a frame: every output voxel of the same frame resampled from source and
+/// target at its own position (identity warp) and blended, in parallel over leaves.
+void identityResample(benchmark::State& state)
+{
+    const Setup& s = setup(int(state.range(0)));
+    const Morpher morpher(s.volumes.source, s.volumes.target, s.scene.pairs, s.scene.warp, s.scene.blend);
+    VolumeSet out = morpher.frame(0.5);
+    // Every output voxel counts, also those the frame stored as tiles afterwards.
+    out.density->tree().voxelizeActiveTiles();
+    out.color->tree().voxelizeActiveTiles();
+    openvdb::tree::LeafManager<openvdb::FloatTree> leaves(out.density->tree());
+    auto colors = out.color;
+    const VolumeSet& src = s.volumes.source;
+    const VolumeSet& dst = s.volumes.target;
+    for (auto _ : state) {
+        leaves.foreach([&](openvdb::FloatTree::LeafNodeType& leaf, size_t) {
+            auto ds = src.density->getConstAccessor(), dt = dst.density->getConstAccessor();
+            auto cs = src.color->getConstAccessor(), ct = dst.color->getConstAccessor();
+            auto* color = colors->tree().probeLeaf(leaf.origin());
+            for (auto it = leaf.beginValueOn(); it; ++it) {
+                const openvdb::Vec3R p = it.getCoord().asVec3d();
+                const float a = openvdb::tools::BoxSampler::sample(ds, p);
+                const float b = openvdb::tools::BoxSampler::sample(dt, p);
+                it.setValue(0.5f * a + 0.5f * b);
+                if (color && a + b > 0.0f)
+                    color->setValueOnly(it.pos(), (a * openvdb::tools::BoxSampler::sample(cs, p) +
+                                                   b * openvdb::tools::BoxSampler::sample(ct, p)) / (a + b));
+            }
+        });
+    }
+    state.counters["active_voxels"] = double(out.density->activeVoxelCount());
+}
+
+} // namespace
+
+BENCHMARK(exactWarp)->Arg(1)->Arg(4)->Arg(16)->Arg(64)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(approximatedWarp)->Arg(1)->Arg(4)->Arg(16)->Arg(64)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(morphFrame)->Arg(128)->Arg(256)->Arg(512)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(identityResample)->Arg(128)->Arg(256)->Arg(512)->Unit(benchmark::kMillisecond)->UseRealTime();

@@ -1,0 +1,74 @@
+#include <volmorph/Frames.h>
+
+#include <gtest/gtest.h>
+
+using namespace volmorph;
+
+namespace {
+
+FramesSpec range(int first, int last)
+{
+    FramesSpec f;
+    f.first = first;
+    f.last = last;
+    return f;
+}
+
+std::string errorOf(const FramesSpec& f, const std::string& spec)
+{
+    try {
+        selectFrames(f, spec);
+    } catch (const UserError& e) {
+        return e.diagnostics().at(0).str();
+    }
+    return "";
+}
+
+} // namespace
+
+TEST(Frames, SpecsAsVfxToolsWriteThem)
+{
+    const FramesSpec f = range(1, 100);
+    EXPECT_EQ(selectFrames(f, "").size(), 100u);
+    EXPECT_EQ(selectFrames(f, "1-10"), (std::vector<int>{1, 2, 3, 4, 5, 6, 7, 8, 9, 10}));
+    EXPECT_EQ(selectFrames(f, "1-100x25"), (std::vector<int>{1, 26, 51, 76}));
+    EXPECT_EQ(selectFrames(f, "1,5,10-12"), (std::vector<int>{1, 5, 10, 11, 12}));
+    EXPECT_EQ(selectFrames(f, "3,2,3"), (std::vector<int>{3, 2})); // order kept, repeats dropped
+}
+
+TEST(Frames, PickingFramesNeverChangesTheirTime)
+{
+    const FramesSpec f = range(1, 48);
+    const std::vector<int> chunk = selectFrames(f, "11-20");
+    EXPECT_DOUBLE_EQ(f.t(chunk.front()), 10.0 / 47.0);
+    EXPECT_DOUBLE_EQ(f.t(chunk.back()), 19.0 / 47.0);
+}
+
+TEST(Frames, BadSpecsAreUserErrors)
+{
+    const FramesSpec f = range(1, 24);
+    EXPECT_EQ(errorOf(f, "30"), "--frames: frame 30 is outside the scene's range 1-24");
+    EXPECT_EQ(errorOf(f, "0-3"), "--frames: frame 0 is outside the scene's range 1-24");
+    EXPECT_NE(errorOf(f, "a-b").find("cannot read the frame spec \"a-b\""), std::string::npos);
+    EXPECT_NE(errorOf(f, "1-2,x").find("cannot read the frame spec"), std::string::npos);
+}
+
+TEST(Frames, PatternsPadLikeHoudiniAndPrintf)
+{
+    EXPECT_EQ(frameFileName("out/f.####.exr", 42), "out/f.0042.exr");
+    EXPECT_EQ(frameFileName("out/f.#.exr", 42), "out/f.42.exr");
+    EXPECT_EQ(frameFileName("out/f.%04d.exr", 7), "out/f.0007.exr");
+    EXPECT_EQ(frameFileName("out/f.%d.exr", 7), "out/f.7.exr");
+    EXPECT_EQ(frameFileName("out/f.####.exr", -3), "out/f.-003.exr");
+    EXPECT_EQ(frameFileName("out/still.exr", 5), "out/still.exr");
+}
+
+TEST(Frames, PatternChecks)
+{
+    EXPECT_EQ(checkFramePattern("a.####.exr"), "");
+    EXPECT_EQ(checkFramePattern("a.%04d.exr"), "");
+    EXPECT_EQ(checkFramePattern("100%%/a.%d.exr"), "");
+    EXPECT_NE(checkFramePattern("a.##.b.##.exr"), "");
+    EXPECT_NE(checkFramePattern("a.%s.exr"), "");
+    EXPECT_NE(checkFramePattern("a.%d.%d.exr"), "");
+}

@@ -1,0 +1,136 @@
+// volmorph check SCENE: validate a scene and summarise it.
+#include "Common.h"
+
+#include <volmorph/Scene.h>
+#include <volmorph/Voxelize.h>
+
+#include <cmath>
+#include <cstdio>
+#include <memory>
+
+namespace volmorph::cli {
+namespace {
+
+void printMesh(const char* label, const ObjectSpec& spec, const Mesh& mesh)
+{
+    const auto [lo, hi] = mesh.bounds();
+    const MeshReport& r = mesh.report;
+    std::printf("%-7s %s\n", label, spec.mesh.string().c_str());
+    std::printf("        %zu vertices, %zu triangles, %s\n", mesh.points.size(), mesh.triangles.size(),
+                describeTopology(r).c_str());
+    if (r.degenerateTriangles)
+        std::printf("        repaired: %zu degenerate (zero-area) triangles dropped\n",
+                    r.degenerateTriangles);
+    std::printf("        bounds %s .. %s world units\n", fmt(lo).c_str(), fmt(hi).c_str());
+    if (spec.color) std::printf("        colour %s (constant)\n", fmt(*spec.color).c_str());
+    else if (mesh.hasColors()) std::printf("        colour from the mesh's vertex colours\n");
+}
+
+/// Hand-placed features far from their mesh are usually a typo in a coordinate.
+void warnFarFeatures(const Scene& scene, const Mesh& source, const Mesh& target)
+{
+    auto outside = [](const Vec3d& p, const std::pair<Vec3d, Vec3d>& b) {
+        const Vec3d size = b.second - b.first;
+        const double margin = 0.5 * std::max({size.x(), size.y(), size.z()});
+        for (int i = 0; i < 3; ++i)
+            if (p[i] < b.first[i] - margin || p[i] > b.second[i] + margin) return true;
+        return false;
+    };
+    const auto sb = source.bounds(), tb = target.bounds();
+    for (size_t i = 0; i < scene.pairs.size(); ++i) {
+        const FeaturePairSpec& pair = scene.pairs[i];
+        if (outside(pair.source.origin, sb))
+            std::fprintf(stderr, "%s: warning: pair %zu: source origin %s is far outside the source mesh\n",
+                         pair.where.str().c_str(), i + 1, fmt(pair.source.origin).c_str());
+        if (outside(pair.target.origin, tb))
+            std::fprintf(stderr, "%s: warning: pair %zu: target origin %s is far outside the target mesh\n",
+                         pair.where.str().c_str(), i + 1, fmt(pair.target.origin).c_str());
+    }
+}
+
+int runCheck(const std::string& scenePath)
+{
+    const Scene scene = loadScene(scenePath);
+    const SceneMeshes meshes = importSceneMeshes(scene);
+    std::printf("scene   %s\n", scenePath.c_str());
+    printMesh("source", scene.source, meshes.source);
+    printMesh("target", scene.target, meshes.target);
+
+    auto [slo, shi] = meshes.source.bounds();
+    auto [tlo, thi] = meshes.target.bounds();
+    const Vec3d extent = maxComponent(shi, thi) - minComponent(slo, tlo);
+    const double voxel = sceneVoxelSize(scene.volume, meshes.source, meshes.target);
+    std::printf("volume  voxel size %s world units; both meshes span %.0f x %.0f x %.0f voxels\n",
+                fmt(voxel).c_str(), std::ceil(extent.x() / voxel), std::ceil(extent.y() / voxel),
+                std::ceil(extent.z() / voxel));
+    const double gib = double(1ull << 30);
+    std::printf("        voxelizing needs about %.2f + %.2f GiB (limit %.1f GiB, half the memory)\n",
+                double(estimateVoxelizeBytes(meshes.source, voxel, 3.0f)) / gib,
+                double(estimateVoxelizeBytes(meshes.target, voxel, 3.0f)) / gib,
+                double(defaultMemoryLimitBytes()) / gib);
+
+    std::printf("pairs   %zu\n", scene.pairs.size());
+    for (size_t i = 0; i < scene.pairs.size(); ++i) {
+        const FeaturePairSpec& p = scene.pairs[i];
+        auto element = [&p](const FeatureElement& e) {
+            std::string s = "origin " + fmt(e.origin);
+            if (p.type != FeatureType::Point)
+                s += ", x axis " + fmt(e.xAxis) + ", scale " + fmt(e.scale);
+            return s;
+        };
+        std::printf("  %3zu %-9s source %s\n      %-9s target %s\n", i + 1, toString(p.type),
+                    element(p.source).c_str(), "", element(p.target).c_str());
+    }
+    const WarpSpec& w = scene.warp;
+    std::printf("warp    %s, epsilon %s world units, tolerance %s voxels%s\n",
+                w.weighting == Weighting::InverseSquare ? "inverse-square" : "beier-neely",
+                fmt(w.epsilon).c_str(), fmt(w.toleranceVoxels).c_str(),
+                w.toleranceVoxels == 0.0 ? " (exact)" : "");
+    const BlendSpec& b = scene.blend;
+    std::printf("blend   %s mode; density %s, colour %s, sdf %s\n",
+                b.mode == BlendMode::Sdf ? "sdf" : "density", b.density.str().c_str(),
+                b.color.str().c_str(), b.sdf.str().c_str());
+    const RenderSpec& r = scene.render;
+    std::printf("render  %dx%d, %d samples, step %s voxels, extinction %s per world unit, albedo %s\n",
+                r.width, r.height, r.samples, fmt(r.stepVoxels).c_str(), fmt(r.extinction).c_str(),
+                fmt(r.albedo).c_str());
+    const CameraSpec& c = r.camera;
+    if (c.projection == Projection::Perspective)
+        std::printf("camera  perspective, eye %s, lookat %s, fov %s degrees (horizontal)\n",
+                    fmt(c.eye).c_str(), fmt(c.lookat).c_str(), fmt(c.fovDegrees).c_str());
+    else
+        std::printf("camera  orthographic, eye %s, lookat %s, width %s world units\n",
+                    fmt(c.eye).c_str(), fmt(c.lookat).c_str(), fmt(c.orthoWidth).c_str());
+    for (const LightSpec& l : r.lights) {
+        if (l.type == LightType::Directional)
+            std::printf("light   directional, travelling %s, colour %s, intensity %s\n",
+                        fmt(l.direction).c_str(), fmt(l.color).c_str(), fmt(l.intensity).c_str());
+        else
+            std::printf("light   point at %s, colour %s, intensity %s\n", fmt(l.position).c_str(),
+                        fmt(l.color).c_str(), fmt(l.intensity).c_str());
+    }
+    const FramesSpec& f = scene.frames;
+    std::printf("frames  %d-%d (%d frames) -> %s\n", f.first, f.last, f.count(),
+                (scene.folder / f.output).string().c_str());
+    constexpr int kPerLine = 8;
+    for (int frame = f.first; frame <= f.last; ++frame) {
+        const int k = frame - f.first;
+        std::printf("%s%5d: t=%-7.4f", k % kPerLine == 0 ? "       " : "", frame, f.t(frame));
+        if (k % kPerLine == kPerLine - 1 || frame == f.last) std::printf("\n");
+    }
+    std::fflush(stdout);
+    warnFarFeatures(scene, meshes.source, meshes.target);
+    return 0;
+}
+
+} // namespace
+
+Command addCheckCommand(CLI::App& app)
+{
+    auto scene = std::make_shared<std::string>();
+    CLI::App* sub = app.add_subcommand("check", "Validate a scene file and summarise it");
+    sub->add_option("SCENE", *scene, "scene file (TOML)")->required();
+    return {sub, [scene] { return runCheck(*scene); }};
+}
+
+} // namespace volmorph::cli

@@ -1,0 +1,99 @@
+// volmorph morph SCENE [--frames SPEC] [-o PATTERN.vdb]: one .vdb of the in-between per frame.
+#include "Common.h"
+
+#include <volmorph/Frames.h>
+#include <volmorph/Morph.h>
+#include <volmorph/Version.h>
+#include <volmorph/Voxelize.h>
+
+#include <unistd.h>
+
+#include <chrono>
+#include <cstdio>
+#include <memory>
+
+namespace volmorph::cli {
+namespace {
+
+struct MorphArgs {
+    std::string scene, frames, output, sampling = "trilinear";
+    bool exact = false, quiet = false;
+    double memoryLimitGiB = 0.0;
+};
+
+double secondsSince(std::chrono::steady_clock::time_point start)
+{
+    return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
+int runMorph(const MorphArgs& args)
+{
+    Scene scene = loadScene(args.scene);
+    const std::vector<int> frames = selectFrames(scene.frames, args.frames);
+    // Default: the scene's output pattern with .vdb for .exr, relative to the scene's folder.
+    std::string pattern = args.output;
+    if (pattern.empty())
+        pattern = (scene.folder / std::filesystem::path(scene.frames.output).replace_extension(".vdb")).string();
+    if (const std::string why = checkFramePattern(pattern); !why.empty())
+        throw UserError(SourceLocation{"-o"}, "\"" + pattern + "\": " + why);
+    if (frames.size() > 1 && frameFileName(pattern, frames[0]) == frameFileName(pattern, frames[1]))
+        throw UserError(SourceLocation{"-o"}, "\"" + pattern + "\" has no frame number placeholder (#### or %04d)");
+    if (args.exact) scene.warp.toleranceVoxels = 0.0;
+    if (scene.blend.mode == BlendMode::Sdf)
+        std::fprintf(stderr, "%s: warning: blend.mode = \"sdf\" is not implemented yet; blending densities\n",
+                     args.scene.c_str());
+
+    Interrupter interrupter(false);
+    StopSignals signals(interrupter);
+    const auto start = std::chrono::steady_clock::now();
+    SceneVolumes volumes = voxelizeScene(scene, &interrupter, uint64_t(args.memoryLimitGiB * double(1ull << 30)));
+    if (!args.quiet)
+        std::printf("voxelized source and target at %g world units in %.2f s\n", volumes.source.voxelSize(),
+                    secondsSince(start));
+    MorphOptions options;
+    if (args.sampling == "triquadratic") options.sampling = MorphOptions::Sampling::Triquadratic;
+    const Morpher morpher(std::move(volumes.source), std::move(volumes.target), scene.pairs, scene.warp,
+                          scene.blend, options);
+
+    for (int frame : frames) {
+        const auto frameStart = std::chrono::steady_clock::now();
+        const double t = scene.frames.t(frame);
+        MorphStats stats;
+        VolumeSet v = morpher.frame(t, &stats, &interrupter);
+        if (interrupter.stopRequested()) throw Interrupted();
+        const std::filesystem::path file = frameFileName(pattern, frame);
+        if (file.has_parent_path()) std::filesystem::create_directories(file.parent_path());
+        writeVolumeSet(v, file,
+                       {{"volmorph_scene", std::filesystem::absolute(args.scene).string()},
+                        {"volmorph_frame", std::to_string(frame)},
+                        {"volmorph_t", fmt(t)},
+                        {"volmorph_version", versionString()}});
+        if (!args.quiet)
+            std::printf("frame %d (t=%.4f): %llu active voxels, warp error <= %.3f voxels, %.2f s -> %s\n", frame, t,
+                        (unsigned long long)stats.activeVoxels, stats.maxWarpErrorVoxels,
+                        secondsSince(frameStart), file.string().c_str());
+        std::fflush(stdout);
+    }
+    return 0;
+}
+
+} // namespace
+
+Command addMorphCommand(CLI::App& app)
+{
+    auto args = std::make_shared<MorphArgs>();
+    CLI::App* sub = app.add_subcommand("morph", "Write the morphed volume of each frame as a .vdb (grids density, Cd)");
+    sub->add_option("SCENE", args->scene, "scene file (TOML)")->required();
+    sub->add_option("--frames", args->frames, "frames to write, e.g. 1-10, 1-100x2, 1,5,10-20 (default: all)");
+    sub->add_option("-o,--output", args->output,
+                    "output pattern, e.g. out/morph.####.vdb (default: the scene's output with .vdb)");
+    sub->add_flag("--exact", args->exact, "use the exact warp everywhere (the reference; slow)");
+    sub->add_option("--sampling", args->sampling, "resampling filter: trilinear or triquadratic")
+        ->check(CLI::IsMember({"trilinear", "triquadratic"}));
+    sub->add_option("--memory-limit", args->memoryLimitGiB, "voxelization memory limit in GiB")
+        ->check(CLI::PositiveNumber);
+    sub->add_flag("-q,--quiet", args->quiet, "print nothing on success");
+    return {sub, [args] { return runMorph(*args); }};
+}
+
+} // namespace volmorph::cli

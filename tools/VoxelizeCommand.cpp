@@ -1,0 +1,100 @@
+// volmorph voxelize MESH -o OUT.vdb: sdf, density and Cd grids of one mesh.
+#include "Common.h"
+
+#include <volmorph/Version.h>
+#include <volmorph/Voxelize.h>
+
+#include <unistd.h>
+
+#include <chrono>
+#include <cstdio>
+#include <memory>
+#include <optional>
+#include <sstream>
+
+namespace volmorph::cli {
+namespace {
+
+struct VoxelizeArgs {
+    std::string mesh, output, sign = "auto";
+    std::optional<double> voxelSize;
+    std::optional<int> resolution;
+    float halfWidth = 3.0f;
+    std::vector<float> color;
+    double memoryLimitGiB = 0.0;
+    bool quiet = false;
+};
+
+int runVoxelize(const VoxelizeArgs& args)
+{
+    const Mesh mesh = importMesh(args.mesh);
+    VoxelizeOptions options;
+    options.voxelSize = args.voxelSize;
+    if (args.resolution) options.resolution = *args.resolution;
+    options.halfWidthVoxels = args.halfWidth;
+    if (!args.color.empty()) options.color = Vec3f(args.color[0], args.color[1], args.color[2]);
+    options.memoryLimitBytes = uint64_t(args.memoryLimitGiB * double(1ull << 30));
+    options.sign = args.sign == "winding"     ? VoxelizeOptions::Sign::WindingNumber
+                   : args.sign == "floodfill" ? VoxelizeOptions::Sign::FloodFill
+                                              : VoxelizeOptions::Sign::Auto;
+    const std::filesystem::path output(args.output);
+    const std::filesystem::path folder = output.has_parent_path() ? output.parent_path() : ".";
+    std::error_code ec;
+    if (!std::filesystem::is_directory(folder, ec))
+        throw UserError(SourceLocation{args.output}, "the output folder does not exist");
+
+    Interrupter interrupter(!args.quiet && isatty(fileno(stderr)));
+    StopSignals signals(interrupter);
+    VoxelizeStats stats;
+    const auto start = std::chrono::steady_clock::now();
+    const VolumeSet volumes = voxelize(mesh, options, &interrupter, &stats);
+    const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    if (interrupter.stopRequested()) throw Interrupted();
+    std::ostringstream voxel;
+    voxel << stats.voxelSize;
+    writeVolumeSet(volumes, output,
+                   {{"volmorph_source", std::filesystem::absolute(args.mesh).string()},
+                    {"volmorph_voxel_size", voxel.str()},
+                    {"volmorph_sign", stats.usedWindingNumber ? "winding number" : "flood fill"},
+                    {"volmorph_version", versionString()}});
+    if (!args.quiet) {
+        std::printf("%s: %zu triangles, %s\n", args.mesh.c_str(), mesh.triangles.size(),
+                    describeTopology(mesh.report).c_str());
+        std::printf("voxel size %s world units; inside/outside by %s\n", voxel.str().c_str(),
+                    stats.usedWindingNumber ? "winding number" : "flood fill (watertight, one shell)");
+        std::printf("sdf %llu active voxels, density %llu active voxels, %.2f s\n",
+                    (unsigned long long)stats.sdfActiveVoxels, (unsigned long long)stats.densityActiveVoxels,
+                    seconds);
+        std::printf("wrote %s (grids sdf, density, Cd)\n", args.output.c_str());
+    }
+    return 0;
+}
+
+} // namespace
+
+Command addVoxelizeCommand(CLI::App& app)
+{
+    auto vox = std::make_shared<VoxelizeArgs>();
+    CLI::App* voxelizeCmd = app.add_subcommand("voxelize", "Voxelize a mesh into sdf, density and Cd grids");
+    voxelizeCmd->add_option("MESH", vox->mesh, "mesh file (OBJ, PLY, STL, OFF, glTF, ...)")->required();
+    voxelizeCmd->add_option("-o,--output", vox->output, "output .vdb file")->required();
+    auto* sizeOpt = voxelizeCmd->add_option("--voxel-size", vox->voxelSize, "voxel edge in world units")
+                        ->check(CLI::PositiveNumber);
+    voxelizeCmd->add_option("--resolution", vox->resolution, "voxels across the longest side (default 128)")
+        ->check(CLI::Range(8, 16384))
+        ->excludes(sizeOpt);
+    voxelizeCmd->add_option("--half-width", vox->halfWidth, "narrow band half width in voxels (>= 3)")
+        ->check(CLI::Range(3.0f, 64.0f));
+    voxelizeCmd->add_option("--color", vox->color, "constant linear RGB colour R,G,B")
+        ->delimiter(',')
+        ->expected(3);
+    voxelizeCmd->add_option("--memory-limit", vox->memoryLimitGiB,
+                            "refuse above this estimate, in GiB (default: half the machine's memory)")
+        ->check(CLI::PositiveNumber);
+    voxelizeCmd->add_option("--sign", vox->sign, "inside/outside: auto, floodfill or winding")
+        ->check(CLI::IsMember({"auto", "floodfill", "winding"}));
+    voxelizeCmd->add_flag("-q,--quiet", vox->quiet, "print nothing on success");
+    return {voxelizeCmd, [vox] { return runVoxelize(*vox); }};
+}
+
+} // namespace volmorph::cli
