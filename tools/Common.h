@@ -28,6 +28,8 @@ struct Command {
 Command addCheckCommand(CLI::App& app);
 Command addVoxelizeCommand(CLI::App& app);
 Command addMorphCommand(CLI::App& app);
+Command addRenderVdbCommand(CLI::App& app);
+Command addRenderCommand(CLI::App& app);
 
 std::string fmt(double v);
 std::string fmt(const Vec3d& v);

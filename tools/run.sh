@@ -1,7 +1,7 @@
 #!/bin/sh
 # One entry point for the README's Quick start: installs what is missing, builds, then
 #   tools/run.sh demo   runs the main job on the default scene (scenes/bunny-to-knot.toml): the morph,
-#                       one .vdb per frame in scenes/out/
+#                       rendered to one EXR per frame in scenes/out/
 #   tools/run.sh test   runs the whole test suite (CTest: unit, cli and bad-input tests)
 # Environment: BUILD_DIR (default build), JOBS (default: number of cores).
 set -eu
@@ -30,12 +30,10 @@ demo)
     scene=scenes/bunny-to-knot.toml
     "$build/bin/volmorph" check "$scene"
     echo
-    out=scenes/out/bunny-to-knot.####.vdb
-    "$build/bin/volmorph" morph "$scene" -o "$out"
+    "$build/bin/volmorph" render "$scene" -o scenes/out/bunny-to-knot.####.exr
     echo
-    echo "volmorph: the morph of $scene is in scenes/out/bunny-to-knot.0001.vdb ... .0024.vdb"
-    echo "(grids density and Cd, one file per frame; the renderer that turns them into EXR frames is"
-    echo "not built yet: view them with vdb_view, Houdini or Blender). The program is $build/bin/volmorph."
+    echo "volmorph: the morph of $scene is rendered to scenes/out/bunny-to-knot.0001.exr ... .0024.exr"
+    echo "(half RGBA OpenEXR, linear, premultiplied). The program is $build/bin/volmorph."
     ;;
 test)
     cd "$build"

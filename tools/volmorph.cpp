@@ -13,7 +13,8 @@ int main(int argc, char** argv)
     CLI::App app{"volmorph: feature-based volumetric morphing of meshes through OpenVDB grids"};
     app.set_version_flag("--version", std::string("volmorph ") + volmorph::versionString());
     app.require_subcommand(1);
-    const std::vector<Command> commands = {addCheckCommand(app), addVoxelizeCommand(app), addMorphCommand(app)};
+    const std::vector<Command> commands = {addCheckCommand(app), addVoxelizeCommand(app), addMorphCommand(app),
+                                          addRenderVdbCommand(app), addRenderCommand(app)};
 
     try {
         app.parse(argc, argv);

@@ -58,7 +58,7 @@ Occupancy::Occupancy(const openvdb::FloatTree& tree)
                      true, true);
     }
     openvdb::tools::dilateActiveValues(mBlocks, 1, openvdb::tools::NN_FACE_EDGE_VERTEX,
-                                       openvdb::tools::IGNORE_TILES);
+                                       openvdb::tools::PRESERVE_TILES);
 }
 
 bool Occupancy::anyIn(const CoordBBox& box) const

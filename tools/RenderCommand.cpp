@@ -1,0 +1,254 @@
+// volmorph render-vdb IN.vdb -o OUT.exr: render any float grid (flags as OpenVDB's vdb_render).
+// volmorph render SCENE [--frames SPEC] [-o PATTERN.exr]: the morph of each frame, rendered.
+#include "Common.h"
+
+#include <volmorph/Frames.h>
+#include <volmorph/Morph.h>
+#include <volmorph/Version.h>
+#include <volmorph/Voxelize.h>
+#include <volmorph/render/Output.h>
+#include <volmorph/render/Renderer.h>
+
+#include <openvdb/io/File.h>
+
+#include <chrono>
+#include <cstdio>
+#include <memory>
+#include <optional>
+#include <sstream>
+
+namespace volmorph::cli {
+namespace {
+
+double secondsSince(std::chrono::steady_clock::time_point start)
+{
+    return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
+Vec3d vec3(const std::vector<double>& v) { return Vec3d(v[0], v[1], v[2]); }
+
+struct RenderVdbArgs {
+    std::string input, output, png, camera = "persp", grid, resolution = "640x360";
+    std::vector<double> translate, lookat, up{0, 1, 0}, light{0.3, 0.7, 0.6};
+    double fov = 40.0, frameWidth = 0.0, extinction = 40.0, albedo = 0.8, step = 0.5, shadowStep = 1.0;
+    int shadowCache = 2;
+    int samples = 4, threads = 0;
+    bool floatExr = false;
+};
+
+void parseResolution(const std::string& text, int& width, int& height)
+{
+    char x = 0;
+    std::istringstream in(text);
+    if (!(in >> width >> x >> height) || x != 'x' || width < 1 || height < 1 || width > 16384 || height > 16384 ||
+        !in.eof())
+        throw UserError(SourceLocation{"--res"}, "expected WIDTHxHEIGHT in pixels (e.g. 640x360), got \"" + text + "\"");
+}
+
+int runRenderVdb(const RenderVdbArgs& args)
+{
+    int width = 0, height = 0;
+    parseResolution(args.resolution, width, height); // flags first: no work before a usage error
+    openvdb::initialize();
+    openvdb::FloatGrid::Ptr density;
+    openvdb::Vec3SGrid::Ptr color;
+    try {
+        openvdb::io::File file(args.input);
+        file.open();
+        for (auto it = file.beginName(); it != file.endName(); ++it) {
+            openvdb::GridBase::Ptr g = file.readGrid(it.gridName());
+            if (!color && g->getName() == "Cd") color = openvdb::gridPtrCast<openvdb::Vec3SGrid>(g);
+            if (density) continue;
+            if (!args.grid.empty() ? g->getName() == args.grid : bool(openvdb::gridPtrCast<openvdb::FloatGrid>(g))) {
+                density = openvdb::gridPtrCast<openvdb::FloatGrid>(g);
+                if (!density) throw UserError(SourceLocation{args.input}, "grid \"" + args.grid + "\" is not a float grid");
+            }
+        }
+        file.close();
+    } catch (const openvdb::Exception& e) {
+        throw UserError(SourceLocation{args.input}, std::string("cannot read volume file (") + e.what() + ")");
+    }
+    if (!density)
+        throw UserError(SourceLocation{args.input},
+                        args.grid.empty() ? "no float grid to render" : "no grid named \"" + args.grid + "\"");
+    // Default view: in front of the grid's active bounds, looking at their centre.
+    openvdb::CoordBBox box = density->evalActiveVoxelBoundingBox();
+    const Vec3d lo = density->indexToWorld(box.min().asVec3d()), hi = density->indexToWorld(box.max().asVec3d());
+    const Vec3d centre = 0.5 * (lo + hi);
+    const double extent = (hi - lo).length();
+    const Vec3d lookat = args.lookat.empty() ? centre : vec3(args.lookat);
+    const Vec3d eye = args.translate.empty() ? centre + Vec3d(0, 0, 1.6 * extent) : vec3(args.translate);
+    const bool ortho = args.camera == "ortho";
+    const render::Camera camera(ortho ? render::Camera::Projection::Orthographic : render::Camera::Projection::Perspective,
+                                eye, lookat, vec3(args.up), args.fov, args.frameWidth > 0 ? args.frameWidth : extent,
+                                width, height);
+    render::Light light;
+    light.direction = -vec3(args.light); // the flag points toward the light, as vdb_render's -light
+    if (args.light.size() == 6) light.color = Vec3d(args.light[3], args.light[4], args.light[5]);
+    render::Medium medium;
+    medium.extinction = args.extinction;
+    medium.albedo = args.albedo;
+    render::RenderSettings settings;
+    settings.samples = args.samples;
+    settings.stepVoxels = args.step;
+    settings.shadowStepVoxels = args.shadowStep;
+    settings.shadowCacheVoxels = args.shadowCache;
+    settings.threads = args.threads;
+    const auto start = std::chrono::steady_clock::now();
+    const render::Image image = render::renderVolume(*density, color.get(), camera, {light}, medium, settings);
+    const double seconds = secondsSince(start);
+    render::ExrOptions exr;
+    exr.halfFloat = !args.floatExr;
+    exr.samples = args.samples;
+    exr.renderSeconds = seconds;
+    exr.metadata["volmorph:source"] = args.input;
+    try {
+        render::writeExr(image, camera, args.output, exr);
+        if (!args.png.empty()) render::writePng(image, args.png);
+    } catch (const std::runtime_error& e) {
+        throw UserError(SourceLocation{args.output}, std::string("cannot write image (") + e.what() + ")");
+    }
+    std::printf("rendered %s (%dx%d, %d samples) in %.2f s -> %s\n", density->getName().c_str(), width, height,
+                args.samples, seconds, args.output.c_str());
+    return 0;
+}
+
+struct RenderSceneArgs {
+    std::string scene, frames, output, png;
+    int threads = 0;
+    bool skipExisting = false, quiet = false;
+};
+
+/// True when `path` exists and reads back whole.
+bool completeImage(const std::filesystem::path& path)
+{
+    std::error_code ec;
+    if (!std::filesystem::exists(path, ec)) return false;
+    try {
+        render::readImage(path);
+        return true;
+    } catch (const std::exception&) {
+        return false;
+    }
+}
+
+int runRenderScene(const RenderSceneArgs& args)
+{
+    const Scene scene = loadScene(args.scene);
+    const std::vector<int> frames = selectFrames(scene.frames, args.frames);
+    const std::string pattern = args.output.empty() ? (scene.folder / scene.frames.output).string() : args.output;
+    if (const std::string why = checkFramePattern(pattern); !why.empty())
+        throw UserError(SourceLocation{"-o"}, "\"" + pattern + "\": " + why);
+    if (scene.blend.mode == BlendMode::Sdf)
+        std::fprintf(stderr, "%s: warning: blend.mode = \"sdf\" is not implemented yet; blending densities\n",
+                     args.scene.c_str());
+
+    Interrupter interrupter(false);
+    StopSignals signals(interrupter);
+    SceneVolumes volumes = voxelizeScene(scene, &interrupter);
+    const Morpher morpher(std::move(volumes.source), std::move(volumes.target), scene.pairs, scene.warp, scene.blend);
+
+    const RenderSpec& r = scene.render;
+    const CameraSpec& c = r.camera;
+    const render::Camera camera(c.projection == Projection::Orthographic ? render::Camera::Projection::Orthographic
+                                                                         : render::Camera::Projection::Perspective,
+                                c.eye, c.lookat, c.up, c.fovDegrees, c.orthoWidth, r.width, r.height);
+    std::vector<render::Light> lights;
+    for (const LightSpec& l : r.lights) {
+        render::Light light;
+        light.type = l.type == LightType::Point ? render::Light::Type::Point : render::Light::Type::Directional;
+        light.direction = l.direction;
+        light.position = l.position;
+        light.color = l.color;
+        light.intensity = l.intensity;
+        lights.push_back(light);
+    }
+    render::Medium medium;
+    medium.extinction = r.extinction;
+    medium.albedo = r.albedo;
+    medium.anisotropy = r.anisotropy;
+
+    int failed = 0;
+    for (int frame : frames) {
+        const std::filesystem::path file = frameFileName(pattern, frame);
+        if (args.skipExisting && completeImage(file)) {
+            if (!args.quiet) std::printf("frame %d: %s exists, skipped\n", frame, file.string().c_str());
+            continue;
+        }
+        const auto start = std::chrono::steady_clock::now();
+        const VolumeSet v = morpher.frame(scene.frames.t(frame), nullptr, &interrupter);
+        render::RenderSettings settings;
+        settings.samples = r.samples;
+        settings.stepVoxels = r.stepVoxels;
+        settings.seed = r.seed;
+        settings.frame = frame;
+        settings.threads = args.threads;
+        const render::Image image = render::renderVolume(*v.density, v.color.get(), camera, lights, medium, settings);
+        if (interrupter.stopRequested()) throw Interrupted();
+        render::ExrOptions exr;
+        exr.frame = frame;
+        exr.samples = r.samples;
+        exr.renderSeconds = secondsSince(start);
+        exr.metadata["volmorph:scene"] = std::filesystem::absolute(args.scene).string();
+        exr.metadata["volmorph:t"] = fmt(scene.frames.t(frame));
+        try {
+            if (file.has_parent_path()) std::filesystem::create_directories(file.parent_path());
+            render::writeExr(image, camera, file, exr);
+        } catch (const std::exception& e) {
+            std::fprintf(stderr, "%s: cannot write frame %d (%s)\n", file.string().c_str(), frame, e.what());
+            ++failed;
+            continue;
+        }
+        if (!args.quiet)
+            std::printf("frame %d (t=%.4f): %.2f s -> %s\n", frame, scene.frames.t(frame), secondsSince(start),
+                        file.string().c_str());
+        std::fflush(stdout);
+    }
+    return failed ? kExitUserError : 0;
+}
+
+} // namespace
+
+Command addRenderVdbCommand(CLI::App& app)
+{
+    auto a = std::make_shared<RenderVdbArgs>();
+    CLI::App* sub = app.add_subcommand("render-vdb", "Render a float grid of a .vdb file to OpenEXR (like vdb_render)");
+    sub->add_option("IN", a->input, "input .vdb")->required();
+    sub->add_option("-o,--output", a->output, "output .exr")->required();
+    sub->add_option("--png", a->png, "also write an sRGB PNG preview");
+    sub->add_option("--camera", a->camera, "persp or ortho")->check(CLI::IsMember({"persp", "ortho"}));
+    sub->add_option("--translate", a->translate, "camera position X,Y,Z (world units)")->delimiter(',')->expected(3);
+    sub->add_option("--lookat", a->lookat, "point the camera looks at X,Y,Z")->delimiter(',')->expected(3);
+    sub->add_option("--up", a->up, "camera up vector X,Y,Z")->delimiter(',')->expected(3);
+    sub->add_option("--fov", a->fov, "horizontal field of view, degrees (perspective)")->check(CLI::Range(0.01, 179.0));
+    sub->add_option("--frame", a->frameWidth, "orthographic frame width, world units")->check(CLI::PositiveNumber);
+    sub->add_option("--res", a->resolution, "image size WIDTHxHEIGHT");
+    sub->add_option("--extinction", a->extinction, "extinction per world unit at density 1")->check(CLI::NonNegativeNumber);
+    sub->add_option("--albedo", a->albedo, "scattering albedo 0..1")->check(CLI::Range(0.0, 1.0));
+    sub->add_option("--light", a->light, "direction toward the light X,Y,Z[,R,G,B] (as vdb_render)")->delimiter(',')
+        ->expected(3, 6);
+    sub->add_option("--samples", a->samples, "samples per pixel")->check(CLI::Range(1, 65536));
+    sub->add_option("--step", a->step, "ray-march step in voxels")->check(CLI::Range(0.01, 8.0));
+    sub->add_option("--shadow-step", a->shadowStep, "step toward the lights, in voxels")->check(CLI::Range(0.05, 16.0));
+    sub->add_option("--shadow-cache", a->shadowCache, "light transmittance cache spacing, in voxels")
+        ->check(CLI::Range(1, 16));
+    sub->add_option("--threads", a->threads, "threads (0 = all cores)")->check(CLI::Range(0, 1024));
+    sub->add_option("--grid", a->grid, "name of the float grid (default: the first)");
+    sub->add_flag("--float", a->floatExr, "float EXR instead of half");
+    return {sub, [a] { return runRenderVdb(*a); }};
+}
+
+Command addRenderCommand(CLI::App& app)
+{
+    auto a = std::make_shared<RenderSceneArgs>();
+    CLI::App* sub = app.add_subcommand("render", "Render the scene's morph to one OpenEXR per frame");
+    sub->add_option("SCENE", a->scene, "scene file (TOML)")->required();
+    sub->add_option("--frames", a->frames, "frames to render, e.g. 1-10, 1-100x2, 1,5,10-20 (default: all)");
+    sub->add_option("-o,--output", a->output, "output pattern, e.g. out/f.####.exr (default: the scene's)");
+    sub->add_option("--threads", a->threads, "threads (0 = all cores)")->check(CLI::Range(0, 1024));
+    sub->add_flag("--skip-existing", a->skipExisting, "skip frames whose file exists and reads back whole");
+    sub->add_flag("-q,--quiet", a->quiet, "print nothing on success");
+    return {sub, [a] { return runRenderScene(*a); }};
+}
+
+} // namespace volmorph::cli
