@@ -39,9 +39,6 @@ int runMorph(const MorphArgs& args)
     if (frames.size() > 1 && frameFileName(pattern, frames[0]) == frameFileName(pattern, frames[1]))
         throw UserError(SourceLocation{"-o"}, "\"" + pattern + "\" has no frame number placeholder (#### or %04d)");
     if (args.exact) scene.warp.toleranceVoxels = 0.0;
-    if (scene.blend.mode == BlendMode::Sdf)
-        std::fprintf(stderr, "%s: warning: blend.mode = \"sdf\" is not implemented yet; blending densities\n",
-                     args.scene.c_str());
 
     Interrupter interrupter(false);
     StopSignals signals(interrupter);

@@ -139,9 +139,6 @@ int runRenderScene(const RenderSceneArgs& args)
     const std::string pattern = args.output.empty() ? (scene.folder / scene.frames.output).string() : args.output;
     if (const std::string why = checkFramePattern(pattern); !why.empty())
         throw UserError(SourceLocation{"-o"}, "\"" + pattern + "\": " + why);
-    if (scene.blend.mode == BlendMode::Sdf)
-        std::fprintf(stderr, "%s: warning: blend.mode = \"sdf\" is not implemented yet; blending densities\n",
-                     args.scene.c_str());
 
     Interrupter interrupter(false);
     StopSignals signals(interrupter);

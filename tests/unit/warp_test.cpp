@@ -351,7 +351,9 @@ TEST(Morph, EndsAreSourceAndTarget)
     up.translate = Vec3d(0, 0.5, 0);
     const VolumeSet d = voxelized("knot1.off", voxel, up);
     const Scene scene = loadScene(std::filesystem::path(VOLMORPH_SOURCE_DIR) / "scenes" / "bunny-to-knot.toml");
-    const Morpher morpher(s, d, scene.pairs, scene.warp, scene.blend);
+    BlendSpec blend = scene.blend;
+    blend.mode = BlendMode::Density; // the density path; SdfModeReproducesTheEndSurfaces covers sdf
+    const Morpher morpher(s, d, scene.pairs, scene.warp, blend);
     EXPECT_LT(maxDifference(*morpher.frame(0.0).density, *s.density), 1e-4);
     EXPECT_LT(maxDifference(*morpher.frame(1.0).density, *d.density), 1e-4);
 }
@@ -381,5 +383,66 @@ TEST(Morph, SparseDomainLosesNothing)
         const VolumeSet dense = morpher.frameOverBox(t, big, spec.toleranceVoxels, &denseStats);
         EXPECT_EQ(maxDifference(*sparse.density, *dense.density), 0.0) << "trial " << trial;
         EXPECT_LT(sparseStats.candidateLeaves, denseStats.candidateLeaves);
+    }
+}
+
+namespace {
+
+/// The largest displacement between the zero sets of two level sets, in voxels, measured on the
+/// grid near either surface (|a| or |b| < half a voxel). With unit gradients the displacement of
+/// the zero set there is |a - b| (|b| alone would add up to the half voxel of the sample's offset).
+double surfaceDistanceVoxels(const openvdb::FloatGrid& a, const openvdb::FloatGrid& b)
+{
+    const double voxel = a.voxelSize()[0];
+    double worst = 0.0;
+    auto one = [&](const openvdb::FloatGrid& x, const openvdb::FloatGrid& y) {
+        auto ya = y.getConstAccessor();
+        for (auto it = x.cbeginValueOn(); it; ++it)
+            if (std::abs(*it) < 0.5 * voxel)
+                worst = std::max(worst, std::abs(double(ya.getValue(it.getCoord())) - double(*it)) / voxel);
+    };
+    one(a, b);
+    one(b, a);
+    return worst;
+}
+
+} // namespace
+
+TEST(Morph, SdfModeReproducesTheEndSurfaces)
+{
+    const Scene scene = loadScene(std::filesystem::path(VOLMORPH_SOURCE_DIR) / "scenes" / "bunny-to-knot.toml");
+    ASSERT_EQ(scene.blend.mode, BlendMode::Sdf);
+    ObjectTransform xf;
+    xf.scale = Vec3d(0.1);
+    ObjectTransform up;
+    up.translate = Vec3d(0, 0.5, 0);
+    const double voxel = 0.016;
+    const VolumeSet s = voxelized("bunny.obj", voxel, xf), d = voxelized("knot1.off", voxel, up);
+    const Morpher morpher(s, d, scene.pairs, scene.warp, scene.blend);
+    const VolumeSet first = morpher.frame(0.0), last = morpher.frame(1.0);
+    ASSERT_TRUE(first.sdf && last.sdf);
+    EXPECT_EQ(first.sdf->getGridClass(), openvdb::GRID_LEVEL_SET);
+    EXPECT_LE(surfaceDistanceVoxels(*first.sdf, *s.sdf), 1.0);
+    EXPECT_LE(surfaceDistanceVoxels(*last.sdf, *d.sdf), 1.0);
+    // In between there is one surface: the fog comes from the blended level set alone.
+    const VolumeSet mid = morpher.frame(0.5);
+    EXPECT_LT(maxDifference(*mid.density, *fogFromLevelSet(*mid.sdf, 1.5f * float(voxel))), 1e-6);
+}
+
+TEST(Morph, SdfModeScalingPairScalesTheVolumeCubically)
+{
+    const double voxel = 0.02;
+    ObjectTransform twice;
+    twice.scale = Vec3d(2.0);
+    const VolumeSet s = voxelized("sphere.obj", voxel), d = voxelized("sphere.obj", voxel, twice);
+    const auto p = pair(FeatureType::Box, element(Vec3d(0.0)), element(Vec3d(0.0), Vec3d(1, 0, 0), Vec3d(0, 1, 0), Vec3d(2.0)));
+    BlendSpec blend;
+    blend.mode = BlendMode::Sdf;
+    const Morpher morpher(s, d, {p}, WarpSpec{}, blend);
+    const double v0 = moments(*s.density).mass;
+    for (double t : {0.25, 0.5, 0.75}) {
+        const double scale = 1.0 + t;
+        EXPECT_NEAR(moments(*morpher.frame(t).density).mass / v0, scale * scale * scale, 0.02 * scale * scale * scale)
+            << "t " << t;
     }
 }

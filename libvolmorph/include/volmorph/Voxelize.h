@@ -56,6 +56,10 @@ struct VoxelizeStats {
     uint64_t densityActiveVoxels = 0;   ///< including voxels of active tiles
 };
 
+/// A fog from a level set (world units): density = smoothstep of -sdf across [-ramp, +ramp] world
+/// units (0.5 on the surface), 1 in the interior as active tiles, 0 outside.
+openvdb::FloatGrid::Ptr fogFromLevelSet(const openvdb::FloatGrid& sdf, float rampWorld);
+
 /// The voxel size the options give for `mesh` (world units).
 double resolveVoxelSize(const Mesh& mesh, const VoxelizeOptions& options);
 

@@ -4,7 +4,10 @@
 
 #include "warp/AdaptiveWarp.h"
 
+#include <volmorph/Voxelize.h>
+
 #include <openvdb/tools/Interpolation.h>
+#include <openvdb/tools/LevelSetRebuild.h>
 #include <openvdb/tools/Prune.h>
 
 #include <memory>
@@ -48,23 +51,41 @@ template <typename Sampler>
 struct Resampler {
     const VolumeSet& source;
     const VolumeSet& target;
-    float tauDensity, tauColor;
+    float tauDensity, tauColor, tauSdf;
     Vec3f background;
+    bool sdfMode;
+    float outside; ///< sdf mode: blended distances at or above this are far outside (dropped)
 
-    /// Fills one output leaf pair; returns false when every voxel is empty.
-    bool operator()(const detail::WarpLeaf& w, FloatTree::LeafNodeType& density, Vec3STree::LeafNodeType& color) const
+    /// Fills one output leaf pair: `value` gets the blended density, or in sdf mode the blended
+    /// signed distance. Returns false when the leaf holds nothing.
+    bool operator()(const detail::WarpLeaf& w, FloatTree::LeafNodeType& value, Vec3STree::LeafNodeType& color) const
     {
         auto ds = source.density->getConstAccessor();
         auto dt = target.density->getConstAccessor();
         auto cs = source.color->getConstAccessor();
         auto ct = target.color->getConstAccessor();
+        std::unique_ptr<openvdb::FloatGrid::ConstAccessor> ss, st;
+        if (sdfMode) {
+            ss = std::make_unique<openvdb::FloatGrid::ConstAccessor>(source.sdf->getConstAccessor());
+            st = std::make_unique<openvdb::FloatGrid::ConstAccessor>(target.sdf->getConstAccessor());
+        }
         bool any = false;
         for (openvdb::Index n = 0; n < 512; ++n) {
             const openvdb::Vec3R ps(w.source[n]), pt(w.target[n]);
             const float a = Sampler::sample(ds, ps);
             const float b = Sampler::sample(dt, pt);
-            const float d = (1.0f - tauDensity) * a + tauDensity * b;
-            if (!(d > kEmpty)) continue;
+            if (sdfMode) {
+                // Beyond a band both distances are clamped to +/- background, so the blend keeps a
+                // consistent sign wherever either side is defined.
+                const float d = (1.0f - tauSdf) * Sampler::sample(*ss, ps) + tauSdf * Sampler::sample(*st, pt);
+                value.setValueOn(n, d);
+                any = any || d < outside;
+            } else {
+                const float d = (1.0f - tauDensity) * a + tauDensity * b;
+                if (!(d > kEmpty)) continue;
+                value.setValueOn(n, d);
+                any = true;
+            }
             // Colour weighted by each side's density, so an empty side contributes no colour.
             const float wa = (1.0f - tauColor) * std::max(a, 0.0f), wb = tauColor * std::max(b, 0.0f);
             Vec3f c = background;
@@ -73,9 +94,7 @@ struct Resampler {
                 const Vec3f cb = wb > 0.0f ? Sampler::sample(ct, pt) : Vec3f(0.0f);
                 c = (wa * ca + wb * cb) / (wa + wb);
             }
-            density.setValueOn(n, d);
             color.setValueOn(n, c);
-            any = true;
         }
         return any;
     }
@@ -90,6 +109,8 @@ Morpher::Morpher(VolumeSet source, VolumeSet target, std::vector<FeaturePairSpec
 {
     if (!mSource.density || !mTarget.density || !mSource.color || !mTarget.color)
         throw std::invalid_argument("Morpher: source and target need density and Cd grids");
+    if (mBlend.mode == BlendMode::Sdf && (!mSource.sdf || !mTarget.sdf))
+        throw std::invalid_argument("Morpher: sdf blending needs sdf grids on both sides");
     if (!(mSource.density->transform() == mTarget.density->transform()))
         throw std::invalid_argument("Morpher: source and target must share one transform");
 }
@@ -135,6 +156,9 @@ VolumeSet Morpher::run(double t, const CoordBBox& box, bool prune, double tolera
         occT = std::make_unique<detail::Occupancy>(mTarget.density->tree());
     }
     const float tauD = float(mBlend.density.evaluate(t)), tauC = float(mBlend.color.evaluate(t));
+    const float tauS = float(mBlend.sdf.evaluate(t));
+    const bool sdfMode = mBlend.mode == BlendMode::Sdf;
+    const float outside = sdfMode ? std::min(mSource.sdf->background(), mTarget.sdf->background()) : 0.0f;
     const Vec3f background = (1.0f - tauC) * mSource.color->background() + tauC * mTarget.color->background();
 
     std::mutex collect;
@@ -151,26 +175,39 @@ VolumeSet Morpher::run(double t, const CoordBBox& box, bool prune, double tolera
     detail::AdaptiveWarpStats warpStats;
     if (mOptions.sampling == MorphOptions::Sampling::Triquadratic)
         adaptive.forEachLeaf(box, occS.get(), occT.get(),
-                             each(Resampler<openvdb::tools::QuadraticSampler>{mSource, mTarget, tauD, tauC, background}),
+                             each(Resampler<openvdb::tools::QuadraticSampler>{mSource, mTarget, tauD, tauC, tauS, background,
+                                                                              sdfMode, outside}),
                              &warpStats, interrupter);
     else
         adaptive.forEachLeaf(box, occS.get(), occT.get(),
-                             each(Resampler<openvdb::tools::BoxSampler>{mSource, mTarget, tauD, tauC, background}),
+                             each(Resampler<openvdb::tools::BoxSampler>{mSource, mTarget, tauD, tauC, tauS, background, sdfMode,
+                                                                        outside}),
                              &warpStats, interrupter);
 
     VolumeSet out;
-    out.density = openvdb::FloatGrid::create(0.0f);
+    openvdb::FloatGrid::Ptr values =
+        openvdb::FloatGrid::create(sdfMode ? std::max(mSource.sdf->background(), mTarget.sdf->background()) : 0.0f);
     out.color = openvdb::Vec3SGrid::create(background);
-    for (auto& [density, color] : leaves) {
-        out.density->tree().addLeaf(density);
+    for (auto& [value, color] : leaves) {
+        values->tree().addLeaf(value);
         out.color->tree().addLeaf(color);
     }
-    // Leaves of constant interior collapse back into tiles.
-    openvdb::tools::prune(out.density->tree());
+    values->setTransform(mSource.density->transform().copy());
+    if (sdfMode) {
+        // The blend of two warped distances has the right zero set but is no distance field: rebuild
+        // a proper narrow band around its surface, then the fog from that surface.
+        values->setGridClass(openvdb::GRID_LEVEL_SET);
+        const float halfWidth = mSource.sdf->background() / float(voxel);
+        out.sdf = openvdb::tools::levelSetRebuild(*values, 0.0f, halfWidth);
+        out.sdf->setName(kSdfGridName);
+        out.sdf->setGridClass(openvdb::GRID_LEVEL_SET);
+        out.density = fogFromLevelSet(*out.sdf, 1.5f * float(voxel));
+    } else {
+        out.density = values;
+        openvdb::tools::prune(out.density->tree()); // leaves of constant interior collapse into tiles
+    }
     openvdb::tools::prune(out.color->tree());
-    for (openvdb::GridBase* g : {static_cast<openvdb::GridBase*>(out.density.get()),
-                                 static_cast<openvdb::GridBase*>(out.color.get())})
-        g->setTransform(mSource.density->transform().copy());
+    out.color->setTransform(mSource.density->transform().copy());
     out.density->setName(kDensityGridName);
     out.density->setGridClass(openvdb::GRID_FOG_VOLUME);
     out.color->setName(kColorGridName);

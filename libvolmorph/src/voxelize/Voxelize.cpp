@@ -123,38 +123,6 @@ void signByWindingNumber(FloatGrid& grid, const Mesh& mesh, Interrupter* interru
     grid.setGridClass(openvdb::GRID_LEVEL_SET);
 }
 
-/// density = smoothstep of the signed distance across [-ramp, +ramp] (0.5 on the surface), 1 in
-/// the interior as active tiles, 0 outside and inactive.
-FloatGrid::Ptr densityFromSdf(const FloatGrid& sdf, float rampWorld)
-{
-    FloatGrid::Ptr density = sdf.deepCopy();
-    FloatTree& tree = density->tree();
-    auto ramp = [rampWorld](float d) {
-        const float x = std::clamp(0.5f - d / (2.0f * rampWorld), 0.0f, 1.0f);
-        return x * x * (3.0f - 2.0f * x);
-    };
-    openvdb::tree::LeafManager<FloatTree> leaves(tree);
-    leaves.foreach([&](FloatTree::LeafNodeType& leaf, size_t) {
-        for (auto it = leaf.beginValueAll(); it; ++it) {
-            const float d = *it;
-            const float value = it.isValueOn() ? ramp(d) : (d < 0.0f ? 1.0f : 0.0f);
-            it.setValue(value);
-            it.setValueOn(value > 0.0f);
-        }
-    });
-    for (auto it = tree.beginValueAll(); it; ++it) {
-        if (it.isVoxelValue()) continue;
-        const bool inside = *it < 0.0f;
-        it.setValue(inside ? 1.0f : 0.0f);
-        it.setActiveState(inside);
-    }
-    tree.root().setBackground(0.0f, /*updateChildNodes=*/true);
-    openvdb::tools::prune(tree);
-    density->setGridClass(openvdb::GRID_FOG_VOLUME);
-    density->setName(kDensityGridName);
-    return density;
-}
-
 /// Colour on the band: vertex colours interpolated at the closest point of the closest triangle.
 Vec3SGrid::Ptr colorFromIndex(const Mesh& mesh, const Int32Grid* index, const FloatGrid& sdf,
                               const std::optional<Vec3f>& constant)
@@ -199,6 +167,38 @@ Vec3SGrid::Ptr colorFromIndex(const Mesh& mesh, const Int32Grid* index, const Fl
 }
 
 } // namespace
+
+/// density = smoothstep of the signed distance across [-ramp, +ramp] (0.5 on the surface), 1 in
+/// the interior as active tiles, 0 outside and inactive.
+FloatGrid::Ptr fogFromLevelSet(const FloatGrid& sdf, float rampWorld)
+{
+    FloatGrid::Ptr density = sdf.deepCopy();
+    FloatTree& tree = density->tree();
+    auto ramp = [rampWorld](float d) {
+        const float x = std::clamp(0.5f - d / (2.0f * rampWorld), 0.0f, 1.0f);
+        return x * x * (3.0f - 2.0f * x);
+    };
+    openvdb::tree::LeafManager<FloatTree> leaves(tree);
+    leaves.foreach([&](FloatTree::LeafNodeType& leaf, size_t) {
+        for (auto it = leaf.beginValueAll(); it; ++it) {
+            const float d = *it;
+            const float value = it.isValueOn() ? ramp(d) : (d < 0.0f ? 1.0f : 0.0f);
+            it.setValue(value);
+            it.setValueOn(value > 0.0f);
+        }
+    });
+    for (auto it = tree.beginValueAll(); it; ++it) {
+        if (it.isVoxelValue()) continue;
+        const bool inside = *it < 0.0f;
+        it.setValue(inside ? 1.0f : 0.0f);
+        it.setActiveState(inside);
+    }
+    tree.root().setBackground(0.0f, /*updateChildNodes=*/true);
+    openvdb::tools::prune(tree);
+    density->setGridClass(openvdb::GRID_FOG_VOLUME);
+    density->setName(kDensityGridName);
+    return density;
+}
 
 uint64_t defaultMemoryLimitBytes()
 {
@@ -321,7 +321,7 @@ VolumeSet voxelize(const Mesh& input, const VoxelizeOptions& options, Interrupte
 
     VolumeSet out;
     out.sdf = sdf;
-    out.density = densityFromSdf(*sdf, options.densityRampVoxels * float(voxelSize));
+    out.density = fogFromLevelSet(*sdf, options.densityRampVoxels * float(voxelSize));
     checkInterrupt(interrupter, 90);
     out.color = colorFromIndex(mesh, index.get(), *sdf, options.color);
     checkInterrupt(interrupter, 100);
