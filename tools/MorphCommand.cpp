@@ -1,6 +1,7 @@
 // volmorph morph SCENE [--frames SPEC] [-o PATTERN.vdb]: one .vdb of the in-between per frame.
 #include "Common.h"
 
+#include <volmorph/Export.h>
 #include <volmorph/Frames.h>
 #include <volmorph/Morph.h>
 #include <volmorph/Version.h>
@@ -16,7 +17,7 @@ namespace volmorph::cli {
 namespace {
 
 struct MorphArgs {
-    std::string scene, frames, output, sampling = "trilinear";
+    std::string scene, frames, output, mesh, sampling = "trilinear";
     bool exact = false, quiet = false;
     double memoryLimitGiB = 0.0;
 };
@@ -38,6 +39,13 @@ int runMorph(const MorphArgs& args)
         throw UserError(SourceLocation{"-o"}, "\"" + pattern + "\": " + why);
     if (frames.size() > 1 && frameFileName(pattern, frames[0]) == frameFileName(pattern, frames[1]))
         throw UserError(SourceLocation{"-o"}, "\"" + pattern + "\" has no frame number placeholder (#### or %04d)");
+    if (!args.mesh.empty()) {
+        if (const std::string why = checkFramePattern(args.mesh); !why.empty())
+            throw UserError(SourceLocation{"--mesh"}, "\"" + args.mesh + "\": " + why);
+        const std::string ext = std::filesystem::path(args.mesh).extension().string();
+        if (ext != ".ply" && ext != ".obj")
+            throw UserError(SourceLocation{"--mesh"}, "expected a pattern ending in .ply or .obj, got \"" + args.mesh + "\"");
+    }
     if (args.exact) scene.warp.toleranceVoxels = 0.0;
 
     Interrupter interrupter(false);
@@ -65,6 +73,11 @@ int runMorph(const MorphArgs& args)
                         {"volmorph_frame", std::to_string(frame)},
                         {"volmorph_t", fmt(t)},
                         {"volmorph_version", versionString()}});
+        if (!args.mesh.empty()) {
+            const std::filesystem::path meshFile = frameFileName(args.mesh, frame);
+            if (meshFile.has_parent_path()) std::filesystem::create_directories(meshFile.parent_path());
+            writeMesh(surfaceMesh(v), meshFile);
+        }
         if (!args.quiet)
             std::printf("frame %d (t=%.4f): %llu active voxels, warp error <= %.3f voxels, %.2f s -> %s\n", frame, t,
                         (unsigned long long)stats.activeVoxels, stats.maxWarpErrorVoxels,
@@ -84,6 +97,8 @@ Command addMorphCommand(CLI::App& app)
     sub->add_option("--frames", args->frames, "frames to write, e.g. 1-10, 1-100x2, 1,5,10-20 (default: all)");
     sub->add_option("-o,--output", args->output,
                     "output pattern, e.g. out/morph.####.vdb (default: the scene's output with .vdb)");
+    sub->add_option("--mesh", args->mesh,
+                    "also write each in-between's surface, e.g. out/morph.####.ply (PLY with colours, or OBJ)");
     sub->add_flag("--exact", args->exact, "use the exact warp everywhere (the reference; slow)");
     sub->add_option("--sampling", args->sampling, "resampling filter: trilinear or triquadratic")
         ->check(CLI::IsMember({"trilinear", "triquadratic"}));
