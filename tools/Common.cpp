@@ -59,4 +59,9 @@ std::string describeTopology(const MeshReport& r)
     return s.str();
 }
 
+double secondsSince(std::chrono::steady_clock::time_point start)
+{
+    return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
 } // namespace volmorph::cli

@@ -6,6 +6,7 @@
 
 #include <CLI/CLI.hpp>
 
+#include <chrono>
 #include <csignal>
 #include <functional>
 #include <string>
@@ -34,6 +35,9 @@ Command addRenderCommand(CLI::App& app);
 std::string fmt(double v);
 std::string fmt(const Vec3d& v);
 std::string describeTopology(const MeshReport& r);
+
+/// Wall-clock seconds since `start`.
+double secondsSince(std::chrono::steady_clock::time_point start);
 
 /// Routes SIGINT and SIGTERM to `interrupter` for the lifetime of this object.
 class StopSignals {

@@ -22,11 +22,6 @@ struct MorphArgs {
     double memoryLimitGiB = 0.0;
 };
 
-double secondsSince(std::chrono::steady_clock::time_point start)
-{
-    return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-}
-
 int runMorph(const MorphArgs& args)
 {
     Scene scene = loadScene(args.scene);

@@ -20,11 +20,6 @@
 namespace volmorph::cli {
 namespace {
 
-double secondsSince(std::chrono::steady_clock::time_point start)
-{
-    return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-}
-
 Vec3d vec3(const std::vector<double>& v) { return Vec3d(v[0], v[1], v[2]); }
 
 struct RenderVdbArgs {

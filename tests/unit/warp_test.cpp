@@ -318,17 +318,22 @@ TEST(Morph, BoxPairRotatesThePrincipalAxis)
 
 TEST(Morph, ScalingPairScalesTheVolumeCubically)
 {
+    // Both sides warped to the same sphere scaled by 1 + t, in either blend mode.
     const double voxel = 0.02;
     ObjectTransform twice;
     twice.scale = Vec3d(2.0);
     const VolumeSet s = voxelized("sphere.obj", voxel), d = voxelized("sphere.obj", voxel, twice);
     const auto p = pair(FeatureType::Box, element(Vec3d(0.0)), element(Vec3d(0.0), Vec3d(1, 0, 0), Vec3d(0, 1, 0), Vec3d(2.0)));
-    const Morpher morpher(s, d, {p}, WarpSpec{}, BlendSpec{});
     const double v0 = moments(*s.density).mass;
-    for (double t : {0.25, 0.5, 0.75}) {
-        const double scale = 1.0 + t;
-        EXPECT_NEAR(moments(*morpher.frame(t).density).mass / v0, scale * scale * scale, 0.02 * scale * scale * scale)
-            << "t " << t;
+    for (BlendMode mode : {BlendMode::Density, BlendMode::Sdf}) {
+        BlendSpec blend;
+        blend.mode = mode;
+        const Morpher morpher(s, d, {p}, WarpSpec{}, blend);
+        for (double t : {0.25, 0.5, 0.75}) {
+            const double scale = 1.0 + t;
+            EXPECT_NEAR(moments(*morpher.frame(t).density).mass / v0, scale * scale * scale, 0.02 * scale * scale * scale)
+                << "t " << t << (mode == BlendMode::Sdf ? " (sdf)" : " (density)");
+        }
     }
 }
 
@@ -428,24 +433,6 @@ TEST(Morph, SdfModeReproducesTheEndSurfaces)
     // In between there is one surface: the fog comes from the blended level set alone.
     const VolumeSet mid = morpher.frame(0.5);
     EXPECT_LT(maxDifference(*mid.density, *fogFromLevelSet(*mid.sdf, 1.5f * float(voxel))), 1e-6);
-}
-
-TEST(Morph, SdfModeScalingPairScalesTheVolumeCubically)
-{
-    const double voxel = 0.02;
-    ObjectTransform twice;
-    twice.scale = Vec3d(2.0);
-    const VolumeSet s = voxelized("sphere.obj", voxel), d = voxelized("sphere.obj", voxel, twice);
-    const auto p = pair(FeatureType::Box, element(Vec3d(0.0)), element(Vec3d(0.0), Vec3d(1, 0, 0), Vec3d(0, 1, 0), Vec3d(2.0)));
-    BlendSpec blend;
-    blend.mode = BlendMode::Sdf;
-    const Morpher morpher(s, d, {p}, WarpSpec{}, blend);
-    const double v0 = moments(*s.density).mass;
-    for (double t : {0.25, 0.5, 0.75}) {
-        const double scale = 1.0 + t;
-        EXPECT_NEAR(moments(*morpher.frame(t).density).mass / v0, scale * scale * scale, 0.02 * scale * scale * scale)
-            << "t " << t;
-    }
 }
 
 TEST(Morph, InBetweenExportsAsAClosedColouredMesh)

@@ -12,7 +12,13 @@
 
 #include <openvdb/math/Coord.h>
 
+#include <memory>
+
 namespace volmorph {
+
+namespace detail {
+class Occupancy;
+}
 
 struct MorphOptions {
     enum class Sampling { Trilinear, Triquadratic };
@@ -53,6 +59,8 @@ private:
                   Interrupter* interrupter) const;
 
     VolumeSet mSource, mTarget;
+    /// Which 8^3 blocks of source and target are occupied; they do not change with t.
+    std::shared_ptr<const detail::Occupancy> mSourceBlocks, mTargetBlocks;
     std::vector<FeaturePairSpec> mPairs;
     WarpSpec mWarp;
     BlendSpec mBlend;

@@ -1,9 +1,9 @@
 #include <volmorph/Diagnostics.h>
 #include <volmorph/VolumeSet.h>
 
-#include <openvdb/io/File.h>
+#include "AtomicFile.h"
 
-#include <unistd.h>
+#include <openvdb/io/File.h>
 
 #include <cstdio>
 #include <mutex>
@@ -30,25 +30,12 @@ void writeVolumeSet(const VolumeSet& volumes, const std::filesystem::path& path,
         for (const auto& [key, value] : metadata) g->insertMeta(key, openvdb::StringMetadata(value));
         grids.push_back(g);
     }
-    // Write beside the final name, then rename: a reader never sees a partial file at `path`.
-    const std::filesystem::path temporary =
-        path.string() + ".partial-" + std::to_string(long(getpid()));
-    try {
+    detail::writeAtomically(path, "volume file", [&grids](const std::filesystem::path& temporary) {
         openvdb::io::File file(temporary.string());
         file.setCompression(openvdb::io::COMPRESS_BLOSC | openvdb::io::COMPRESS_ACTIVE_MASK);
         file.write(grids);
         file.close();
-    } catch (const std::exception& e) {
-        std::error_code ec;
-        std::filesystem::remove(temporary, ec);
-        throw UserError(SourceLocation{path.string()}, std::string("cannot write volume file (") + e.what() + ")");
-    }
-    std::error_code ec;
-    std::filesystem::rename(temporary, path, ec);
-    if (ec) {
-        std::filesystem::remove(temporary, ec);
-        throw UserError(SourceLocation{path.string()}, "cannot write volume file (" + ec.message() + ")");
-    }
+    });
 }
 
 VolumeSet readVolumeSet(const std::filesystem::path& path)

@@ -1,13 +1,14 @@
 #include <volmorph/Export.h>
 
+#include "core/AtomicFile.h"
+
 #include <assimp/Exporter.hpp>
 #include <assimp/scene.h>
 #include <openvdb/tools/Interpolation.h>
 #include <openvdb/tools/VolumeToMesh.h>
 
-#include <unistd.h>
-
 #include <memory>
+#include <stdexcept>
 
 namespace volmorph {
 
@@ -81,21 +82,11 @@ void writeMesh(const Mesh& mesh, const std::filesystem::path& path)
         m.mFaces[f].mIndices = new unsigned[3]{mesh.triangles[f][0], mesh.triangles[f][1], mesh.triangles[f][2]};
     }
 
-    const std::filesystem::path temporary =
-        path.parent_path() / (path.stem().string() + ".partial-" + std::to_string(long(getpid())) + ext);
-    Assimp::Exporter exporter;
-    if (exporter.Export(scene.get(), format, temporary.string()) != aiReturn_SUCCESS) {
-        std::error_code ec;
-        std::filesystem::remove(temporary, ec);
-        throw UserError(SourceLocation{path.string()},
-                        std::string("cannot write mesh (") + exporter.GetErrorString() + ")");
-    }
-    std::error_code ec;
-    std::filesystem::rename(temporary, path, ec);
-    if (ec) {
-        std::filesystem::remove(temporary, ec);
-        throw UserError(SourceLocation{path.string()}, "cannot write mesh (" + ec.message() + ")");
-    }
+    detail::writeAtomically(path, "mesh", [&](const std::filesystem::path& temporary) {
+        Assimp::Exporter exporter;
+        if (exporter.Export(scene.get(), format, temporary.string()) != aiReturn_SUCCESS)
+            throw std::runtime_error(exporter.GetErrorString());
+    });
 }
 
 } // namespace volmorph

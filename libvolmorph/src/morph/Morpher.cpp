@@ -24,8 +24,6 @@ using openvdb::Vec3STree;
 /// Densities at or below this are empty (a trilinear sample at the edge of a fog's support).
 constexpr float kEmpty = 1e-6f;
 
-CoordBBox boundsOf(const VolumeSet& v) { return detail::Occupancy(v.density->tree()).bounds(); }
-
 /// The box of the 8 corners of `box` under p -> M^-1 (p - b), M and b of `a`.
 CoordBBox inverseImage(const InverseWarp::Affine& a, const CoordBBox& box)
 {
@@ -113,11 +111,13 @@ Morpher::Morpher(VolumeSet source, VolumeSet target, std::vector<FeaturePairSpec
         throw std::invalid_argument("Morpher: sdf blending needs sdf grids on both sides");
     if (!(mSource.density->transform() == mTarget.density->transform()))
         throw std::invalid_argument("Morpher: source and target must share one transform");
+    mSourceBlocks = std::make_shared<const detail::Occupancy>(mSource.density->tree());
+    mTargetBlocks = std::make_shared<const detail::Occupancy>(mTarget.density->tree());
 }
 
 CoordBBox Morpher::candidateBounds(double t) const
 {
-    const CoordBBox s = boundsOf(mSource), d = boundsOf(mTarget);
+    const CoordBBox s = mSourceBlocks->bounds(), d = mTargetBlocks->bounds();
     CoordBBox box;
     if (!s.empty()) box.expand(s);
     if (!d.empty()) box.expand(d);
@@ -149,12 +149,8 @@ VolumeSet Morpher::run(double t, const CoordBBox& box, bool prune, double tolera
     const double voxel = mSource.voxelSize();
     const InverseWarp warp(mPairs, mWarp, t, 1.0 / voxel);
     const detail::AdaptiveWarp adaptive(warp, tolerance, mWarp.epsilon / voxel);
-    // The occupancies do not depend on t; they are cheap next to a frame (one pass over leaves).
-    std::unique_ptr<detail::Occupancy> occS, occT;
-    if (prune) {
-        occS = std::make_unique<detail::Occupancy>(mSource.density->tree());
-        occT = std::make_unique<detail::Occupancy>(mTarget.density->tree());
-    }
+    const detail::Occupancy* occS = prune ? mSourceBlocks.get() : nullptr;
+    const detail::Occupancy* occT = prune ? mTargetBlocks.get() : nullptr;
     const float tauD = float(mBlend.density.evaluate(t)), tauC = float(mBlend.color.evaluate(t));
     const float tauS = float(mBlend.sdf.evaluate(t));
     const bool sdfMode = mBlend.mode == BlendMode::Sdf;
@@ -174,12 +170,12 @@ VolumeSet Morpher::run(double t, const CoordBBox& box, bool prune, double tolera
     };
     detail::AdaptiveWarpStats warpStats;
     if (mOptions.sampling == MorphOptions::Sampling::Triquadratic)
-        adaptive.forEachLeaf(box, occS.get(), occT.get(),
+        adaptive.forEachLeaf(box, occS, occT,
                              each(Resampler<openvdb::tools::QuadraticSampler>{mSource, mTarget, tauD, tauC, tauS, background,
                                                                               sdfMode, outside}),
                              &warpStats, interrupter);
     else
-        adaptive.forEachLeaf(box, occS.get(), occT.get(),
+        adaptive.forEachLeaf(box, occS, occT,
                              each(Resampler<openvdb::tools::BoxSampler>{mSource, mTarget, tauD, tauC, tauS, background, sdfMode,
                                                                         outside}),
                              &warpStats, interrupter);
