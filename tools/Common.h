@@ -31,6 +31,7 @@ Command addVoxelizeCommand(CLI::App& app);
 Command addMorphCommand(CLI::App& app);
 Command addRenderVdbCommand(CLI::App& app);
 Command addRenderCommand(CLI::App& app);
+Command addDiffCommand(CLI::App& app);
 
 std::string fmt(double v);
 std::string fmt(const Vec3d& v);

@@ -14,7 +14,8 @@ int main(int argc, char** argv)
     app.set_version_flag("--version", std::string("volmorph ") + volmorph::versionString());
     app.require_subcommand(1);
     const std::vector<Command> commands = {addCheckCommand(app), addVoxelizeCommand(app), addMorphCommand(app),
-                                          addRenderVdbCommand(app), addRenderCommand(app)};
+                                          addRenderVdbCommand(app), addRenderCommand(app),
+                                          addDiffCommand(app)};
 
     try {
         app.parse(argc, argv);
