@@ -1,5 +1,10 @@
 #include "Common.h"
 
+#include <algorithm>
+
+#include <unistd.h>
+
+#include <cstdio>
 #include <sstream>
 
 namespace volmorph::cli {
@@ -57,6 +62,95 @@ std::string describeTopology(const MeshReport& r)
     if (!r.consistentlyOriented()) s << ", " << r.misorientedEdges << " inconsistently oriented edges";
     s << ", " << r.components << (r.components == 1 ? " shell" : " shells");
     return s.str();
+}
+
+std::filesystem::path CacheArgs::resolve() const
+{
+    if (disabled) return {};
+    if (!folder.empty()) return folder;
+    return defaultCacheFolder();
+}
+
+void addCacheOptions(CLI::App* command, CacheArgs& args)
+{
+    command->add_option("--cache", args.folder,
+                        "voxel cache folder (default: $VOLMORPH_CACHE, else $XDG_CACHE_HOME/volmorph, else "
+                        "~/.cache/volmorph); share it between the chunks of a farm job");
+    command->add_flag("--no-cache", args.disabled, "voxelize without reading or writing the cache");
+}
+
+SceneVolumes loadSceneVolumes(const Scene& scene, const CacheArgs& cache, Interrupter& interrupter,
+                              uint64_t memoryLimitBytes, bool quiet)
+{
+    const auto start = std::chrono::steady_clock::now();
+    CacheReport report;
+    SceneVolumes volumes = voxelizeSceneCached(scene, cache.resolve(), &interrupter, memoryLimitBytes, &report);
+    const std::string entry = report.entry.string();
+    if (report.outcome == CacheReport::Outcome::Rebuilt)
+        std::fprintf(stderr, "%s: voxel cache entry not used (%s); voxelized again and replaced\n", entry.c_str(),
+                     report.problem.c_str());
+    if (!report.storeProblem.empty())
+        std::fprintf(stderr, "volmorph: warning: the voxels were not cached: %s\n", report.storeProblem.c_str());
+    if (!quiet) {
+        const double seconds = secondsSince(start);
+        if (report.outcome == CacheReport::Outcome::Hit)
+            std::printf("voxels of source and target read from the cache in %.2f s (%s)\n", seconds, entry.c_str());
+        else
+            std::printf("voxelized source and target at %g world units in %.2f s%s%s\n", volumes.source.voxelSize(),
+                        seconds, report.storeProblem.empty() && !entry.empty() ? "; cached in " : "",
+                        report.storeProblem.empty() ? entry.c_str() : "");
+        std::fflush(stdout);
+    }
+    return volumes;
+}
+
+Progress::Progress(int steps, bool quiet)
+    : mSteps(std::max(1, steps)), mQuiet(quiet), mTerminal(isatty(STDOUT_FILENO) == 1),
+      mStart(std::chrono::steady_clock::now())
+{
+}
+
+void Progress::update(int done)
+{
+    if (mQuiet) return;
+    mLastDone = done;
+    const int percent = int(100.0 * double(done) / double(mSteps));
+    if (!mTerminal) {
+        if (percent == mLastPercent) return;
+        mLastPercent = percent;
+        std::printf("ALF_PROGRESS %d%%\n", percent);
+        std::fflush(stdout);
+        return;
+    }
+    const double elapsed = secondsSince(mStart);
+    const double eta = done > 0 ? elapsed * double(mSteps - done) / double(done) : 0.0;
+    constexpr int kWidth = 30;
+    const int filled = kWidth * done / mSteps;
+    std::string bar(size_t(filled), '#');
+    bar.append(size_t(kWidth - filled), '.');
+    char text[160];
+    if (done > 0)
+        std::snprintf(text, sizeof text, "\r[%s] %3d%%  %d/%d  elapsed %.0f s  ETA %.0f s ", bar.c_str(), percent,
+                      done, mSteps, elapsed, eta);
+    else
+        std::snprintf(text, sizeof text, "\r[%s] %3d%%  %d/%d ", bar.c_str(), percent, done, mSteps);
+    std::fputs(text, stdout);
+    std::fflush(stdout);
+    mBarShown = true;
+}
+
+void Progress::log(const std::string& line)
+{
+    if (mQuiet) return;
+    if (mTerminal && mBarShown) std::fputs("\r\033[K", stdout); // clear the bar, print, redraw below
+    std::printf("%s\n", line.c_str());
+    if (mTerminal && mBarShown) update(mLastDone);
+    std::fflush(stdout);
+}
+
+Progress::~Progress()
+{
+    if (!mQuiet && mTerminal && mBarShown) std::fputs("\n", stdout);
 }
 
 double secondsSince(std::chrono::steady_clock::time_point start)

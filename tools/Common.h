@@ -3,6 +3,7 @@
 
 #include <volmorph/Interrupter.h>
 #include <volmorph/Mesh.h>
+#include <volmorph/VoxelCache.h>
 
 #include <CLI/CLI.hpp>
 
@@ -32,6 +33,7 @@ Command addMorphCommand(CLI::App& app);
 Command addRenderVdbCommand(CLI::App& app);
 Command addRenderCommand(CLI::App& app);
 Command addDiffCommand(CLI::App& app);
+Command addCacheCommand(CLI::App& app);
 
 std::string fmt(double v);
 std::string fmt(const Vec3d& v);
@@ -39,6 +41,38 @@ std::string describeTopology(const MeshReport& r);
 
 /// Wall-clock seconds since `start`.
 double secondsSince(std::chrono::steady_clock::time_point start);
+
+/// Where the voxel cache lives: --cache DIR, or --no-cache, or defaultCacheFolder().
+struct CacheArgs {
+    std::string folder;
+    bool disabled = false;
+    std::filesystem::path resolve() const;
+};
+void addCacheOptions(CLI::App* command, CacheArgs& args);
+
+/// The scene's voxelized source and target through the cache, saying where they came from (on
+/// stdout unless `quiet`; a rebuilt or unstorable entry always on stderr).
+SceneVolumes loadSceneVolumes(const Scene& scene, const CacheArgs& cache, Interrupter& interrupter,
+                              uint64_t memoryLimitBytes, bool quiet);
+
+/// Progress of a sequence. On a terminal: a live bar with the ETA, redrawn in place. Otherwise
+/// (a log, a render farm): one flushed line per update, `ALF_PROGRESS 42%`, which farm software
+/// (Tractor, OpenCue, Deadline with a regex) parses.
+class Progress {
+public:
+    Progress(int steps, bool quiet);
+    /// Marks `done` of the steps finished.
+    void update(int done);
+    /// Prints a log line, keeping the bar below it on a terminal.
+    void log(const std::string& line);
+    /// Ends the bar's line (on a terminal).
+    ~Progress();
+
+private:
+    int mSteps, mLastPercent = -1, mLastDone = 0;
+    bool mQuiet, mTerminal, mBarShown = false;
+    std::chrono::steady_clock::time_point mStart;
+};
 
 /// Routes SIGINT and SIGTERM to `interrupter` for the lifetime of this object.
 class StopSignals {

@@ -20,6 +20,7 @@ struct MorphArgs {
     std::string scene, frames, output, mesh, sampling = "trilinear";
     bool exact = false, quiet = false;
     double memoryLimitGiB = 0.0;
+    CacheArgs cache;
 };
 
 int runMorph(const MorphArgs& args)
@@ -45,17 +46,17 @@ int runMorph(const MorphArgs& args)
 
     Interrupter interrupter(false);
     StopSignals signals(interrupter);
-    const auto start = std::chrono::steady_clock::now();
-    SceneVolumes volumes = voxelizeScene(scene, &interrupter, uint64_t(args.memoryLimitGiB * double(1ull << 30)));
-    if (!args.quiet)
-        std::printf("voxelized source and target at %g world units in %.2f s\n", volumes.source.voxelSize(),
-                    secondsSince(start));
+    SceneVolumes volumes = loadSceneVolumes(scene, args.cache, interrupter,
+                                            uint64_t(args.memoryLimitGiB * double(1ull << 30)), args.quiet);
     MorphOptions options;
     if (args.sampling == "triquadratic") options.sampling = MorphOptions::Sampling::Triquadratic;
     const Morpher morpher(std::move(volumes.source), std::move(volumes.target), scene.pairs, scene.warp,
                           scene.blend, options);
 
-    for (int frame : frames) {
+    Progress progress(int(frames.size()), args.quiet);
+    progress.update(0);
+    for (size_t i = 0; i < frames.size(); ++i) {
+        const int frame = frames[i];
         const auto frameStart = std::chrono::steady_clock::now();
         const double t = scene.frames.t(frame);
         MorphStats stats;
@@ -73,11 +74,12 @@ int runMorph(const MorphArgs& args)
             if (meshFile.has_parent_path()) std::filesystem::create_directories(meshFile.parent_path());
             writeMesh(surfaceMesh(v), meshFile);
         }
-        if (!args.quiet)
-            std::printf("frame %d (t=%.4f): %llu active voxels, warp error <= %.3f voxels, %.2f s -> %s\n", frame, t,
-                        (unsigned long long)stats.activeVoxels, stats.maxWarpErrorVoxels,
-                        secondsSince(frameStart), file.string().c_str());
-        std::fflush(stdout);
+        char line[512];
+        std::snprintf(line, sizeof line, "frame %d (t=%.4f): %llu active voxels, warp error <= %.3f voxels, %.2f s -> %s",
+                      frame, t, (unsigned long long)stats.activeVoxels, stats.maxWarpErrorVoxels,
+                      secondsSince(frameStart), file.string().c_str());
+        progress.log(line);
+        progress.update(int(i + 1));
     }
     return 0;
 }
@@ -99,6 +101,7 @@ Command addMorphCommand(CLI::App& app)
         ->check(CLI::IsMember({"trilinear", "triquadratic"}));
     sub->add_option("--memory-limit", args->memoryLimitGiB, "voxelization memory limit in GiB")
         ->check(CLI::PositiveNumber);
+    addCacheOptions(sub, args->cache);
     sub->add_flag("-q,--quiet", args->quiet, "print nothing on success");
     return {sub, [args] { return runMorph(*args); }};
 }

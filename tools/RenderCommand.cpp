@@ -112,6 +112,7 @@ struct RenderSceneArgs {
     std::string scene, frames, output, png;
     int threads = 0;
     bool skipExisting = false, quiet = false;
+    CacheArgs cache;
 };
 
 /// True when `path` exists and reads back whole.
@@ -137,7 +138,7 @@ int runRenderScene(const RenderSceneArgs& args)
 
     Interrupter interrupter(false);
     StopSignals signals(interrupter);
-    SceneVolumes volumes = voxelizeScene(scene, &interrupter);
+    SceneVolumes volumes = loadSceneVolumes(scene, args.cache, interrupter, 0, args.quiet);
     const Morpher morpher(std::move(volumes.source), std::move(volumes.target), scene.pairs, scene.warp, scene.blend);
 
     const RenderSpec& r = scene.render;
@@ -161,14 +162,21 @@ int runRenderScene(const RenderSceneArgs& args)
     medium.anisotropy = r.anisotropy;
 
     int failed = 0;
-    for (int frame : frames) {
+    // Two steps per frame (morph, render), so the progress moves within long frames too.
+    Progress progress(2 * int(frames.size()), args.quiet);
+    progress.update(0);
+    for (size_t i = 0; i < frames.size(); ++i) {
+        const int frame = frames[i];
         const std::filesystem::path file = frameFileName(pattern, frame);
         if (args.skipExisting && completeImage(file)) {
-            if (!args.quiet) std::printf("frame %d: %s exists, skipped\n", frame, file.string().c_str());
+            progress.log("frame " + std::to_string(frame) + ": " + file.string() + " exists, skipped");
+            progress.update(2 * int(i + 1));
             continue;
         }
         const auto start = std::chrono::steady_clock::now();
         const VolumeSet v = morpher.frame(scene.frames.t(frame), nullptr, &interrupter);
+        if (interrupter.stopRequested()) throw Interrupted();
+        progress.update(2 * int(i) + 1);
         render::RenderSettings settings;
         settings.samples = r.samples;
         settings.stepVoxels = r.stepVoxels;
@@ -189,13 +197,16 @@ int runRenderScene(const RenderSceneArgs& args)
         } catch (const std::exception& e) {
             std::fprintf(stderr, "%s: cannot write frame %d (%s)\n", file.string().c_str(), frame, e.what());
             ++failed;
+            progress.update(2 * int(i + 1));
             continue;
         }
-        if (!args.quiet)
-            std::printf("frame %d (t=%.4f): %.2f s -> %s\n", frame, scene.frames.t(frame), secondsSince(start),
-                        file.string().c_str());
-        std::fflush(stdout);
+        char line[512];
+        std::snprintf(line, sizeof line, "frame %d (t=%.4f): %.2f s -> %s", frame, scene.frames.t(frame),
+                      secondsSince(start), file.string().c_str());
+        progress.log(line);
+        progress.update(2 * int(i + 1));
     }
+    if (failed) std::fprintf(stderr, "volmorph: %d of %zu frames failed\n", failed, frames.size());
     return failed ? kExitUserError : 0;
 }
 
@@ -239,6 +250,7 @@ Command addRenderCommand(CLI::App& app)
     sub->add_option("-o,--output", a->output, "output pattern, e.g. out/f.####.exr (default: the scene's)");
     sub->add_option("--threads", a->threads, "threads (0 = all cores)")->check(CLI::Range(0, 1024));
     sub->add_flag("--skip-existing", a->skipExisting, "skip frames whose file exists and reads back whole");
+    addCacheOptions(sub, a->cache);
     sub->add_flag("-q,--quiet", a->quiet, "print nothing on success");
     return {sub, [a] { return runRenderScene(*a); }};
 }

@@ -70,7 +70,38 @@ int runVoxelize(const VoxelizeArgs& args)
     return 0;
 }
 
+struct CacheCommandArgs {
+    std::string scene;
+    CacheArgs cache;
+    double memoryLimitGiB = 0.0;
+    bool quiet = false;
+};
+
+int runCache(const CacheCommandArgs& args)
+{
+    const Scene scene = loadScene(args.scene);
+    if (args.cache.resolve().empty())
+        throw UserError(SourceLocation{"--cache"}, "no cache folder: give --cache DIR or set VOLMORPH_CACHE");
+    Interrupter interrupter(false);
+    StopSignals signals(interrupter);
+    loadSceneVolumes(scene, args.cache, interrupter, uint64_t(args.memoryLimitGiB * double(1ull << 30)), args.quiet);
+    return 0;
+}
+
 } // namespace
+
+Command addCacheCommand(CLI::App& app)
+{
+    auto a = std::make_shared<CacheCommandArgs>();
+    CLI::App* sub = app.add_subcommand(
+        "cache", "Voxelize a scene's source and target into the voxel cache (once, before a farm job's chunks)");
+    sub->add_option("SCENE", a->scene, "scene file (TOML)")->required();
+    sub->add_option("--cache", a->cache.folder,
+                    "voxel cache folder (default: $VOLMORPH_CACHE, else $XDG_CACHE_HOME/volmorph, else ~/.cache/volmorph)");
+    sub->add_option("--memory-limit", a->memoryLimitGiB, "voxelization memory limit in GiB")->check(CLI::PositiveNumber);
+    sub->add_flag("-q,--quiet", a->quiet, "print nothing on success");
+    return {sub, [a] { return runCache(*a); }};
+}
 
 Command addVoxelizeCommand(CLI::App& app)
 {

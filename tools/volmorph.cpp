@@ -15,7 +15,7 @@ int main(int argc, char** argv)
     app.require_subcommand(1);
     const std::vector<Command> commands = {addCheckCommand(app), addVoxelizeCommand(app), addMorphCommand(app),
                                           addRenderVdbCommand(app), addRenderCommand(app),
-                                          addDiffCommand(app)};
+                                          addDiffCommand(app), addCacheCommand(app)};
 
     try {
         app.parse(argc, argv);

@@ -1,0 +1,175 @@
+#include <volmorph/Diagnostics.h>
+#include <volmorph/Version.h>
+#include <volmorph/VolumeSet.h>
+#include <volmorph/VoxelCache.h>
+
+#include "core/AtomicFile.h"
+
+#include <OpenImageIO/hash.h>
+#include <openvdb/io/File.h>
+
+#include <cstdio>
+#include <cstdlib>
+#include <fstream>
+#include <iterator>
+#include <sstream>
+
+namespace volmorph {
+namespace {
+
+/// Bump when the entry's layout changes.
+constexpr int kCacheFormat = 1;
+constexpr const char* kKeyMeta = "volmorph_cache_key";
+
+std::string fileDigest(const std::filesystem::path& path, const SourceLocation& where)
+{
+    std::ifstream in(path, std::ios::binary);
+    if (!in) throw UserError(where, "cannot read mesh file \"" + path.string() + "\"");
+    OIIO::SHA1 sha;
+    char buffer[1 << 16];
+    while (in) {
+        in.read(buffer, sizeof buffer);
+        if (in.gcount() > 0) sha.append(buffer, size_t(in.gcount()));
+    }
+    return sha.digest();
+}
+
+/// The digest of the running program, so that any other build (a changed voxelizer included) gets
+/// other keys; the version string alone would not see a developer's local change.
+const std::string& programDigest()
+{
+    static const std::string digest = [] {
+        std::error_code ec;
+        const std::filesystem::path self = std::filesystem::read_symlink("/proc/self/exe", ec);
+        if (ec) return std::string("unknown");
+        try {
+            return fileDigest(self, SourceLocation{self.string()});
+        } catch (const UserError&) {
+            return std::string("unknown");
+        }
+    }();
+    return digest;
+}
+
+void describe(std::ostream& s, const char* side, const ObjectSpec& o)
+{
+    const ObjectTransform& x = o.transform;
+    s << side << " translate " << x.translate << " rotate " << x.rotateRadians << " scale " << x.scale;
+    if (o.color) s << " color " << *o.color;
+    s << '\n';
+}
+
+std::string gridName(const char* side, const char* grid) { return std::string(side) + "." + grid; }
+
+/// Reads and checks an entry; returns an empty string and fills `out`, or says what is wrong.
+std::string readEntry(const std::filesystem::path& path, const std::string& key, SceneVolumes& out)
+{
+    try {
+        openvdb::io::File file(path.string());
+        file.open(/*delayLoad*/ false);
+        const openvdb::MetaMap::Ptr meta = file.getMetadata();
+        const auto stored = meta ? meta->getMetadata<openvdb::StringMetadata>(kKeyMeta) : nullptr;
+        if (!stored || stored->value() != key) return "it was written for other inputs";
+        for (const char* side : {"source", "target"}) {
+            VolumeSet& v = std::string(side) == "source" ? out.source : out.target;
+            for (const char* grid : {kSdfGridName, kDensityGridName, kColorGridName}) {
+                const std::string name = gridName(side, grid);
+                if (!file.hasGrid(name)) return "grid " + name + " is missing";
+                openvdb::GridBase::Ptr g = file.readGrid(name);
+                g->setName(grid);
+                if (grid == kColorGridName) v.color = openvdb::gridPtrCast<openvdb::Vec3SGrid>(g);
+                else if (grid == kSdfGridName) v.sdf = openvdb::gridPtrCast<openvdb::FloatGrid>(g);
+                else v.density = openvdb::gridPtrCast<openvdb::FloatGrid>(g);
+            }
+            if (!v.sdf || !v.density || !v.color) return "a grid of the " + std::string(side) + " has the wrong type";
+            if (v.sdf->getGridClass() != openvdb::GRID_LEVEL_SET) return "the " + std::string(side) + " sdf is not a level set";
+        }
+        file.close();
+        if (out.source.sdf->transform() != out.target.sdf->transform()) return "source and target grids disagree";
+    } catch (const std::exception& e) {
+        return std::string("it does not read back (") + e.what() + ")";
+    }
+    return {};
+}
+
+void writeEntry(const std::filesystem::path& path, const std::string& key, const SceneVolumes& v)
+{
+    openvdb::GridPtrVec grids;
+    auto add = [&grids](const openvdb::GridBase::Ptr& g, const std::string& name) {
+        openvdb::GridBase::Ptr shallow = g->copyGrid(); // shares the tree, renames the copy
+        shallow->setName(name);
+        grids.push_back(shallow);
+    };
+    for (const char* side : {"source", "target"}) {
+        const VolumeSet& s = std::string(side) == "source" ? v.source : v.target;
+        add(s.sdf, gridName(side, kSdfGridName));
+        add(s.density, gridName(side, kDensityGridName));
+        add(s.color, gridName(side, kColorGridName));
+    }
+    openvdb::MetaMap meta;
+    meta.insertMeta(kKeyMeta, openvdb::StringMetadata(key));
+    std::filesystem::create_directories(path.parent_path());
+    detail::writeAtomically(path, "voxel cache entry", [&](const std::filesystem::path& temporary) {
+        openvdb::io::File file(temporary.string());
+        file.setCompression(openvdb::io::COMPRESS_BLOSC | openvdb::io::COMPRESS_ACTIVE_MASK);
+        file.write(grids, meta);
+        file.close();
+    });
+}
+
+} // namespace
+
+std::filesystem::path defaultCacheFolder()
+{
+    if (const char* v = std::getenv("VOLMORPH_CACHE"); v && *v) return v;
+    if (const char* v = std::getenv("XDG_CACHE_HOME"); v && *v) return std::filesystem::path(v) / "volmorph";
+    if (const char* v = std::getenv("HOME"); v && *v) return std::filesystem::path(v) / ".cache" / "volmorph";
+    return {};
+}
+
+std::string voxelCacheKey(const Scene& scene)
+{
+    std::ostringstream s;
+    s.precision(17);
+    s << "volmorph voxel cache " << kCacheFormat << " version " << versionString() << " program "
+      << programDigest() << '\n';
+    s << "source mesh " << fileDigest(scene.source.mesh, scene.source.meshWhere) << '\n';
+    s << "target mesh " << fileDigest(scene.target.mesh, scene.target.meshWhere) << '\n';
+    describe(s, "source", scene.source);
+    describe(s, "target", scene.target);
+    if (scene.volume.voxelSize) s << "voxel_size " << *scene.volume.voxelSize << '\n';
+    if (scene.volume.resolution) s << "resolution " << *scene.volume.resolution << '\n';
+    return OIIO::SHA1::digest(s.str().data(), s.str().size());
+}
+
+SceneVolumes voxelizeSceneCached(const Scene& scene, const std::filesystem::path& folder, Interrupter* interrupter,
+                                 uint64_t memoryLimitBytes, CacheReport* report)
+{
+    CacheReport local;
+    CacheReport& r = report ? *report : local;
+    r = CacheReport{};
+    if (folder.empty()) return voxelizeScene(scene, interrupter, memoryLimitBytes);
+
+    openvdb::initialize();
+    const std::string key = voxelCacheKey(scene);
+    r.entry = folder / (key + ".vdb");
+    std::error_code ec;
+    if (std::filesystem::exists(r.entry, ec)) {
+        SceneVolumes cached;
+        r.problem = readEntry(r.entry, key, cached);
+        if (r.problem.empty()) {
+            r.outcome = CacheReport::Outcome::Hit;
+            return cached;
+        }
+    }
+    SceneVolumes volumes = voxelizeScene(scene, interrupter, memoryLimitBytes);
+    r.outcome = r.problem.empty() ? CacheReport::Outcome::Stored : CacheReport::Outcome::Rebuilt;
+    try {
+        writeEntry(r.entry, key, volumes);
+    } catch (const std::exception& e) {
+        r.storeProblem = e.what();
+    }
+    return volumes;
+}
+
+} // namespace volmorph
