@@ -34,6 +34,7 @@ Command addRenderVdbCommand(CLI::App& app);
 Command addRenderCommand(CLI::App& app);
 Command addDiffCommand(CLI::App& app);
 Command addCacheCommand(CLI::App& app);
+Command addPreviewCommand(CLI::App& app);
 
 std::string fmt(double v);
 std::string fmt(const Vec3d& v);

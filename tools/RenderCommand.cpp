@@ -1,6 +1,7 @@
 // volmorph render-vdb IN.vdb -o OUT.exr: render any float grid (flags as OpenVDB's vdb_render).
 // volmorph render SCENE [--frames SPEC] [-o PATTERN.exr]: the morph of each frame, rendered.
 #include "Common.h"
+#include "SceneRender.h"
 
 #include <volmorph/Frames.h>
 #include <volmorph/Morph.h>
@@ -11,7 +12,9 @@
 
 #include <openvdb/io/File.h>
 
+#include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <memory>
 #include <optional>
@@ -141,25 +144,8 @@ int runRenderScene(const RenderSceneArgs& args)
     SceneVolumes volumes = loadSceneVolumes(scene, args.cache, interrupter, 0, args.quiet);
     const Morpher morpher(std::move(volumes.source), std::move(volumes.target), scene.pairs, scene.warp, scene.blend);
 
-    const RenderSpec& r = scene.render;
-    const CameraSpec& c = r.camera;
-    const render::Camera camera(c.projection == Projection::Orthographic ? render::Camera::Projection::Orthographic
-                                                                         : render::Camera::Projection::Perspective,
-                                c.eye, c.lookat, c.up, c.fovDegrees, c.orthoWidth, r.width, r.height);
-    std::vector<render::Light> lights;
-    for (const LightSpec& l : r.lights) {
-        render::Light light;
-        light.type = l.type == LightType::Point ? render::Light::Type::Point : render::Light::Type::Directional;
-        light.direction = l.direction;
-        light.position = l.position;
-        light.color = l.color;
-        light.intensity = l.intensity;
-        lights.push_back(light);
-    }
-    render::Medium medium;
-    medium.extinction = r.extinction;
-    medium.albedo = r.albedo;
-    medium.anisotropy = r.anisotropy;
+    const SceneRender renderer(scene, args.threads);
+    const render::Camera& camera = renderer.camera;
 
     int failed = 0;
     // Two steps per frame (morph, render), so the progress moves within long frames too.
@@ -177,17 +163,11 @@ int runRenderScene(const RenderSceneArgs& args)
         const VolumeSet v = morpher.frame(scene.frames.t(frame), nullptr, &interrupter);
         if (interrupter.stopRequested()) throw Interrupted();
         progress.update(2 * int(i) + 1);
-        render::RenderSettings settings;
-        settings.samples = r.samples;
-        settings.stepVoxels = r.stepVoxels;
-        settings.seed = r.seed;
-        settings.frame = frame;
-        settings.threads = args.threads;
-        const render::Image image = render::renderVolume(*v.density, v.color.get(), camera, lights, medium, settings);
+        const render::Image image = renderer.renderFrame(v, frame);
         if (interrupter.stopRequested()) throw Interrupted();
         render::ExrOptions exr;
         exr.frame = frame;
-        exr.samples = r.samples;
+        exr.samples = scene.render.samples;
         exr.renderSeconds = secondsSince(start);
         exr.metadata["volmorph:scene"] = std::filesystem::absolute(args.scene).string();
         exr.metadata["volmorph:t"] = fmt(scene.frames.t(frame));
@@ -211,6 +191,48 @@ int runRenderScene(const RenderSceneArgs& args)
 }
 
 } // namespace
+
+namespace {
+
+render::Camera sceneCamera(const RenderSpec& r, int width)
+{
+    const CameraSpec& c = r.camera;
+    const int w = width > 0 ? width : r.width;
+    const int h = width > 0 ? std::max(1, int(std::lround(double(r.height) * w / r.width))) : r.height;
+    return render::Camera(c.projection == Projection::Orthographic ? render::Camera::Projection::Orthographic
+                                                                   : render::Camera::Projection::Perspective,
+                          c.eye, c.lookat, c.up, c.fovDegrees, c.orthoWidth, w, h);
+}
+
+} // namespace
+
+SceneRender::SceneRender(const Scene& scene, int threads, int width) : camera(sceneCamera(scene.render, width))
+{
+    const RenderSpec& r = scene.render;
+    for (const LightSpec& l : r.lights) {
+        render::Light light;
+        light.type = l.type == LightType::Point ? render::Light::Type::Point : render::Light::Type::Directional;
+        light.direction = l.direction;
+        light.position = l.position;
+        light.color = l.color;
+        light.intensity = l.intensity;
+        lights.push_back(light);
+    }
+    medium.extinction = r.extinction;
+    medium.albedo = r.albedo;
+    medium.anisotropy = r.anisotropy;
+    settings.samples = r.samples;
+    settings.stepVoxels = r.stepVoxels;
+    settings.seed = r.seed;
+    settings.threads = threads;
+}
+
+render::Image SceneRender::renderFrame(const VolumeSet& volumes, int frame) const
+{
+    render::RenderSettings s = settings;
+    s.frame = frame;
+    return render::renderVolume(*volumes.density, volumes.color.get(), camera, lights, medium, s);
+}
 
 Command addRenderVdbCommand(CLI::App& app)
 {

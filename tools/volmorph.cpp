@@ -15,7 +15,8 @@ int main(int argc, char** argv)
     app.require_subcommand(1);
     const std::vector<Command> commands = {addCheckCommand(app), addVoxelizeCommand(app), addMorphCommand(app),
                                           addRenderVdbCommand(app), addRenderCommand(app),
-                                          addDiffCommand(app), addCacheCommand(app)};
+                                          addDiffCommand(app), addCacheCommand(app),
+                                          addPreviewCommand(app)};
 
     try {
         app.parse(argc, argv);

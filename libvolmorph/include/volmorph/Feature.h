@@ -3,6 +3,9 @@
 
 #include <volmorph/Scene.h>
 
+#include <array>
+#include <vector>
+
 namespace volmorph {
 
 /// A feature element in some space (world units, or index space once scaled): origin, a right-
@@ -41,6 +44,9 @@ struct Feature {
     /// length, the rectangle's and the box's diagonal.
     double length() const;
 
+    /// The element's edges as world-space segments, for drawing: none for a point, one for a
+    /// segment, four for a rectangle, twelve for a box.
+    std::vector<std::array<Vec3d, 2>> outline() const;
     /// The same element with lengths multiplied by k (world units -> index space: k = 1 / voxel).
     Feature scaled(double k) const;
 };

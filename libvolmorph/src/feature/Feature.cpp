@@ -46,6 +46,37 @@ double Feature::length() const
     return 1.0;
 }
 
+std::vector<std::array<Vec3d, 2>> Feature::outline() const
+{
+    // Corners in local coordinates u in {-1/2, 1/2}^3 (z = 0 for a rectangle), mapped by fromLocal.
+    std::vector<std::array<Vec3d, 2>> edges;
+    auto edge = [this, &edges](const Vec3d& u0, const Vec3d& u1) { edges.push_back({fromLocal(u0), fromLocal(u1)}); };
+    switch (type) {
+    case FeatureType::Point: break;
+    case FeatureType::Segment: edge(Vec3d(-0.5, 0, 0), Vec3d(0.5, 0, 0)); break;
+    case FeatureType::Rectangle:
+        for (int i = 0; i < 4; ++i) {
+            const double a[4][2] = {{-0.5, -0.5}, {0.5, -0.5}, {0.5, 0.5}, {-0.5, 0.5}};
+            edge(Vec3d(a[i][0], a[i][1], 0), Vec3d(a[(i + 1) % 4][0], a[(i + 1) % 4][1], 0));
+        }
+        break;
+    case FeatureType::Box:
+        // The 12 edges: along each axis, the 4 parallel edges at the other two coordinates' corners.
+        for (int axis = 0; axis < 3; ++axis)
+            for (int corner = 0; corner < 4; ++corner) {
+                Vec3d u0, u1;
+                const int b = (axis + 1) % 3, c = (axis + 2) % 3;
+                u0[axis] = -0.5;
+                u1[axis] = 0.5;
+                u0[b] = u1[b] = (corner & 1) ? 0.5 : -0.5;
+                u0[c] = u1[c] = (corner & 2) ? 0.5 : -0.5;
+                edge(u0, u1);
+            }
+        break;
+    }
+    return edges;
+}
+
 Feature Feature::scaled(double k) const
 {
     Feature f = *this;

@@ -1,0 +1,184 @@
+// volmorph preview SCENE --frame N -o OUT.png: one frame with every feature pair drawn on it, for
+// editing the pairs by hand; --contact-sheet: a grid of frames.
+#include "Common.h"
+#include "SceneRender.h"
+
+#include <volmorph/Feature.h>
+#include <volmorph/Frames.h>
+#include <volmorph/Morph.h>
+#include <volmorph/render/Output.h>
+#include <volmorph/render/Overlay.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <memory>
+#include <optional>
+
+namespace volmorph::cli {
+namespace {
+
+// Linear RGB. The interpolated element (the one the warp uses at t) is the brightest.
+constexpr render::Color kInterpolated{1.0f, 0.75f, 0.05f};
+constexpr render::Color kSourceSide{0.05f, 0.6f, 1.0f};
+constexpr render::Color kTargetSide{1.0f, 0.1f, 0.6f};
+constexpr render::Color kBackground{0.02f, 0.02f, 0.025f};
+
+struct PreviewArgs {
+    std::string scene, output, frames, from;
+    std::optional<int> frame;
+    bool contactSheet = false, sides = false, noFeatures = false, features = false, quiet = false;
+    int width = 0, columns = 6, tileWidth = 240, threads = 0;
+    std::optional<int> samples;
+    CacheArgs cache;
+};
+
+void drawElement(render::Image& image, const render::Camera& camera, const Feature& f, const render::Color& color)
+{
+    for (const auto& [a, b] : f.outline()) render::drawSegment(image, camera, a, b, color);
+    render::drawMarker(image, camera, f.origin, color, f.type == FeatureType::Point ? 5 : 2);
+}
+
+/// Draws every pair at time t: the interpolated element with its number, and optionally the
+/// source-side and target-side elements. Returns false when the labels could not be drawn.
+bool drawFeatures(render::Image& image, const render::Camera& camera, const Scene& scene, double t, bool sides)
+{
+    bool labels = true;
+    for (size_t i = 0; i < scene.pairs.size(); ++i) {
+        const FeaturePairSpec& p = scene.pairs[i];
+        const Feature source = Feature::fromElement(p.source, p.type);
+        const Feature target = Feature::fromElement(p.target, p.type);
+        if (sides) {
+            drawElement(image, camera, source, kSourceSide);
+            drawElement(image, camera, target, kTargetSide);
+        }
+        const Feature now = interpolate(source, target, t);
+        drawElement(image, camera, now, kInterpolated);
+        if (const auto q = render::project(camera, now.origin); q && labels)
+            labels = render::drawText(image, int((*q)[0]) + 7, int((*q)[1]) - 7, std::to_string(i + 1), kInterpolated, 16);
+    }
+    return labels;
+}
+
+void writeImage(const render::Image& image, const std::string& path, const render::Camera& camera, int frame)
+{
+    const std::filesystem::path file(path);
+    if (file.has_parent_path()) std::filesystem::create_directories(file.parent_path());
+    try {
+        if (file.extension() == ".exr") {
+            render::ExrOptions exr;
+            exr.frame = frame;
+            render::writeExr(image, camera, file, exr);
+        } else {
+            render::writePng(image, file);
+        }
+    } catch (const std::exception& e) {
+        throw UserError(SourceLocation{path}, std::string("cannot write the preview (") + e.what() + ")");
+    }
+}
+
+int runPreview(const PreviewArgs& args)
+{
+    const Scene scene = loadScene(args.scene);
+    if (args.contactSheet == args.frame.has_value())
+        throw UserError(SourceLocation{"preview"}, "give either --frame N or --contact-sheet");
+    std::vector<int> frames;
+    if (args.frame) frames = selectFrames(scene.frames, std::to_string(*args.frame));
+    else frames = selectFrames(scene.frames, args.frames);
+    const bool drawPairs = args.contactSheet ? args.features : !args.noFeatures;
+    const int width = args.contactSheet ? args.tileWidth : args.width;
+
+    // Frames come from existing EXRs (--from) or are morphed and rendered here.
+    std::optional<Morpher> morpher;
+    std::optional<SceneRender> renderer;
+    std::optional<Interrupter> interrupter;
+    std::optional<StopSignals> signals;
+    SceneRender layout(scene, args.threads, width); // the camera the features are drawn with
+    if (args.from.empty()) {
+        interrupter.emplace(false);
+        signals.emplace(*interrupter);
+        SceneVolumes volumes = loadSceneVolumes(scene, args.cache, *interrupter, 0, args.quiet);
+        morpher.emplace(std::move(volumes.source), std::move(volumes.target), scene.pairs, scene.warp, scene.blend);
+        renderer.emplace(scene, args.threads, width);
+        if (args.samples) renderer->settings.samples = *args.samples;
+    } else if (const std::string why = checkFramePattern(args.from); !why.empty()) {
+        throw UserError(SourceLocation{"--from"}, "\"" + args.from + "\": " + why);
+    }
+
+    std::vector<render::Image> images;
+    std::vector<std::string> labels;
+    bool labelsDrawn = true;
+    Progress progress(int(frames.size()), args.quiet);
+    for (size_t i = 0; i < frames.size(); ++i) {
+        const int frame = frames[i];
+        const double t = scene.frames.t(frame);
+        render::Image image;
+        if (morpher) {
+            const VolumeSet v = morpher->frame(t, nullptr, &*interrupter);
+            if (interrupter->stopRequested()) throw Interrupted();
+            image = renderer->renderFrame(v, frame);
+            if (interrupter->stopRequested()) throw Interrupted();
+        } else {
+            const std::filesystem::path file = frameFileName(args.from, frame);
+            try {
+                image = render::readImage(file);
+            } catch (const std::exception& e) {
+                throw UserError(SourceLocation{file.string()},
+                                std::string("cannot read frame ") + std::to_string(frame) + " (" + e.what() +
+                                    "); render it first with volmorph render");
+            }
+        }
+        if (drawPairs) {
+            // Features are drawn at the image's own size (a frame read from disk keeps its size).
+            const SceneRender atSize(scene, 0, image.width);
+            labelsDrawn = drawFeatures(image, atSize.camera, scene, t, args.sides) && labelsDrawn;
+        }
+        char label[64];
+        std::snprintf(label, sizeof label, "frame %d  t=%.3f", frame, t);
+        images.push_back(std::move(image));
+        labels.push_back(label);
+        progress.update(int(i + 1));
+    }
+    if (!labelsDrawn)
+        std::fprintf(stderr, "volmorph: warning: no font (DejaVu Sans, Debian package fonts-dejavu-core); "
+                             "pair numbers are not drawn\n");
+
+    if (args.contactSheet) {
+        const render::Image sheet = render::contactSheet(images, labels, args.columns, args.tileWidth, kBackground);
+        writeImage(sheet, args.output, layout.camera, frames.front());
+    } else {
+        writeImage(render::overBackground(images.front(), kBackground), args.output, layout.camera, frames.front());
+    }
+    if (!args.quiet) std::printf("wrote %s (%zu frame%s)\n", args.output.c_str(), frames.size(), frames.size() == 1 ? "" : "s");
+    return 0;
+}
+
+} // namespace
+
+Command addPreviewCommand(CLI::App& app)
+{
+    auto a = std::make_shared<PreviewArgs>();
+    CLI::App* sub = app.add_subcommand(
+        "preview", "A frame with the feature pairs drawn on it (PNG), or a contact sheet of frames");
+    sub->add_option("SCENE", a->scene, "scene file (TOML)")->required();
+    sub->add_option("-o,--output", a->output, "output image (.png: sRGB 8-bit; .exr: linear)")->required();
+    sub->add_option("--frame", a->frame, "the frame to show, with its features");
+    sub->add_flag("--contact-sheet", a->contactSheet, "a grid of frames instead of one");
+    sub->add_option("--frames", a->frames, "contact sheet frames, e.g. 1-48x4 (default: all)");
+    sub->add_option("--columns", a->columns, "contact sheet columns (default 6)")->check(CLI::Range(1, 64));
+    sub->add_option("--tile-width", a->tileWidth, "contact sheet tile width in pixels (default 240)")
+        ->check(CLI::Range(16, 4096));
+    sub->add_option("--from", a->from, "read the frames from these EXRs (e.g. out/f.####.exr) instead of rendering");
+    sub->add_flag("--sides", a->sides, "also draw the source-side (blue) and target-side (pink) elements");
+    sub->add_flag("--no-features", a->noFeatures, "--frame: the frame alone");
+    sub->add_flag("--features", a->features, "--contact-sheet: draw the features on every tile");
+    sub->add_option("--width", a->width, "--frame: image width in pixels (default: the scene's)")
+        ->check(CLI::Range(16, 16384));
+    sub->add_option("--samples", a->samples, "samples per pixel (default: the scene's)")->check(CLI::Range(1, 4096));
+    sub->add_option("--threads", a->threads, "threads (0 = all cores)")->check(CLI::Range(0, 1024));
+    addCacheOptions(sub, a->cache);
+    sub->add_flag("-q,--quiet", a->quiet, "print nothing on success");
+    return {sub, [a] { return runPreview(*a); }};
+}
+
+} // namespace volmorph::cli

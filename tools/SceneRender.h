@@ -1,0 +1,26 @@
+// The scene's [render] table turned into the renderer's objects, shared by `render` and `preview`.
+#pragma once
+
+#include <volmorph/Scene.h>
+#include <volmorph/VolumeSet.h>
+#include <volmorph/render/Camera.h>
+#include <volmorph/render/Renderer.h>
+
+#include <vector>
+
+namespace volmorph::cli {
+
+struct SceneRender {
+    render::Camera camera;
+    std::vector<render::Light> lights;
+    render::Medium medium;
+    render::RenderSettings settings; ///< frame left 0: set it per frame
+
+    /// `width` overrides the scene's image width in pixels (the height follows the aspect ratio).
+    SceneRender(const Scene& scene, int threads, int width = 0);
+
+    /// Renders frame `frame` of the morph, `volumes` being that frame's in-between.
+    render::Image renderFrame(const VolumeSet& volumes, int frame) const;
+};
+
+} // namespace volmorph::cli
