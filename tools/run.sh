@@ -1,7 +1,8 @@
 #!/bin/sh
 # One entry point for the README's Quick start: installs what is missing, builds, then
 #   tools/run.sh demo   runs the main job on the default scene (scenes/bunny-to-knot.toml): the morph,
-#                       rendered to one EXR per frame in scenes/out/
+#                       rendered to one EXR per frame in scenes/out/, a contact sheet and a preview of
+#                       the feature pairs
 #   tools/run.sh test   runs the whole test suite (CTest: unit, cli and bad-input tests)
 # Environment: BUILD_DIR (default build), JOBS (default: number of cores).
 set -eu
@@ -28,12 +29,19 @@ cmake --build "$build" --parallel "$jobs"
 case "$mode" in
 demo)
     scene=scenes/bunny-to-knot.toml
+    out=scenes/out
     "$build/bin/volmorph" check "$scene"
     echo
-    "$build/bin/volmorph" render "$scene" -o scenes/out/bunny-to-knot.####.exr
+    "$build/bin/volmorph" render "$scene" -o "$out/bunny-to-knot.####.exr"
+    "$build/bin/volmorph" preview "$scene" --contact-sheet --from "$out/bunny-to-knot.####.exr" --columns 6 \
+        --tile-width 200 -o "$out/bunny-to-knot.contact-sheet.png" -q
+    "$build/bin/volmorph" preview "$scene" --frame 12 --sides -o "$out/bunny-to-knot.features.0012.png" -q
     echo
-    echo "volmorph: the morph of $scene is rendered to scenes/out/bunny-to-knot.0001.exr ... .0024.exr"
-    echo "(half RGBA OpenEXR, linear, premultiplied). The program is $build/bin/volmorph."
+    echo "volmorph: the morph of $scene is rendered:"
+    echo "  frames         $out/bunny-to-knot.0001.exr ... .0024.exr (half RGBA OpenEXR, linear, premultiplied)"
+    echo "  contact sheet  $out/bunny-to-knot.contact-sheet.png"
+    echo "  feature pairs  $out/bunny-to-knot.features.0012.png (frame 12; amber: at t, blue: source, pink: target)"
+    echo "The program is $build/bin/volmorph (volmorph --help)."
     ;;
 test)
     cd "$build"
