@@ -73,19 +73,38 @@ TEST(Scene, DefaultSceneValues)
     const Scene s = loadScene(kRoot / "scenes" / "bunny-to-knot.toml");
     EXPECT_EQ(s.source.mesh, kRoot / "scenes" / "meshes" / "bunny.obj");
     EXPECT_DOUBLE_EQ(*s.volume.voxelSize, 0.008);
-    ASSERT_EQ(s.pairs.size(), 4u);
+    ASSERT_EQ(s.pairs.size(), 3u);
     EXPECT_EQ(s.pairs[0].type, FeatureType::Box);
-    EXPECT_EQ(s.pairs[1].type, FeatureType::Segment);
-    // [0.707, 0, 0.707] is normalized on reading.
-    EXPECT_NEAR(s.pairs[1].source.xAxis.length(), 1.0, 1e-12);
-    EXPECT_NEAR(s.pairs[1].source.xAxis.x(), std::sqrt(0.5), 1e-12);
+    EXPECT_EQ(s.pairs[1].type, FeatureType::Point);
     EXPECT_EQ(s.blend.mode, BlendMode::Sdf);
+    EXPECT_EQ(s.blend.minIslandVoxels, 100);
     EXPECT_EQ(s.blend.density.kind, ScheduleSpec::Kind::Sigmoid);
     EXPECT_DOUBLE_EQ(s.blend.density.k, 8.0);
     EXPECT_EQ(s.render.lights.size(), 2u);
     EXPECT_EQ(s.render.lights[1].type, LightType::Point);
     EXPECT_EQ(s.frames.first, 1);
     EXPECT_EQ(s.frames.last, 24);
+}
+
+TEST(Scene, FeatureAxesAreNormalizedOnReading)
+{
+    const Scene s = parseScene(R"(
+[source]
+mesh = "meshes/bunny.obj"
+[target]
+mesh = "meshes/knot1.off"
+[volume]
+voxel_size = 0.01
+[[pair]]
+type = "segment"
+source = { origin = [0, 0.9, 0], axes = [[0.707, 0, 0.707], [0, 1, 0]], scale = [0.5, 0.1, 0.1] }
+target = { origin = [0, 0.9, 0], axes = [[1, 0, 0], [0, 1, 0]], scale = [0.5, 0.1, 0.1] }
+)",
+                               kRoot / "scenes" / "inline.toml");
+    ASSERT_EQ(s.pairs.size(), 1u);
+    EXPECT_NEAR(s.pairs[0].source.xAxis.length(), 1.0, 1e-12);
+    EXPECT_NEAR(s.pairs[0].source.xAxis.x(), std::sqrt(0.5), 1e-12);
+    EXPECT_EQ(s.blend.minIslandVoxels, 27);
 }
 
 TEST(Scene, MinimalSceneGetsDocumentedDefaults)

@@ -4,6 +4,13 @@
 // target (the approximated warp of src/warp/AdaptiveWarp.h, or the exact one), both are resampled
 // with OpenVDB's samplers, and blended: density by the density schedule, colour density-weighted
 // by the colour schedule (so no colour leaks in from the side that is empty there).
+//
+// sdf mode blends signed distances. A narrow band clamps distances to +/- its width, and the blend
+// of two clamped values, (1 - tau)(-w) + tau(+w), changes sign at tau = 1/2 everywhere at once: every
+// voxel inside one object and a few voxels outside the other would flip in one frame (the shape
+// snaps instead of morphing). So the Morpher first extends both distance fields over the box of
+// source and target together, plus a margin (OpenVDB's fast sweeping, tools::maskSdf), once; only
+// farther than that margin are distances clamped, where both sides are outside anyway.
 #pragma once
 
 #include <volmorph/Interrupter.h>
@@ -59,6 +66,8 @@ private:
                   Interrupter* interrupter) const;
 
     VolumeSet mSource, mTarget;
+    /// sdf mode: the source's and target's distances extended over both objects' box (see above).
+    openvdb::FloatGrid::Ptr mWideSdfSource, mWideSdfTarget;
     /// Which 8^3 blocks of source and target are occupied; they do not change with t.
     std::shared_ptr<const detail::Occupancy> mSourceBlocks, mTargetBlocks;
     std::vector<FeaturePairSpec> mPairs;

@@ -97,6 +97,10 @@ struct BlendSpec {
     ScheduleSpec density;
     ScheduleSpec color;
     ScheduleSpec sdf;
+    /// sdf mode: pieces of an in-between smaller than this many voxels, apart from its largest
+    /// piece, are dropped (dust that a distance blend leaves where the blended field has an isolated
+    /// minimum); 0 keeps everything.
+    int minIslandVoxels = 27;
 };
 
 enum class Projection { Perspective, Orthographic };

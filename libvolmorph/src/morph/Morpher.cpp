@@ -6,9 +6,14 @@
 
 #include <volmorph/Voxelize.h>
 
+#include <openvdb/tools/FastSweeping.h>
 #include <openvdb/tools/Interpolation.h>
 #include <openvdb/tools/LevelSetRebuild.h>
+#include <openvdb/tools/LevelSetUtil.h>
+#include <openvdb/tools/ChangeBackground.h>
 #include <openvdb/tools/Prune.h>
+#include <openvdb/tree/LeafManager.h>
+#include <openvdb/util/Util.h>
 
 #include <memory>
 #include <mutex>
@@ -45,10 +50,95 @@ CoordBBox inverseImage(const InverseWarp::Affine& a, const CoordBBox& box)
                      Coord(clampInt(std::ceil(hi.x())), clampInt(std::ceil(hi.y())), clampInt(std::ceil(hi.z()))));
 }
 
+/// `sdf` with its distances extended by fast sweeping over `box` (index space); elsewhere it keeps
+/// its narrow band.
+openvdb::FloatGrid::Ptr extendedDistances(const openvdb::FloatGrid& sdf, const CoordBBox& box)
+{
+    openvdb::BoolGrid mask(false);
+    mask.setTransform(sdf.transform().copy());
+    mask.sparseFill(box, true, true);
+    openvdb::FloatGrid::Ptr wide = openvdb::tools::maskSdf(sdf, mask, /*ignoreActiveTiles*/ false, /*nIter*/ 1);
+    if (!wide) throw std::runtime_error("Morpher: fast sweeping could not extend a signed distance field");
+    return wide;
+}
+
+/// Removes dust from the blended field before its surface is rebuilt: face-connected pieces of the
+/// interior (values < 0) with fewer than `minVoxels` voxels, apart from the largest, become outside
+/// (`outside`); bubbles, pieces of the exterior with fewer than `minVoxels` voxels enclosed by the
+/// interior (no face neighbour in the background), become inside (-`outside`). Returns the count.
+size_t dropIslands(openvdb::FloatGrid& values, int minVoxels, float outside)
+{
+    if (minVoxels <= 0) return 0;
+    auto pieces = [&values](bool negative) {
+        openvdb::BoolGrid mask(false);
+        auto acc = mask.getAccessor();
+        for (auto it = values.cbeginValueOn(); it; ++it)
+            if ((*it < 0.0f) == negative) {
+                if (it.isVoxelValue()) acc.setValueOn(it.getCoord(), true);
+                else mask.sparseFill(it.getBoundingBox(), true, true);
+            }
+        std::vector<openvdb::BoolGrid::Ptr> out;
+        openvdb::tools::segmentActiveVoxels(mask, out); // largest first
+        return out;
+    };
+    size_t changed = 0;
+    auto acc = values.getAccessor();
+    auto set = [&acc](const openvdb::BoolGrid& piece, float value) {
+        for (auto it = piece.cbeginValueOn(); it; ++it)
+            for (auto c = it.getBoundingBox().begin(); c; ++c) acc.setValue(*c, value);
+    };
+    const std::vector<openvdb::BoolGrid::Ptr> islands = pieces(true);
+    for (size_t i = 1; i < islands.size(); ++i)
+        if (islands[i]->activeVoxelCount() < openvdb::Index64(minVoxels)) {
+            set(*islands[i], outside);
+            ++changed;
+        }
+    for (const openvdb::BoolGrid::Ptr& gap : pieces(false)) {
+        if (gap->activeVoxelCount() >= openvdb::Index64(minVoxels)) continue;
+        bool enclosed = true;
+        for (auto it = gap->cbeginValueOn(); it && enclosed; ++it)
+            for (auto c = it.getBoundingBox().begin(); c && enclosed; ++c)
+                for (int k = 0; k < 6 && enclosed; ++k) {
+                    const openvdb::Coord n = *c + openvdb::util::COORD_OFFSETS[k];
+                    enclosed = acc.isValueOn(n);
+                }
+        if (enclosed) {
+            set(*gap, -outside);
+            ++changed;
+        }
+    }
+    return changed;
+}
+
+/// `sdf` as a level set of half width `width` (world units): voxels at or beyond it become inactive
+/// with value +/- width, and constant leaves collapse into tiles.
+openvdb::FloatGrid::Ptr narrowBand(openvdb::FloatGrid& sdf, float width)
+{
+    openvdb::tree::LeafManager<FloatTree> leaves(sdf.tree());
+    leaves.foreach([width](FloatTree::LeafNodeType& leaf, size_t) {
+        for (auto it = leaf.beginValueOn(); it; ++it)
+            if (!(std::abs(*it) < width)) {
+                const float v = *it < 0.0f ? -width : width;
+                it.setValue(v);
+                it.setValueOff();
+            }
+    });
+    for (auto it = sdf.tree().beginValueOn(); it; ++it) // active tiles, if any: deep inside or outside
+        if (!it.isVoxelValue()) {
+            it.setValue(*it < 0.0f ? -width : width);
+            it.setValueOff();
+        }
+    openvdb::tools::changeLevelSetBackground(sdf.tree(), width);
+    openvdb::tools::pruneLevelSet(sdf.tree());
+    return sdf.copy();
+}
+
 template <typename Sampler>
 struct Resampler {
     const VolumeSet& source;
     const VolumeSet& target;
+    const openvdb::FloatGrid* sdfSource; ///< sdf mode: the extended distances
+    const openvdb::FloatGrid* sdfTarget;
     float tauDensity, tauColor, tauSdf;
     Vec3f background;
     bool sdfMode;
@@ -64,8 +154,8 @@ struct Resampler {
         auto ct = target.color->getConstAccessor();
         std::unique_ptr<openvdb::FloatGrid::ConstAccessor> ss, st;
         if (sdfMode) {
-            ss = std::make_unique<openvdb::FloatGrid::ConstAccessor>(source.sdf->getConstAccessor());
-            st = std::make_unique<openvdb::FloatGrid::ConstAccessor>(target.sdf->getConstAccessor());
+            ss = std::make_unique<openvdb::FloatGrid::ConstAccessor>(sdfSource->getConstAccessor());
+            st = std::make_unique<openvdb::FloatGrid::ConstAccessor>(sdfTarget->getConstAccessor());
         }
         bool any = false;
         for (openvdb::Index n = 0; n < 512; ++n) {
@@ -73,8 +163,8 @@ struct Resampler {
             const float a = Sampler::sample(ds, ps);
             const float b = Sampler::sample(dt, pt);
             if (sdfMode) {
-                // Beyond a band both distances are clamped to +/- background, so the blend keeps a
-                // consistent sign wherever either side is defined.
+                // Distances are real over both objects' box; beyond it both are clamped to positive
+                // values (outside), so the blend's sign is right wherever either side is defined.
                 const float d = (1.0f - tauSdf) * Sampler::sample(*ss, ps) + tauSdf * Sampler::sample(*st, pt);
                 value.setValueOn(n, d);
                 any = any || d < outside;
@@ -113,6 +203,21 @@ Morpher::Morpher(VolumeSet source, VolumeSet target, std::vector<FeaturePairSpec
         throw std::invalid_argument("Morpher: source and target must share one transform");
     mSourceBlocks = std::make_shared<const detail::Occupancy>(mSource.density->tree());
     mTargetBlocks = std::make_shared<const detail::Occupancy>(mTarget.density->tree());
+    if (mBlend.mode == BlendMode::Sdf) {
+        CoordBBox box = mSource.sdf->evalActiveVoxelBoundingBox();
+        box.expand(mTarget.sdf->evalActiveVoxelBoundingBox());
+        if (!box.empty()) {
+            // A margin for warped points that leave the box: an eighth of its size, at least 8 voxels.
+            const Coord dim = box.dim();
+            const int margin = std::max(8, std::max({dim.x(), dim.y(), dim.z()}) / 8);
+            box.expand(margin);
+            mWideSdfSource = extendedDistances(*mSource.sdf, box);
+            mWideSdfTarget = extendedDistances(*mTarget.sdf, box);
+        } else {
+            mWideSdfSource = mSource.sdf;
+            mWideSdfTarget = mTarget.sdf;
+        }
+    }
 }
 
 CoordBBox Morpher::candidateBounds(double t) const
@@ -171,12 +276,14 @@ VolumeSet Morpher::run(double t, const CoordBBox& box, bool prune, double tolera
     detail::AdaptiveWarpStats warpStats;
     if (mOptions.sampling == MorphOptions::Sampling::Triquadratic)
         adaptive.forEachLeaf(box, occS, occT,
-                             each(Resampler<openvdb::tools::QuadraticSampler>{mSource, mTarget, tauD, tauC, tauS, background,
+                             each(Resampler<openvdb::tools::QuadraticSampler>{mSource, mTarget, mWideSdfSource.get(),
+                                                                              mWideSdfTarget.get(), tauD, tauC, tauS, background,
                                                                               sdfMode, outside}),
                              &warpStats, interrupter);
     else
         adaptive.forEachLeaf(box, occS, occT,
-                             each(Resampler<openvdb::tools::BoxSampler>{mSource, mTarget, tauD, tauC, tauS, background, sdfMode,
+                             each(Resampler<openvdb::tools::BoxSampler>{mSource, mTarget, mWideSdfSource.get(),
+                                                                        mWideSdfTarget.get(), tauD, tauC, tauS, background, sdfMode,
                                                                         outside}),
                              &warpStats, interrupter);
 
@@ -190,11 +297,13 @@ VolumeSet Morpher::run(double t, const CoordBBox& box, bool prune, double tolera
     }
     values->setTransform(mSource.density->transform().copy());
     if (sdfMode) {
-        // The blend of two warped distances has the right zero set but is no distance field: rebuild
-        // a proper narrow band around its surface, then the fog from that surface.
+        // The blend of two warped distances has the right zero set but is no distance field:
+        // redistance it (fast sweeping, which keeps the blend's signs; a rebuild through a mesh and
+        // its scanline flood fill flipped single voxels where two sheets nearly touch), then keep a
+        // narrow band around the surface, and derive the fog from that surface.
         values->setGridClass(openvdb::GRID_LEVEL_SET);
-        const float halfWidth = mSource.sdf->background() / float(voxel);
-        out.sdf = openvdb::tools::levelSetRebuild(*values, 0.0f, halfWidth);
+        dropIslands(*values, mBlend.minIslandVoxels, outside);
+        out.sdf = narrowBand(*openvdb::tools::sdfToSdf(*values, 0.0f, 1), outside);
         out.sdf->setName(kSdfGridName);
         out.sdf->setGridClass(openvdb::GRID_LEVEL_SET);
         out.density = fogFromLevelSet(*out.sdf, 1.5f * float(voxel));

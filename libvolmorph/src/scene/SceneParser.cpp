@@ -33,7 +33,7 @@ const std::vector<std::string> kVolumeKeys = {"voxel_size", "resolution"};
 const std::vector<std::string> kPairKeys = {"type", "source", "target"};
 const std::vector<std::string> kElementKeys = {"origin", "axes", "scale"};
 const std::vector<std::string> kWarpKeys = {"epsilon", "tolerance", "weighting", "a", "b", "p"};
-const std::vector<std::string> kBlendKeys = {"mode", "density", "color", "sdf"};
+const std::vector<std::string> kBlendKeys = {"mode", "density", "color", "sdf", "min_island"};
 const std::vector<std::string> kRenderKeys = {"resolution", "samples", "step", "extinction",
                                               "albedo", "anisotropy", "seed", "camera", "lights"};
 const std::vector<std::string> kCameraKeys = {"projection", "eye", "lookat", "up", "fov", "width"};
@@ -343,6 +343,8 @@ private:
         if (const toml::node* n = t->get("density")) parseSchedule(*n, "blend.density", b.density);
         if (const toml::node* n = t->get("color")) parseSchedule(*n, "blend.color", b.color);
         if (const toml::node* n = t->get("sdf")) parseSchedule(*n, "blend.sdf", b.sdf);
+        if (const toml::node* n = t->get("min_island"))
+            if (auto v = r.integerIn(*n, "blend.min_island", 0, 1000000000)) b.minIslandVoxels = int(*v);
     }
 
     void parseCamera(const toml::node& node)
