@@ -1,5 +1,7 @@
 #include "Common.h"
 
+#include <volmorph/Voxelize.h>
+
 #include <algorithm>
 
 #include <unistd.h>
@@ -151,6 +153,20 @@ void Progress::log(const std::string& line)
 Progress::~Progress()
 {
     if (!mQuiet && mTerminal && mBarShown) std::fputs("\n", stdout);
+}
+
+void checkFilmMemory(int width, int height, double limitGiB)
+{
+    constexpr double kBytesPerPixel = 48.0; // the float RGBA film, and a float and a half copy to write it
+    const double bytes = kBytesPerPixel * double(width) * double(height);
+    const double limit = limitGiB > 0.0 ? limitGiB * double(1ull << 30) : double(defaultMemoryLimitBytes());
+    if (bytes <= limit) return;
+    char text[300];
+    std::snprintf(text, sizeof text,
+                  "a %dx%d image needs about %.1f GiB, more than the memory limit of %.1f GiB; render fewer pixels "
+                  "or raise --memory-limit (default: half the machine's memory)",
+                  width, height, bytes / double(1ull << 30), limit / double(1ull << 30));
+    throw UserError(SourceLocation{"render"}, text);
 }
 
 double secondsSince(std::chrono::steady_clock::time_point start)

@@ -50,6 +50,7 @@ int runMorph(const MorphArgs& args)
                                             uint64_t(args.memoryLimitGiB * double(1ull << 30)), args.quiet);
     MorphOptions options;
     if (args.sampling == "triquadratic") options.sampling = MorphOptions::Sampling::Triquadratic;
+    options.memoryLimitBytes = uint64_t(args.memoryLimitGiB * double(1ull << 30));
     const Morpher morpher(std::move(volumes.source), std::move(volumes.target), scene.pairs, scene.warp,
                           scene.blend, options);
 
@@ -99,7 +100,8 @@ Command addMorphCommand(CLI::App& app)
     sub->add_flag("--exact", args->exact, "use the exact warp everywhere (the reference; slow)");
     sub->add_option("--sampling", args->sampling, "resampling filter: trilinear or triquadratic")
         ->check(CLI::IsMember({"trilinear", "triquadratic"}));
-    sub->add_option("--memory-limit", args->memoryLimitGiB, "voxelization memory limit in GiB")
+    sub->add_option("--memory-limit", args->memoryLimitGiB,
+                    "voxelization and in-between memory limit in GiB (default: half the machine's memory)")
         ->check(CLI::PositiveNumber);
     addCacheOptions(sub, args->cache);
     sub->add_flag("-q,--quiet", args->quiet, "print nothing on success");

@@ -31,6 +31,7 @@ struct RenderVdbArgs {
     double fov = 40.0, frameWidth = 0.0, extinction = 40.0, albedo = 0.8, step = 0.5, shadowStep = 1.0;
     int shadowCache = 2;
     int samples = 4, threads = 0;
+    double memoryLimitGiB = 0.0;
     bool floatExr = false;
 };
 
@@ -47,6 +48,7 @@ int runRenderVdb(const RenderVdbArgs& args)
 {
     int width = 0, height = 0;
     parseResolution(args.resolution, width, height); // flags first: no work before a usage error
+    checkFilmMemory(width, height, args.memoryLimitGiB);
     openvdb::initialize();
     openvdb::FloatGrid::Ptr density;
     openvdb::Vec3SGrid::Ptr color;
@@ -115,6 +117,7 @@ struct RenderSceneArgs {
     std::string scene, frames, output, png;
     int threads = 0;
     bool skipExisting = false, quiet = false;
+    double memoryLimitGiB = 0.0;
     CacheArgs cache;
 };
 
@@ -141,8 +144,13 @@ int runRenderScene(const RenderSceneArgs& args)
 
     Interrupter interrupter(false);
     StopSignals signals(interrupter);
-    SceneVolumes volumes = loadSceneVolumes(scene, args.cache, interrupter, 0, args.quiet);
-    const Morpher morpher(std::move(volumes.source), std::move(volumes.target), scene.pairs, scene.warp, scene.blend);
+    checkFilmMemory(scene.render.width, scene.render.height, args.memoryLimitGiB);
+    const uint64_t memoryLimit = uint64_t(args.memoryLimitGiB * double(1ull << 30));
+    SceneVolumes volumes = loadSceneVolumes(scene, args.cache, interrupter, memoryLimit, args.quiet);
+    MorphOptions morphOptions;
+    morphOptions.memoryLimitBytes = memoryLimit;
+    const Morpher morpher(std::move(volumes.source), std::move(volumes.target), scene.pairs, scene.warp, scene.blend,
+                          morphOptions);
 
     const SceneRender renderer(scene, args.threads);
     const render::Camera& camera = renderer.camera;
@@ -259,6 +267,8 @@ Command addRenderVdbCommand(CLI::App& app)
         ->check(CLI::Range(1, 16));
     sub->add_option("--threads", a->threads, "threads (0 = all cores)")->check(CLI::Range(0, 1024));
     sub->add_option("--grid", a->grid, "name of the float grid (default: the first)");
+    sub->add_option("--memory-limit", a->memoryLimitGiB, "refuse a film above this, in GiB (default: half the machine's memory)")
+        ->check(CLI::PositiveNumber);
     sub->add_flag("--float", a->floatExr, "float EXR instead of half");
     return {sub, [a] { return runRenderVdb(*a); }};
 }
@@ -272,6 +282,10 @@ Command addRenderCommand(CLI::App& app)
     sub->add_option("-o,--output", a->output, "output pattern, e.g. out/f.####.exr (default: the scene's)");
     sub->add_option("--threads", a->threads, "threads (0 = all cores)")->check(CLI::Range(0, 1024));
     sub->add_flag("--skip-existing", a->skipExisting, "skip frames whose file exists and reads back whole");
+    sub->add_option("--memory-limit", a->memoryLimitGiB,
+                    "voxels, in-betweens and film above this estimate are refused, in GiB (default: half the "
+                    "machine's memory)")
+        ->check(CLI::PositiveNumber);
     addCacheOptions(sub, a->cache);
     sub->add_flag("-q,--quiet", a->quiet, "print nothing on success");
     return {sub, [a] { return runRenderScene(*a); }};

@@ -180,7 +180,7 @@ TEST(MeshErrors, BadFilesAreRefusedWithTheirName)
     expectRefused("no_faces.obj", "cannot read mesh");
     expectRefused("all_degenerate.obj", "degenerate");
     expectRefused("garbage.stl", "cannot read mesh");
-    expectRefused("truncated.ply", "cannot read mesh");
+    expectRefused("truncated.ply", "no triangles"); // the header promises faces the file lacks
     expectRefused("truncated_binary.stl", "cannot read mesh");
     expectRefused("does_not_exist.obj", "not found");
 }

@@ -30,7 +30,14 @@ class Occupancy;
 struct MorphOptions {
     enum class Sampling { Trilinear, Triquadratic };
     Sampling sampling = Sampling::Trilinear;
+    /// A frame stops with a UserError once its output would need more than this many bytes
+    /// (kMorphBytesPerLeaf per kept 8^3 leaf); 0 = half the machine's memory.
+    uint64_t memoryLimitBytes = 0;
 };
+
+/// What one kept output leaf costs while a frame is made: density, colour and, in sdf mode, the
+/// distance field and its fog, with the tools' temporaries (an upper estimate).
+inline constexpr uint64_t kMorphBytesPerLeaf = 24 * 1024;
 
 struct MorphStats {
     double maxWarpErrorVoxels = 0.0;   ///< largest error measured where the warp was interpolated

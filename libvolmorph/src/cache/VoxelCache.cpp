@@ -110,10 +110,7 @@ void writeEntry(const std::filesystem::path& path, const std::string& key, const
     meta.insertMeta(kKeyMeta, openvdb::StringMetadata(key));
     std::filesystem::create_directories(path.parent_path());
     detail::writeAtomically(path, "voxel cache entry", [&](const std::filesystem::path& temporary) {
-        openvdb::io::File file(temporary.string());
-        file.setCompression(openvdb::io::COMPRESS_BLOSC | openvdb::io::COMPRESS_ACTIVE_MASK);
-        file.write(grids, meta);
-        file.close();
+        detail::writeVdbChecked(temporary, openvdb::GridCPtrVec(grids.begin(), grids.end()), meta);
     });
 }
 

@@ -3,6 +3,8 @@
 
 #include <volmorph/Diagnostics.h>
 
+#include <openvdb/openvdb.h>
+
 #include <unistd.h>
 
 #include <filesystem>
@@ -32,5 +34,10 @@ inline void writeAtomically(const std::filesystem::path& path, const std::string
     std::filesystem::remove(temporary, ec);
     throw UserError(SourceLocation{path.string()}, "cannot write " + what + " (" + failure + ")");
 }
+
+/// Writes `grids` (and file-level `meta`) as a .vdb file at `path` (Blosc, active mask), checking the
+/// stream: OpenVDB's io::File does not report a failed write (a full disk left a truncated file).
+/// Throws std::runtime_error with the reason. Defined in VolumeIO.cpp.
+void writeVdbChecked(const std::filesystem::path& path, const openvdb::GridCPtrVec& grids, const openvdb::MetaMap& meta);
 
 } // namespace volmorph::detail

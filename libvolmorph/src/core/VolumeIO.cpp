@@ -4,6 +4,11 @@
 #include "AtomicFile.h"
 
 #include <openvdb/io/File.h>
+#include <openvdb/io/Stream.h>
+
+#include <cerrno>
+#include <cstring>
+#include <fstream>
 
 #include <cstdio>
 #include <mutex>
@@ -31,12 +36,28 @@ void writeVolumeSet(const VolumeSet& volumes, const std::filesystem::path& path,
         grids.push_back(g);
     }
     detail::writeAtomically(path, "volume file", [&grids](const std::filesystem::path& temporary) {
-        openvdb::io::File file(temporary.string());
-        file.setCompression(openvdb::io::COMPRESS_BLOSC | openvdb::io::COMPRESS_ACTIVE_MASK);
-        file.write(grids);
-        file.close();
+        detail::writeVdbChecked(temporary, openvdb::GridCPtrVec(grids.begin(), grids.end()), openvdb::MetaMap());
     });
 }
+
+namespace detail {
+
+void writeVdbChecked(const std::filesystem::path& path, const openvdb::GridCPtrVec& grids, const openvdb::MetaMap& meta)
+{
+    std::ofstream out(path, std::ios::binary | std::ios::trunc);
+    if (!out) throw std::runtime_error(std::strerror(errno));
+    openvdb::io::Stream stream(out);
+    stream.setCompression(openvdb::io::COMPRESS_BLOSC | openvdb::io::COMPRESS_ACTIVE_MASK);
+    stream.write(grids, meta);
+    out.flush();
+    const bool written = bool(out);
+    const int error = errno;
+    out.close();
+    if (!written || out.fail())
+        throw std::runtime_error(std::string("write failed: ") + (error ? std::strerror(error) : "unknown reason"));
+}
+
+} // namespace detail
 
 VolumeSet readVolumeSet(const std::filesystem::path& path)
 {

@@ -2,14 +2,23 @@
 //
 // Assimp's JoinIdenticalVertices compares normals and texture coordinates too, so an STL file (one
 // normal per face) would stay a soup of unconnected triangles. We weld on exact positions instead,
-// which is what topology (holes, non-manifold edges, shells) is about.
+// which is what topology (holes, non-manifold edges, shells) is about. Assimp runs in a child
+// process with a time limit (see readIsolated).
 #include <volmorph/Mesh.h>
 
 #include <assimp/Importer.hpp>
 #include <assimp/postprocess.h>
 #include <assimp/scene.h>
 
+#include <poll.h>
+#include <signal.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
 #include <algorithm>
+#include <cerrno>
+#include <chrono>
+#include <cstdio>
 #include <cstring>
 #include <cmath>
 #include <limits>
@@ -108,6 +117,198 @@ void analyzeTopology(Mesh& mesh)
         if (used[v] && sets.find(v) == v) ++r.components;
 }
 
+namespace {
+
+/// What Assimp read: every placed mesh instance concatenated, with node transforms applied and
+/// polygons split into fans. Indices are into `positions` (3 floats per vertex).
+struct RawMesh {
+    std::vector<float> positions, colors; ///< colors: 3 per vertex, or empty
+    std::vector<uint32_t> triangles;      ///< 3 per triangle
+    std::string error;                    ///< set when the file could not be read
+};
+
+/// Reads `file` with Assimp into a RawMesh (in whichever process calls it).
+RawMesh readWithAssimp(const std::filesystem::path& file)
+{
+    RawMesh raw;
+    Assimp::Importer importer;
+    // Only validation: Assimp's own post-processing steps (Triangulate, PreTransformVertices,
+    // SortByPType) abort the process on some malformed files (an ai_assert in TriangulateProcess,
+    // found by fuzzing). Node transforms and polygon splitting are done here instead.
+    const aiScene* scene = importer.ReadFile(file.string(), aiProcess_ValidateDataStructure);
+    if (!scene) {
+        raw.error = importer.GetErrorString();
+        raw.error = "cannot read mesh (" + (raw.error.empty() ? std::string("unknown reason") : raw.error) + ")";
+        return raw;
+    }
+    if (scene->mFlags & AI_SCENE_FLAGS_INCOMPLETE) {
+        raw.error = "the mesh file is incomplete or malformed";
+        return raw;
+    }
+    bool anyColors = false;
+    for (unsigned mi = 0; mi < scene->mNumMeshes; ++mi)
+        anyColors = anyColors || scene->mMeshes[mi]->HasVertexColors(0);
+    auto addMesh = [&](const aiMesh* am, const aiMatrix4x4& node) {
+        const uint32_t base = uint32_t(raw.positions.size() / 3);
+        for (unsigned v = 0; v < am->mNumVertices; ++v) {
+            const aiVector3D& a = am->mVertices[v];
+            // A non-finite input stays non-finite (the transform could hide a NaN behind a 0 scale).
+            const bool finite = std::isfinite(a.x) && std::isfinite(a.y) && std::isfinite(a.z);
+            const aiVector3D w = finite ? node * a : aiVector3D(std::numeric_limits<float>::quiet_NaN());
+            raw.positions.insert(raw.positions.end(), {w.x, w.y, w.z});
+            if (anyColors) {
+                const aiColor4D c = am->HasVertexColors(0) ? am->mColors[0][v] : aiColor4D(0.8f, 0.8f, 0.8f, 1.0f);
+                raw.colors.insert(raw.colors.end(), {c.r, c.g, c.b});
+            }
+        }
+        // Points and lines are of no use to a voxelizer; polygons become fans (exact when convex).
+        for (unsigned f = 0; f < am->mNumFaces; ++f) {
+            const aiFace& face = am->mFaces[f];
+            if (face.mNumIndices < 3) continue;
+            bool inRange = true;
+            for (unsigned k = 0; k < face.mNumIndices; ++k) inRange = inRange && face.mIndices[k] < am->mNumVertices;
+            if (!inRange) {
+                raw.error = "face " + std::to_string(f + 1) + " names a vertex that does not exist";
+                return;
+            }
+            for (unsigned k = 1; k + 1 < face.mNumIndices; ++k)
+                raw.triangles.insert(raw.triangles.end(), {base + face.mIndices[0], base + face.mIndices[k],
+                                                           base + face.mIndices[k + 1]});
+        }
+    };
+    // Every mesh as often as the node hierarchy places it (what PreTransformVertices would do).
+    std::vector<std::pair<const aiNode*, aiMatrix4x4>> stack;
+    if (scene->mRootNode) stack.emplace_back(scene->mRootNode, scene->mRootNode->mTransformation);
+    size_t placed = 0;
+    while (!stack.empty() && raw.error.empty()) {
+        const auto [node, xf] = stack.back();
+        stack.pop_back();
+        for (unsigned i = 0; i < node->mNumMeshes; ++i)
+            if (node->mMeshes[i] < scene->mNumMeshes) {
+                addMesh(scene->mMeshes[node->mMeshes[i]], xf);
+                ++placed;
+            }
+        if (stack.size() + node->mNumChildren > 100000) {
+            raw.error = "the node hierarchy is too deep or too large";
+            break;
+        }
+        for (unsigned c = 0; c < node->mNumChildren; ++c)
+            stack.emplace_back(node->mChildren[c], xf * node->mChildren[c]->mTransformation);
+    }
+    if (placed == 0 && raw.error.empty()) // no node hierarchy: the meshes as stored
+        for (unsigned mi = 0; mi < scene->mNumMeshes; ++mi) addMesh(scene->mMeshes[mi], aiMatrix4x4());
+    return raw;
+}
+
+bool writeAll(int fd, const void* data, size_t size)
+{
+    const char* p = static_cast<const char*>(data);
+    while (size > 0) {
+        const ssize_t n = ::write(fd, p, size);
+        if (n < 0 && errno == EINTR) continue;
+        if (n <= 0) return false;
+        p += n;
+        size -= size_t(n);
+    }
+    return true;
+}
+
+template <typename T>
+bool writeVector(int fd, const std::vector<T>& v)
+{
+    const uint64_t n = v.size();
+    return writeAll(fd, &n, sizeof n) && writeAll(fd, v.data(), v.size() * sizeof(T));
+}
+
+/// Reads exactly `size` bytes before `deadline`; false on EOF, error or timeout.
+bool readAll(int fd, void* data, size_t size, std::chrono::steady_clock::time_point deadline, bool& timedOut)
+{
+    char* p = static_cast<char*>(data);
+    while (size > 0) {
+        const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(deadline - std::chrono::steady_clock::now());
+        if (left.count() <= 0) {
+            timedOut = true;
+            return false;
+        }
+        pollfd pfd{fd, POLLIN, 0};
+        const int r = ::poll(&pfd, 1, int(std::min<long long>(left.count(), 1000)));
+        if (r < 0 && errno == EINTR) continue;
+        if (r < 0) return false;
+        if (r == 0) continue;
+        const ssize_t n = ::read(fd, p, size);
+        if (n < 0 && errno == EINTR) continue;
+        if (n <= 0) return false;
+        p += n;
+        size -= size_t(n);
+    }
+    return true;
+}
+
+template <typename T>
+bool readVector(int fd, std::vector<T>& v, std::chrono::steady_clock::time_point deadline, bool& timedOut)
+{
+    uint64_t n = 0;
+    if (!readAll(fd, &n, sizeof n, deadline, timedOut) || n > (uint64_t(1) << 34) / sizeof(T)) return false;
+    v.resize(size_t(n));
+    return readAll(fd, v.data(), v.size() * sizeof(T), deadline, timedOut);
+}
+
+/// readWithAssimp() in a child process, so that a parser that aborts, crashes or never returns on
+/// a malformed file (Assimp 5.2 does all three; fuzzing found them) becomes an error message, not
+/// a dead or hung volmorph. The time limit grows with the file: 5 s plus 2 s per MB.
+RawMesh readIsolated(const std::filesystem::path& file, uintmax_t bytes)
+{
+    RawMesh raw;
+    int fds[2];
+    if (::pipe(fds) != 0) return readWithAssimp(file);
+    std::fflush(nullptr);
+    const pid_t child = ::fork();
+    if (child < 0) {
+        ::close(fds[0]);
+        ::close(fds[1]);
+        return readWithAssimp(file);
+    }
+    if (child == 0) {
+        ::close(fds[0]);
+        const RawMesh r = readWithAssimp(file);
+        const bool ok = writeVector(fds[1], std::vector<char>(r.error.begin(), r.error.end())) &&
+                        writeVector(fds[1], r.positions) && writeVector(fds[1], r.colors) &&
+                        writeVector(fds[1], r.triangles);
+        ::_exit(ok ? 0 : 1);
+    }
+    ::close(fds[1]);
+    const double limit = 5.0 + 2.0 * double(bytes) / 1e6;
+    const auto deadline = std::chrono::steady_clock::now() + std::chrono::milliseconds(long(limit * 1000.0));
+    bool timedOut = false;
+    std::vector<char> error;
+    const bool ok = readVector(fds[0], error, deadline, timedOut) && readVector(fds[0], raw.positions, deadline, timedOut) &&
+                    readVector(fds[0], raw.colors, deadline, timedOut) && readVector(fds[0], raw.triangles, deadline, timedOut);
+    ::close(fds[0]);
+    if (!ok) ::kill(child, SIGKILL);
+    int status = 0;
+    while (::waitpid(child, &status, 0) < 0 && errno == EINTR) {
+    }
+    if (ok) {
+        raw.error.assign(error.begin(), error.end());
+        return raw;
+    }
+    raw = RawMesh{};
+    if (timedOut) {
+        char text[160];
+        std::snprintf(text, sizeof text, "the mesh reader did not finish within %.0f s; the file is probably malformed",
+                      limit);
+        raw.error = text;
+    } else if (WIFSIGNALED(status)) {
+        raw.error = "the mesh reader (Assimp) crashed on this file (signal " + std::to_string(WTERMSIG(status)) +
+                    "); the file is probably malformed";
+    } else {
+        raw.error = "the mesh reader (Assimp) failed on this file; it is probably malformed";
+    }
+    return raw;
+}
+
+} // namespace
+
 Mesh importMesh(const std::filesystem::path& file, const ObjectTransform& transform,
                 const SourceLocation& where)
 {
@@ -116,78 +317,52 @@ Mesh importMesh(const std::filesystem::path& file, const ObjectTransform& transf
     std::error_code ec;
     if (!std::filesystem::is_regular_file(file, ec))
         throw UserError(place, pre + "mesh file not found or not a regular file");
-    if (std::filesystem::file_size(file, ec) == 0)
+    const uintmax_t bytes = std::filesystem::file_size(file, ec);
+    if (bytes == 0)
         throw UserError(place, pre + "mesh file is empty");
 
-    Assimp::Importer importer;
-    // Points and lines are of no use to a voxelizer; let Assimp drop them.
-    importer.SetPropertyInteger(AI_CONFIG_PP_SBP_REMOVE, aiPrimitiveType_POINT | aiPrimitiveType_LINE);
-    const unsigned flags = aiProcess_Triangulate | aiProcess_PreTransformVertices |
-                           aiProcess_SortByPType | aiProcess_ValidateDataStructure;
-    const aiScene* scene = importer.ReadFile(file.string(), flags);
-    if (!scene) {
-        std::string why = importer.GetErrorString();
-        if (why.empty()) why = "unknown reason";
-        throw UserError(place, pre + "cannot read mesh (" + why + ")");
-    }
-    if (scene->mFlags & AI_SCENE_FLAGS_INCOMPLETE)
-        throw UserError(place, pre + "the mesh file is incomplete or malformed");
+    const RawMesh raw = readIsolated(file, bytes);
+    if (!raw.error.empty()) throw UserError(place, pre + raw.error);
 
     Mesh mesh;
     mesh.file = file;
     const Mat4d m = transform.matrix();
     std::unordered_map<Vec3f, uint32_t, PositionHash> index;
-    bool anyColors = false;
-    for (unsigned mi = 0; mi < scene->mNumMeshes; ++mi)
-        anyColors = anyColors || scene->mMeshes[mi]->HasVertexColors(0);
-
-    std::vector<uint32_t> remap;
-    for (unsigned mi = 0; mi < scene->mNumMeshes; ++mi) {
-        const aiMesh* am = scene->mMeshes[mi];
-        if (!(am->mPrimitiveTypes & aiPrimitiveType_TRIANGLE)) continue;
-        remap.assign(am->mNumVertices, 0);
-        for (unsigned v = 0; v < am->mNumVertices; ++v) {
-            const aiVector3D& a = am->mVertices[v];
-            if (!std::isfinite(a.x) || !std::isfinite(a.y) || !std::isfinite(a.z))
-                throw UserError(place, pre + "vertex " + std::to_string(v + 1) +
-                                           " has a non-finite coordinate (NaN or inf)");
-            const Vec3d w = m.transform(Vec3d(a.x, a.y, a.z));
-            Vec3f p(float(w.x()) + 0.0f, float(w.y()) + 0.0f, float(w.z()) + 0.0f); // -0 -> +0
-            if (!std::isfinite(p.x()) || !std::isfinite(p.y()) || !std::isfinite(p.z()))
-                throw UserError(place, pre + "vertex " + std::to_string(v + 1) +
-                                           " is out of range after the transform");
-            const auto [it, inserted] = index.try_emplace(p, uint32_t(mesh.points.size()));
-            if (inserted) {
-                mesh.points.push_back(p);
-                if (anyColors) {
-                    Vec3f c(0.8f);
-                    if (am->HasVertexColors(0)) {
-                        const aiColor4D& ac = am->mColors[0][v];
-                        c = Vec3f(ac.r, ac.g, ac.b);
-                    }
-                    mesh.colors.push_back(c);
-                }
-            } else {
-                ++mesh.report.duplicateVertices;
-            }
-            remap[v] = it->second;
+    const size_t vertices = raw.positions.size() / 3;
+    const bool anyColors = raw.colors.size() == raw.positions.size() && !raw.colors.empty();
+    std::vector<uint32_t> remap(vertices, 0);
+    for (size_t v = 0; v < vertices; ++v) {
+        const float* a = &raw.positions[3 * v];
+        if (!std::isfinite(a[0]) || !std::isfinite(a[1]) || !std::isfinite(a[2]))
+            throw UserError(place, pre + "vertex " + std::to_string(v + 1) + " has a non-finite coordinate (NaN or inf)");
+        const Vec3d w = m.transform(Vec3d(a[0], a[1], a[2]));
+        Vec3f p(float(w.x()) + 0.0f, float(w.y()) + 0.0f, float(w.z()) + 0.0f); // -0 -> +0
+        if (!std::isfinite(p.x()) || !std::isfinite(p.y()) || !std::isfinite(p.z()))
+            throw UserError(place, pre + "vertex " + std::to_string(v + 1) + " is out of range after the transform");
+        const auto [it, inserted] = index.try_emplace(p, uint32_t(mesh.points.size()));
+        if (inserted) {
+            mesh.points.push_back(p);
+            if (anyColors) mesh.colors.emplace_back(raw.colors[3 * v], raw.colors[3 * v + 1], raw.colors[3 * v + 2]);
+        } else {
+            ++mesh.report.duplicateVertices;
         }
-        for (unsigned f = 0; f < am->mNumFaces; ++f) {
-            const aiFace& face = am->mFaces[f];
-            if (face.mNumIndices != 3) continue;
-            ++mesh.report.inputTriangles;
-            const Vec3I tri(remap[face.mIndices[0]], remap[face.mIndices[1]], remap[face.mIndices[2]]);
-            if (tri[0] == tri[1] || tri[1] == tri[2] || tri[0] == tri[2]) {
-                ++mesh.report.degenerateTriangles;
-                continue;
-            }
-            const Vec3d a(mesh.points[tri[0]]), b(mesh.points[tri[1]]), c(mesh.points[tri[2]]);
-            if ((b - a).cross(c - a).lengthSqr() == 0.0) {
-                ++mesh.report.degenerateTriangles;
-                continue;
-            }
-            mesh.triangles.push_back(tri);
+        remap[v] = it->second;
+    }
+    for (size_t t = 0; t + 2 < raw.triangles.size(); t += 3) {
+        ++mesh.report.inputTriangles;
+        if (raw.triangles[t] >= vertices || raw.triangles[t + 1] >= vertices || raw.triangles[t + 2] >= vertices)
+            throw UserError(place, pre + "a face names a vertex that does not exist");
+        const Vec3I tri(remap[raw.triangles[t]], remap[raw.triangles[t + 1]], remap[raw.triangles[t + 2]]);
+        if (tri[0] == tri[1] || tri[1] == tri[2] || tri[0] == tri[2]) {
+            ++mesh.report.degenerateTriangles;
+            continue;
         }
+        const Vec3d a(mesh.points[tri[0]]), b(mesh.points[tri[1]]), c(mesh.points[tri[2]]);
+        if ((b - a).cross(c - a).lengthSqr() == 0.0) {
+            ++mesh.report.degenerateTriangles;
+            continue;
+        }
+        mesh.triangles.push_back(tri);
     }
     if (mesh.report.inputTriangles == 0)
         throw UserError(place, pre + "the mesh has no triangles");

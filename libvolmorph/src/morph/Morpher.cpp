@@ -4,6 +4,7 @@
 
 #include "warp/AdaptiveWarp.h"
 
+#include <volmorph/Diagnostics.h>
 #include <volmorph/Voxelize.h>
 
 #include <openvdb/tools/FastSweeping.h>
@@ -17,6 +18,7 @@
 
 #include <memory>
 #include <mutex>
+#include <cstdio>
 
 namespace volmorph {
 namespace {
@@ -69,14 +71,16 @@ openvdb::FloatGrid::Ptr extendedDistances(const openvdb::FloatGrid& sdf, const C
 size_t dropIslands(openvdb::FloatGrid& values, int minVoxels, float outside)
 {
     if (minVoxels <= 0) return 0;
+    // Interior: every negative value, active or not (after narrowBand the deep interior is inactive
+    // tiles). Exterior candidates: positive active values only (the far exterior is background).
     auto pieces = [&values](bool negative) {
         openvdb::BoolGrid mask(false);
         auto acc = mask.getAccessor();
-        for (auto it = values.cbeginValueOn(); it; ++it)
-            if ((*it < 0.0f) == negative) {
-                if (it.isVoxelValue()) acc.setValueOn(it.getCoord(), true);
-                else mask.sparseFill(it.getBoundingBox(), true, true);
-            }
+        for (auto it = values.cbeginValueAll(); it; ++it) {
+            if ((*it < 0.0f) != negative || (!negative && !it.isValueOn())) continue;
+            if (it.isVoxelValue()) acc.setValueOn(it.getCoord(), true);
+            else mask.sparseFill(it.getBoundingBox(), true, true);
+        }
         std::vector<openvdb::BoolGrid::Ptr> out;
         openvdb::tools::segmentActiveVoxels(mask, out); // largest first
         return out;
@@ -99,8 +103,9 @@ size_t dropIslands(openvdb::FloatGrid& values, int minVoxels, float outside)
         for (auto it = gap->cbeginValueOn(); it && enclosed; ++it)
             for (auto c = it.getBoundingBox().begin(); c && enclosed; ++c)
                 for (int k = 0; k < 6 && enclosed; ++k) {
+                    // A face neighbour that is positive and inactive is the far exterior.
                     const openvdb::Coord n = *c + openvdb::util::COORD_OFFSETS[k];
-                    enclosed = acc.isValueOn(n);
+                    enclosed = acc.isValueOn(n) || acc.getValue(n) < 0.0f;
                 }
         if (enclosed) {
             set(*gap, -outside);
@@ -110,16 +115,15 @@ size_t dropIslands(openvdb::FloatGrid& values, int minVoxels, float outside)
     return changed;
 }
 
-/// `sdf` as a level set of half width `width` (world units): voxels at or beyond it become inactive
-/// with value +/- width, and constant leaves collapse into tiles.
-openvdb::FloatGrid::Ptr narrowBand(openvdb::FloatGrid& sdf, float width)
+/// Makes `sdf` a level set of half width `width` (world units), in place: voxels at or beyond it
+/// become inactive with value +/- width, and constant leaves collapse into tiles.
+void narrowBand(openvdb::FloatGrid& sdf, float width)
 {
     openvdb::tree::LeafManager<FloatTree> leaves(sdf.tree());
     leaves.foreach([width](FloatTree::LeafNodeType& leaf, size_t) {
-        for (auto it = leaf.beginValueOn(); it; ++it)
-            if (!(std::abs(*it) < width)) {
-                const float v = *it < 0.0f ? -width : width;
-                it.setValue(v);
+        for (auto it = leaf.beginValueAll(); it; ++it)
+            if (!(std::abs(*it) < width) || !it.isValueOn()) {
+                it.setValue(*it < 0.0f ? -width : width);
                 it.setValueOff();
             }
     });
@@ -130,7 +134,6 @@ openvdb::FloatGrid::Ptr narrowBand(openvdb::FloatGrid& sdf, float width)
         }
     openvdb::tools::changeLevelSetBackground(sdf.tree(), width);
     openvdb::tools::pruneLevelSet(sdf.tree());
-    return sdf.copy();
 }
 
 template <typename Sampler>
@@ -264,28 +267,49 @@ VolumeSet Morpher::run(double t, const CoordBBox& box, bool prune, double tolera
 
     std::mutex collect;
     std::vector<std::pair<FloatTree::LeafNodeType*, Vec3STree::LeafNodeType*>> leaves;
+    // The memory guard: a warp that blows the shape up (a pair scaling by 100, say) would
+    // otherwise fill the machine's memory leaf by leaf.
+    const uint64_t limit = mOptions.memoryLimitBytes ? mOptions.memoryLimitBytes : defaultMemoryLimitBytes();
+    const size_t maxLeaves = size_t(std::max<uint64_t>(1, limit / kMorphBytesPerLeaf));
     auto each = [&](auto resampler) {
         return [&, resampler](const detail::WarpLeaf& w) {
             auto density = std::make_unique<FloatTree::LeafNodeType>(w.origin, 0.0f, false);
             auto color = std::make_unique<Vec3STree::LeafNodeType>(w.origin, background, false);
             if (!resampler(w, *density, *color)) return;
             std::lock_guard<std::mutex> lock(collect);
+            if (leaves.size() >= maxLeaves) { // the leaves kept so far are freed below
+                char text[300];
+                std::snprintf(text, sizeof text,
+                              "the in-between at t = %.4f needs more than the memory limit of %.1f GiB (over %zu "
+                              "blocks of 8^3 voxels); use a larger voxel size, check the feature pairs' scales, or "
+                              "raise --memory-limit (default: half the machine's memory)",
+                              t, double(limit) / double(1ull << 30), maxLeaves);
+                throw UserError(SourceLocation{"morph"}, text);
+            }
             leaves.emplace_back(density.release(), color.release());
         };
     };
     detail::AdaptiveWarpStats warpStats;
-    if (mOptions.sampling == MorphOptions::Sampling::Triquadratic)
-        adaptive.forEachLeaf(box, occS, occT,
-                             each(Resampler<openvdb::tools::QuadraticSampler>{mSource, mTarget, mWideSdfSource.get(),
-                                                                              mWideSdfTarget.get(), tauD, tauC, tauS, background,
-                                                                              sdfMode, outside}),
-                             &warpStats, interrupter);
-    else
-        adaptive.forEachLeaf(box, occS, occT,
-                             each(Resampler<openvdb::tools::BoxSampler>{mSource, mTarget, mWideSdfSource.get(),
-                                                                        mWideSdfTarget.get(), tauD, tauC, tauS, background, sdfMode,
-                                                                        outside}),
-                             &warpStats, interrupter);
+    try {
+        if (mOptions.sampling == MorphOptions::Sampling::Triquadratic)
+            adaptive.forEachLeaf(box, occS, occT,
+                                 each(Resampler<openvdb::tools::QuadraticSampler>{mSource, mTarget, mWideSdfSource.get(),
+                                                                                  mWideSdfTarget.get(), tauD, tauC, tauS, background,
+                                                                                  sdfMode, outside}),
+                                 &warpStats, interrupter);
+        else
+            adaptive.forEachLeaf(box, occS, occT,
+                                 each(Resampler<openvdb::tools::BoxSampler>{mSource, mTarget, mWideSdfSource.get(),
+                                                                            mWideSdfTarget.get(), tauD, tauC, tauS, background, sdfMode,
+                                                                            outside}),
+                                 &warpStats, interrupter);
+    } catch (...) {
+        for (auto& [density, color] : leaves) {
+            delete density;
+            delete color;
+        }
+        throw;
+    }
 
     VolumeSet out;
     openvdb::FloatGrid::Ptr values =
@@ -297,13 +321,16 @@ VolumeSet Morpher::run(double t, const CoordBBox& box, bool prune, double tolera
     }
     values->setTransform(mSource.density->transform().copy());
     if (sdfMode) {
-        // The blend of two warped distances has the right zero set but is no distance field:
-        // redistance it (fast sweeping, which keeps the blend's signs; a rebuild through a mesh and
-        // its scanline flood fill flipped single voxels where two sheets nearly touch), then keep a
-        // narrow band around the surface, and derive the fog from that surface.
+        // The blend of two warped distances has the right zero set but is no distance field. Keep
+        // the part that can lie within the band (|blend| < 3 bands: its gradient is at most the
+        // warp's local stretch, taken to be under 3), drop dust, redistance by fast sweeping
+        // (which keeps the blend's signs; a rebuild through a mesh and its scanline flood fill
+        // flipped single voxels where two sheets nearly touch), keep the band, and derive the fog.
         values->setGridClass(openvdb::GRID_LEVEL_SET);
-        dropIslands(*values, mBlend.minIslandVoxels, outside);
-        out.sdf = narrowBand(*openvdb::tools::sdfToSdf(*values, 0.0f, 1), outside);
+        narrowBand(*values, 3.0f * outside);
+        dropIslands(*values, mBlend.minIslandVoxels, 3.0f * outside);
+        out.sdf = openvdb::tools::sdfToSdf(*values, 0.0f, 1);
+        narrowBand(*out.sdf, outside);
         out.sdf->setName(kSdfGridName);
         out.sdf->setGridClass(openvdb::GRID_LEVEL_SET);
         out.density = fogFromLevelSet(*out.sdf, 1.5f * float(voxel));

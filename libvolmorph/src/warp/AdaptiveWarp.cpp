@@ -37,7 +37,6 @@ inline Vec3d trilinear(const Vec3d c[8], double fx, double fy, double fz)
 inline int latticeIndex(int a, int b, int c) { return a + 3 * b + 9 * c; }
 
 /// Corner k (bit 0: x, bit 1: y, bit 2: z) as a lattice index.
-inline int cornerLattice(int k) { return latticeIndex((k & 1) * 2, ((k >> 1) & 1) * 2, ((k >> 2) & 1) * 2); }
 
 } // namespace
 

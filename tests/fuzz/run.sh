@@ -1,0 +1,44 @@
+#!/bin/sh
+# Builds the libFuzzer targets with clang (ASan, UBSan, coverage) in build-fuzz/ and runs each for a
+# bounded time from a seed corpus (scenes/, tests/bad/, small meshes). Fails on any crash,
+# sanitizer report, leak, timeout (a hang: one input over 10 s) or out-of-memory; the input that
+# did it is kept under build-fuzz/findings/.
+# usage: tests/fuzz/run.sh [SECONDS per target, default 60]
+set -eu
+cd "$(dirname "$0")/../.."
+seconds=${1:-60}
+build=build-fuzz
+cmake -S . -B "$build" -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo \
+      -DCMAKE_CXX_COMPILER=clang++ \
+      -DVOLMORPH_SANITIZE=address,undefined,fuzzer-no-link -DVOLMORPH_BUILD_FUZZERS=ON \
+      -DVOLMORPH_BUILD_TESTS=OFF >/dev/null
+cmake --build "$build" --parallel "$(nproc)" --target volmorph_fuzz_scene volmorph_fuzz_mesh
+
+work=$(mktemp -d)
+trap 'rm -rf "$work"' EXIT
+mkdir -p "$work/scene" "$work/mesh" "$build/findings"
+cp scenes/*.toml tests/bad/*.toml "$work/scene/"
+# Mesh seeds: the extension byte (0 obj, 1 ply, 2 stl, 3 off, 4 gltf) followed by the file.
+i=0
+for f in tests/data/meshes/* scenes/meshes/cube.obj scenes/meshes/sphere.obj; do
+    case "$f" in *.obj) b='\000' ;; *.ply) b='\001' ;; *.stl) b='\002' ;; *.off) b='\003' ;; *.gltf) b='\004' ;; *) continue ;; esac
+    [ "$(wc -c <"$f")" -le 200000 ] || continue
+    { printf "$b"; cat "$f"; } >"$work/mesh/seed$i"
+    i=$((i + 1))
+done
+
+export ASAN_OPTIONS=detect_leaks=1:abort_on_error=0
+export LSAN_OPTIONS=suppressions=$PWD/tests/fuzz/lsan.supp:print_suppressions=0
+export UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1
+status=0
+for target in scene mesh; do
+    echo "fuzz: $target for ${seconds} s"
+    if ! "$build/tests/fuzz/volmorph_fuzz_$target" "$work/$target" -max_total_time="$seconds" -timeout=10 \
+            -rss_limit_mb=4096 -max_len=65536 -print_final_stats=1 \
+            -artifact_prefix="$build/findings/$target-" >"$work/$target.log" 2>&1; then
+        echo "fuzz: $target FAILED"; tail -60 "$work/$target.log"; status=1
+    else
+        grep -E "stat::number_of_executed_runs|stat::new_units_added" "$work/$target.log" | sed "s/^/  /"
+    fi
+done
+exit $status
