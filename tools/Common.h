@@ -35,6 +35,7 @@ Command addRenderCommand(CLI::App& app);
 Command addDiffCommand(CLI::App& app);
 Command addCacheCommand(CLI::App& app);
 Command addPreviewCommand(CLI::App& app);
+Command addFramesCommand(CLI::App& app);
 
 std::string fmt(double v);
 std::string fmt(const Vec3d& v);

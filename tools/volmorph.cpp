@@ -16,7 +16,7 @@ int main(int argc, char** argv)
     const std::vector<Command> commands = {addCheckCommand(app), addVoxelizeCommand(app), addMorphCommand(app),
                                           addRenderVdbCommand(app), addRenderCommand(app),
                                           addDiffCommand(app), addCacheCommand(app),
-                                          addPreviewCommand(app)};
+                                          addPreviewCommand(app), addFramesCommand(app)};
 
     try {
         app.parse(argc, argv);

@@ -72,3 +72,27 @@ TEST(Frames, PatternChecks)
     EXPECT_NE(checkFramePattern("a.%s.exr"), "");
     EXPECT_NE(checkFramePattern("a.%d.%d.exr"), "");
 }
+
+TEST(Frames, ChunksCoverEveryFrameOnceInOrder)
+{
+    EXPECT_EQ(formatFrames({1, 2, 3, 5, 7, 8}), "1-3,5,7-8");
+    EXPECT_EQ(formatFrames({-3, -2, 4}), "-3--2,4");
+    EXPECT_EQ(formatFrames({}), "");
+    for (int n : {1, 7, 24, 25}) {
+        std::vector<int> frames;
+        for (int f = 0; f < n; ++f) frames.push_back(10 + 2 * f);
+        for (int size : {1, 5, 24, 100}) {
+            const int chunks = chunkCount(frames, size);
+            EXPECT_EQ(chunks, (n + size - 1) / size);
+            std::vector<int> all;
+            for (int i = 0; i < chunks; ++i) {
+                const std::vector<int> c = chunkFrames(frames, size, i);
+                EXPECT_FALSE(c.empty());
+                EXPECT_LE(int(c.size()), size);
+                all.insert(all.end(), c.begin(), c.end());
+            }
+            EXPECT_EQ(all, frames) << n << " frames in chunks of " << size;
+            EXPECT_TRUE(chunkFrames(frames, size, chunks).empty());
+        }
+    }
+}

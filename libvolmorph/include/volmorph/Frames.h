@@ -16,6 +16,14 @@ namespace volmorph {
 std::vector<int> selectFrames(const FramesSpec& frames, const std::string& spec,
                               const std::string& what = "--frames");
 
+/// `frames` written as a frame spec, consecutive runs as ranges: {1,2,3,5,7,8} -> "1-3,5,7-8".
+std::string formatFrames(const std::vector<int>& frames);
+
+/// The frames of chunk `index` (0-based) when `frames` are cut into chunks of `chunkSize` in order;
+/// the last chunk takes the remainder. chunkCount() gives how many there are.
+std::vector<int> chunkFrames(const std::vector<int>& frames, int chunkSize, int index);
+int chunkCount(const std::vector<int>& frames, int chunkSize);
+
 /// Checks a pattern's frame placeholder: one run of N '#' (the frame zero-padded to N digits:
 /// #### -> 0042), or a printf %d / %0Nd. Returns an empty string when valid, else why not.
 std::string checkFramePattern(const std::string& pattern);

@@ -70,4 +70,32 @@ std::vector<int> selectFrames(const FramesSpec& frames, const std::string& spec,
     return picked;
 }
 
+std::string formatFrames(const std::vector<int>& frames)
+{
+    std::string out;
+    for (size_t i = 0; i < frames.size();) {
+        size_t j = i;
+        while (j + 1 < frames.size() && frames[j + 1] == frames[j] + 1) ++j;
+        if (!out.empty()) out += ',';
+        out += std::to_string(frames[i]);
+        if (j > i) out += '-' + std::to_string(frames[j]);
+        i = j + 1;
+    }
+    return out;
+}
+
+int chunkCount(const std::vector<int>& frames, int chunkSize)
+{
+    if (chunkSize < 1) return 0;
+    return int((frames.size() + size_t(chunkSize) - 1) / size_t(chunkSize));
+}
+
+std::vector<int> chunkFrames(const std::vector<int>& frames, int chunkSize, int index)
+{
+    if (chunkSize < 1 || index < 0 || index >= chunkCount(frames, chunkSize)) return {};
+    const size_t first = size_t(index) * size_t(chunkSize);
+    const size_t last = std::min(frames.size(), first + size_t(chunkSize));
+    return std::vector<int>(frames.begin() + long(first), frames.begin() + long(last));
+}
+
 } // namespace volmorph
