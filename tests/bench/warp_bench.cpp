@@ -1,6 +1,6 @@
 // The warp and the morph frame, each beside its anchor in one process:
 //  - exact vs approximated warp (tolerance 0.25 voxel) over the output domain of the default scene
-//    at 256 voxels across, for 1, 4, 16 and 64 pairs (the scene's 4, plus hand-like random ones);
+//    at 256 voxels across, for 1, 4, 16 and 64 pairs (the scene's 3, plus hand-like random ones);
 //    counter max_error_voxels is measured against the exact warp on every 3rd voxel;
 //  - a whole frame (domain, warp, resample, blend) vs its lower bound: resampling source and target
 //    once per output voxel of the same frame with the identity warp;
@@ -129,7 +129,7 @@ void warpOnly(benchmark::State& state, double tolerance)
 void exactWarp(benchmark::State& state) { warpOnly(state, 0.0); }
 void approximatedWarp(benchmark::State& state) { warpOnly(state, 0.25); }
 
-/// One whole frame at t = 0.5 with the scene's 4 pairs.
+/// One whole frame at t = 0.5 with the scene's pairs.
 void morphFrame(benchmark::State& state)
 {
     const Setup& s = setup(int(state.range(0)));
