@@ -48,6 +48,31 @@ void warnFarFeatures(const Scene& scene, const Mesh& source, const Mesh& target)
     }
 }
 
+/// Two pairs with the same element on one side are legal (their weights add up) but almost always
+/// a copy-paste slip; pairs whose source and target elements are both the same pull in two
+/// directions from one place.
+void warnCoincidentFeatures(const Scene& scene)
+{
+    auto same = [](const FeatureElement& a, const FeatureElement& b) {
+        constexpr double kTolerance = 1e-9;
+        return (a.origin - b.origin).length() < kTolerance && (a.xAxis - b.xAxis).length() < kTolerance &&
+               (a.yAxis - b.yAxis).length() < kTolerance && (a.scale - b.scale).length() < kTolerance;
+    };
+    for (size_t j = 1; j < scene.pairs.size(); ++j)
+        for (size_t i = 0; i < j; ++i) {
+            const FeaturePairSpec& a = scene.pairs[i];
+            const FeaturePairSpec& b = scene.pairs[j];
+            if (a.type != b.type) continue;
+            const bool s = same(a.source, b.source), t = same(a.target, b.target);
+            if (!s && !t) continue;
+            std::fprintf(stderr, "%s: warning: pair %zu has the same %s element as pair %zu%s\n", b.where.str().c_str(),
+                         j + 1, s && t ? "source and target" : s ? "source" : "target", i + 1,
+                         s && t ? " (a duplicate: its weight counts twice)"
+                         : s    ? ": one place is sent to two destinations, which are averaged"
+                                : ": two places are sent to one destination");
+        }
+}
+
 int runCheck(const std::string& scenePath)
 {
     const Scene scene = loadScene(scenePath);
@@ -120,6 +145,7 @@ int runCheck(const std::string& scenePath)
     }
     std::fflush(stdout);
     warnFarFeatures(scene, meshes.source, meshes.target);
+    warnCoincidentFeatures(scene);
     return 0;
 }
 

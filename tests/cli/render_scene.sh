@@ -1,5 +1,5 @@
 #!/bin/sh
-# volmorph render SCENE: one EXR per frame; a chunk equals the same frames of a full run pixel for
+# volmorph render SCENE: one EXR per frame; three chunks give the frames of a full run pixel for
 # pixel; --skip-existing leaves finished frames alone and redoes a truncated one.
 # usage: render_scene.sh VOLMORPH SOURCE_DIR
 set -eu
@@ -11,8 +11,11 @@ trap 'rm -rf "$out"' EXIT
 "$volmorph" render "$scene" -o "$out/full/f.####.exr" -q
 [ "$(ls "$out/full" | tr '\n' ' ')" = "f.0000.exr f.0001.exr f.0002.exr f.0003.exr f.0004.exr " ] \
     || { echo "full run wrote: $(ls "$out/full")"; exit 1; }
+# Three chunks, as three farm tasks would run them (one with one thread): the frames of the full run.
+"$volmorph" render "$scene" --frames 0-1 -o "$out/chunk/f.####.exr" -q
 "$volmorph" render "$scene" --frames 2-3 -o "$out/chunk/f.####.exr" -q --threads 1
-for f in 0002 0003; do
+"$volmorph" render "$scene" --frames 4 -o "$out/chunk/f.####.exr" -q
+for f in 0000 0001 0002 0003 0004; do
     idiff -fail 0 -failpercent 0 -hardfail 0 "$out/full/f.$f.exr" "$out/chunk/f.$f.exr" >/dev/null \
         || { echo "frame $f differs between chunk and full run"; exit 1; }
 done

@@ -20,7 +20,7 @@ mkdir -p "$work/scene" "$work/mesh" "$build/findings"
 cp scenes/*.toml tests/bad/*.toml "$work/scene/"
 # Mesh seeds: the extension byte (0 obj, 1 ply, 2 stl, 3 off, 4 gltf) followed by the file.
 i=0
-for f in tests/data/meshes/* scenes/meshes/cube.obj scenes/meshes/sphere.obj; do
+for f in tests/data/meshes/* tests/data/stl-models-broken/*.stl scenes/meshes/cube.obj scenes/meshes/sphere.obj; do
     case "$f" in *.obj) b='\000' ;; *.ply) b='\001' ;; *.stl) b='\002' ;; *.off) b='\003' ;; *.gltf) b='\004' ;; *) continue ;; esac
     [ "$(wc -c <"$f")" -le 200000 ] || continue
     { printf "$b"; cat "$f"; } >"$work/mesh/seed$i"

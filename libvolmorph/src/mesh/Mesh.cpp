@@ -137,8 +137,16 @@ RawMesh readWithAssimp(const std::filesystem::path& file)
     // found by fuzzing). Node transforms and polygon splitting are done here instead.
     const aiScene* scene = importer.ReadFile(file.string(), aiProcess_ValidateDataStructure);
     if (!scene) {
-        raw.error = importer.GetErrorString();
-        raw.error = "cannot read mesh (" + (raw.error.empty() ? std::string("unknown reason") : raw.error) + ")";
+        // Assimp's message may quote the file: keep it to one printable line of reasonable length.
+        std::string why;
+        for (const char c : std::string(importer.GetErrorString())) {
+            if (why.size() >= 160) {
+                why += "...";
+                break;
+            }
+            why += (c >= 32 && c < 127) ? c : ' ';
+        }
+        raw.error = "cannot read mesh (" + (why.empty() ? std::string("unknown reason") : why) + ")";
         return raw;
     }
     if (scene->mFlags & AI_SCENE_FLAGS_INCOMPLETE) {
