@@ -5,6 +5,9 @@
 #   # expect-stderr: TEXT         a fragment stderr must contain (any number of these lines)
 #   # expect-no-file: PATH        a file that must not exist afterwards (any number of these lines)
 # Whatever else, stderr must not show a crash, an uncaught exception or a sanitizer report.
+if(NOT TIMEOUT)
+  set(TIMEOUT 10)
+endif()
 file(STRINGS "${CASE}" _lines)
 set(_args "check {case}")
 set(_exit "")
@@ -31,7 +34,7 @@ foreach(_file IN LISTS _no_files)
 endforeach()
 
 execute_process(COMMAND "${VOLMORPH}" ${_argv}
-                RESULT_VARIABLE _rc OUTPUT_VARIABLE _out ERROR_VARIABLE _err TIMEOUT 10)
+                RESULT_VARIABLE _rc OUTPUT_VARIABLE _out ERROR_VARIABLE _err TIMEOUT ${TIMEOUT})
 set(_failed FALSE)
 if(NOT _rc STREQUAL _exit)
   message(SEND_ERROR "${CASE}: exit status ${_rc}, expected ${_exit}")

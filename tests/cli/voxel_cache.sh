@@ -1,7 +1,7 @@
 #!/bin/sh
 # The voxel cache: a second run reads the voxels instead of voxelizing and renders the same pixels;
-# a truncated or garbage entry is reported, rebuilt and replaced, never trusted; changing an input
-# misses; an unwritable cache folder only warns.
+# a truncated or garbage entry, or one without its checksum, is reported, rebuilt and replaced,
+# never trusted; changing an input misses; an unusable cache folder only warns.
 # usage: voxel_cache.sh VOLMORPH SOURCE_DIR
 set -eu
 volmorph=$1
@@ -24,14 +24,17 @@ run() { # folder, extra flags...
 run first
 grep -q "cached in $cache/" "$dir/log" || { echo "first run did not store:"; cat "$dir/log"; exit 1; }
 entry=$(ls "$cache"/*.vdb)
-[ "$(ls "$cache" | wc -l)" = 1 ] || { echo "cache holds: $(ls "$cache")"; exit 1; }
+[ "$(ls "$cache"/*.vdb | wc -l)" = 1 ] && [ -f "${entry%.vdb}.sha1" ] || { echo "cache holds: $(ls "$cache")"; exit 1; }
 run hit
 grep -q "read from the cache" "$dir/log" || { echo "second run missed:"; cat "$dir/log"; exit 1; }
 same "$dir/nocache" "$dir/hit"
 
-for damage in truncate garbage; do
-    if [ $damage = truncate ]; then head -c 5000 "$entry" >"$dir/t"; else head -c 5000 /dev/urandom >"$dir/t"; fi
-    mv "$dir/t" "$entry"
+for damage in truncate garbage nochecksum; do
+    case $damage in
+        truncate) head -c 5000 "$entry" >"$dir/t"; mv "$dir/t" "$entry" ;;
+        garbage) head -c 5000 /dev/urandom >"$dir/t"; mv "$dir/t" "$entry" ;;
+        nochecksum) rm "${entry%.vdb}.sha1" ;;
+    esac
     run $damage
     grep -q "voxel cache entry not used" "$dir/err" || { echo "$damage entry not reported:"; cat "$dir/err"; exit 1; }
     same "$dir/nocache" "$dir/$damage"
@@ -43,7 +46,7 @@ done
 sed "s|meshes/|$2/scenes/meshes/|; s|scale = 0.8 }|scale = 0.7 }|" "$scene" >"$dir/changed.toml"
 "$volmorph" render "$dir/changed.toml" --frames 1 -o "$dir/changed/f.####.exr" --cache "$cache" >"$dir/log"
 grep -q "cached in" "$dir/log" || { echo "changed scene hit the old entry"; cat "$dir/log"; exit 1; }
-[ "$(ls "$cache" | wc -l)" = 2 ] || { echo "cache holds: $(ls "$cache")"; exit 1; }
+[ "$(ls "$cache"/*.vdb | wc -l)" = 2 ] || { echo "cache holds: $(ls "$cache")"; exit 1; }
 
 # A cache folder that cannot be created (its parent is a file): a warning, the frames still appear.
 touch "$dir/plainfile"

@@ -1,7 +1,8 @@
 // An on-disk cache of a scene's voxelized source and target, so that the chunks of a sequence
 // rendered on a farm voxelize once, not once per chunk.
 //
-// An entry is one .vdb file, <folder>/<key>.vdb, holding the six grids of both sides. The key is
+// An entry is one .vdb file, <folder>/<key>.vdb, holding the six grids of both sides, and the SHA-1
+// of its bytes in <folder>/<key>.sha1, checked before OpenVDB reads the entry. The key is
 // the SHA-1 of everything the voxels depend on: the cache format, the volmorph version and the bytes
 // of the running program (another build never reads this build's entries), the bytes of both mesh
 // files (not of files they reference, such as an OBJ's .mtl), both object transforms and colours, and the scene's [volume] settings. A changed

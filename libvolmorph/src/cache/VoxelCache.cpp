@@ -61,9 +61,25 @@ void describe(std::ostream& s, const char* side, const ObjectSpec& o)
 
 std::string gridName(const char* side, const char* grid) { return std::string(side) + "." + grid; }
 
-/// Reads and checks an entry; returns an empty string and fills `out`, or says what is wrong.
+std::filesystem::path checksumFile(const std::filesystem::path& entry)
+{
+    return std::filesystem::path(entry).replace_extension(".sha1");
+}
+
+/// Reads and checks an entry; returns an empty string and fills `out`, or says what is wrong. The
+/// file's SHA-1 must match the one written beside it before OpenVDB reads it: OpenVDB trusts the
+/// sizes inside a file, and a truncated one can make it ask for petabytes.
 std::string readEntry(const std::filesystem::path& path, const std::string& key, SceneVolumes& out)
 {
+    std::ifstream sum(checksumFile(path));
+    std::string expected;
+    if (!(sum >> expected)) return "its checksum file is missing";
+    try {
+        if (fileDigest(path, SourceLocation{path.string()}) != expected)
+            return "its bytes do not match its checksum (truncated or damaged)";
+    } catch (const UserError&) {
+        return "it cannot be read";
+    }
     try {
         openvdb::io::File file(path.string());
         file.open(/*delayLoad*/ false);
@@ -111,6 +127,14 @@ void writeEntry(const std::filesystem::path& path, const std::string& key, const
     std::filesystem::create_directories(path.parent_path());
     detail::writeAtomically(path, "voxel cache entry", [&](const std::filesystem::path& temporary) {
         detail::writeVdbChecked(temporary, openvdb::GridCPtrVec(grids.begin(), grids.end()), meta);
+    });
+    // The checksum last: a reader that finds it can trust the entry it names.
+    const std::string digest = fileDigest(path, SourceLocation{path.string()});
+    detail::writeAtomically(checksumFile(path), "voxel cache checksum", [&](const std::filesystem::path& temporary) {
+        std::ofstream out(temporary);
+        out << digest << '\n';
+        out.close();
+        if (!out) throw std::runtime_error("write failed");
     });
 }
 
