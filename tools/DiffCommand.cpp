@@ -11,6 +11,8 @@
 // does, so a size mismatch is a failure.
 #include "Common.h"
 
+#include <volmorph/render/Output.h>
+
 #include <OpenImageIO/imagebuf.h>
 #include <OpenImageIO/imagebufalgo.h>
 
@@ -18,7 +20,6 @@
 #include <limits>
 #include <memory>
 #include <string>
-#include <unistd.h>
 
 namespace volmorph::cli {
 namespace {
@@ -56,18 +57,14 @@ bool writeDifference(const DiffArgs& args, const OIIO::ImageBuf& a, const OIIO::
 {
     OIIO::ImageBuf diff = args.absolute ? OIIO::ImageBufAlgo::absdiff(a, b) : OIIO::ImageBufAlgo::sub(a, b);
     if (args.scale != 1.0f) diff = OIIO::ImageBufAlgo::mul(diff, args.scale);
-    // Written under a temporary name beside the final one, then renamed: never a partial file.
-    const std::filesystem::path final(args.output);
-    const std::filesystem::path temporary =
-        final.parent_path() / (final.stem().string() + ".partial-" + std::to_string(long(getpid())) +
-                               final.extension().string());
-    bool ok = diff.write(temporary.string(), OIIO::TypeDesc::FLOAT);
-    std::error_code ec;
-    if (ok) std::filesystem::rename(temporary, final, ec);
-    if (!ok || ec) {
-        std::filesystem::remove(temporary, ec);
-        std::fprintf(stderr, "%s: cannot write the difference image (%s)\n", args.output.c_str(),
-                     ok ? "rename failed" : diff.geterror().c_str());
+    try {
+        render::writeAtomically(args.output, [&diff](const std::filesystem::path& temporary, std::string& error) {
+            const bool ok = diff.write(temporary.string(), OIIO::TypeDesc::FLOAT);
+            if (!ok) error = diff.geterror();
+            return ok;
+        });
+    } catch (const std::exception& e) {
+        std::fprintf(stderr, "%s: cannot write the difference image (%s)\n", args.output.c_str(), e.what());
         return false;
     }
     return true;

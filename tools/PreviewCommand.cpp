@@ -90,17 +90,15 @@ int runPreview(const PreviewArgs& args)
 
     // Frames come from existing EXRs (--from) or are morphed and rendered here.
     std::optional<Morpher> morpher;
-    std::optional<SceneRender> renderer;
     std::optional<Interrupter> interrupter;
     std::optional<StopSignals> signals;
-    SceneRender layout(scene, args.threads, width); // the camera the features are drawn with
+    SceneRender view(scene, args.threads, width);
+    if (args.samples) view.settings.samples = *args.samples;
     if (args.from.empty()) {
         interrupter.emplace(false);
         signals.emplace(*interrupter);
         SceneVolumes volumes = loadSceneVolumes(scene, args.cache, *interrupter, 0, args.quiet);
         morpher.emplace(std::move(volumes.source), std::move(volumes.target), scene.pairs, scene.warp, scene.blend);
-        renderer.emplace(scene, args.threads, width);
-        if (args.samples) renderer->settings.samples = *args.samples;
     } else if (const std::string why = checkFramePattern(args.from); !why.empty()) {
         throw UserError(SourceLocation{"--from"}, "\"" + args.from + "\": " + why);
     }
@@ -116,7 +114,7 @@ int runPreview(const PreviewArgs& args)
         if (morpher) {
             const VolumeSet v = morpher->frame(t, nullptr, &*interrupter);
             if (interrupter->stopRequested()) throw Interrupted();
-            image = renderer->renderFrame(v, frame);
+            image = view.renderFrame(v, frame);
             if (interrupter->stopRequested()) throw Interrupted();
         } else {
             const std::filesystem::path file = frameFileName(args.from, frame);
@@ -145,9 +143,9 @@ int runPreview(const PreviewArgs& args)
 
     if (args.contactSheet) {
         const render::Image sheet = render::contactSheet(images, labels, args.columns, args.tileWidth, kBackground);
-        writeImage(sheet, args.output, layout.camera, frames.front());
+        writeImage(sheet, args.output, view.camera, frames.front());
     } else {
-        writeImage(render::overBackground(images.front(), kBackground), args.output, layout.camera, frames.front());
+        writeImage(render::overBackground(images.front(), kBackground), args.output, view.camera, frames.front());
     }
     if (!args.quiet) std::printf("wrote %s (%zu frame%s)\n", args.output.c_str(), frames.size(), frames.size() == 1 ? "" : "s");
     return 0;

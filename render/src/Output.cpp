@@ -11,23 +11,6 @@
 namespace volmorph::render {
 namespace {
 
-std::filesystem::path temporaryName(const std::filesystem::path& path)
-{
-    // Same folder (so rename is atomic) and same extension (so the format is unchanged).
-    return path.parent_path() / (path.stem().string() + ".partial-" + std::to_string(long(getpid())) +
-                                 path.extension().string());
-}
-
-void commit(const std::filesystem::path& temporary, const std::filesystem::path& path)
-{
-    std::error_code ec;
-    std::filesystem::rename(temporary, path, ec);
-    if (ec) {
-        std::filesystem::remove(temporary, ec);
-        throw std::runtime_error("cannot rename " + temporary.string() + " to " + path.string());
-    }
-}
-
 OIIO::ImageSpec specOf(const Image& image, OIIO::TypeDesc type)
 {
     OIIO::ImageSpec spec(image.width, image.height, 4, type);
@@ -41,17 +24,13 @@ void writeWith(const std::filesystem::path& path, const OIIO::ImageSpec& spec, c
     // Created from the final name (format from its extension), written under a temporary one.
     auto out = OIIO::ImageOutput::create(path.string());
     if (!out) throw std::runtime_error("no image writer for " + path.string() + ": " + OIIO::geterror());
-    const std::filesystem::path temporary = temporaryName(path);
-    bool ok = out->open(temporary.string(), spec);
-    ok = ok && out->write_image(OIIO::TypeDesc::FLOAT, image.pixels.data());
-    ok = out->close() && ok;
-    if (!ok) {
-        const std::string why = out->geterror();
-        std::error_code ec;
-        std::filesystem::remove(temporary, ec);
-        throw std::runtime_error(why.empty() ? "write failed" : why);
-    }
-    commit(temporary, path);
+    writeAtomically(path, [&](const std::filesystem::path& temporary, std::string& error) {
+        bool ok = out->open(temporary.string(), spec);
+        ok = ok && out->write_image(OIIO::TypeDesc::FLOAT, image.pixels.data());
+        ok = out->close() && ok;
+        if (!ok) error = out->geterror();
+        return ok;
+    });
 }
 
 OIIO::TypeDesc matrixType() { return OIIO::TypeDesc(OIIO::TypeDesc::FLOAT, OIIO::TypeDesc::MATRIX44); }
@@ -66,6 +45,31 @@ void setMatrix(OIIO::ImageSpec& spec, const char* name, const Mat4d& m)
 }
 
 } // namespace
+
+void writeAtomically(const std::filesystem::path& path,
+                     const std::function<bool(const std::filesystem::path& temporary, std::string& error)>& write)
+{
+    // Same folder (so rename is atomic) and same extension (so the format is unchanged).
+    const std::filesystem::path temporary = path.parent_path() / (path.stem().string() + ".partial-" +
+                                                                  std::to_string(long(getpid())) +
+                                                                  path.extension().string());
+    std::string error;
+    bool ok = false;
+    try {
+        ok = write(temporary, error);
+    } catch (const std::exception& e) {
+        error = e.what();
+    }
+    std::error_code ec;
+    if (ok) {
+        std::filesystem::rename(temporary, path, ec);
+        if (ec) error = "cannot rename " + temporary.string() + " to " + path.string();
+    }
+    if (!ok || ec) {
+        std::filesystem::remove(temporary, ec);
+        throw std::runtime_error(error.empty() ? "write failed" : error);
+    }
+}
 
 void writeExr(const Image& image, const Camera& camera, const std::filesystem::path& path, const ExrOptions& options)
 {
@@ -89,13 +93,11 @@ void writePng(const Image& image, const std::filesystem::path& path)
     OIIO::ImageBuf linear(specOf(image, OIIO::TypeDesc::FLOAT), const_cast<float*>(image.pixels.data()));
     OIIO::ImageBuf srgb = OIIO::ImageBufAlgo::colorconvert(linear, "linear", "sRGB");
     OIIO::ImageBuf clamped = OIIO::ImageBufAlgo::clamp(srgb, 0.0f, 1.0f);
-    const std::filesystem::path temporary = temporaryName(path);
-    if (!clamped.write(temporary.string(), OIIO::TypeDesc::UINT8)) {
-        std::error_code ec;
-        std::filesystem::remove(temporary, ec);
-        throw std::runtime_error(clamped.geterror());
-    }
-    commit(temporary, path);
+    writeAtomically(path, [&clamped](const std::filesystem::path& temporary, std::string& error) {
+        const bool ok = clamped.write(temporary.string(), OIIO::TypeDesc::UINT8);
+        if (!ok) error = clamped.geterror();
+        return ok;
+    });
 }
 
 Image readImage(const std::filesystem::path& path)

@@ -111,11 +111,10 @@ bool drawText(Image& image, int x, int y, const std::string& text, const Color& 
 Image overBackground(const Image& image, const Color& background)
 {
     Image out = image;
-    for (size_t p = 0; p < out.pixels.size(); p += 4) {
-        const float keep = 1.0f - out.pixels[p + 3];
-        for (size_t c = 0; c < 3; ++c) out.pixels[p + c] += keep * background[c];
-        out.pixels[p + 3] = 1.0f;
-    }
+    OIIO::ImageBuf front = wrap(out);
+    OIIO::ImageBuf back(front.spec());
+    OIIO::ImageBufAlgo::fill(back, {background[0], background[1], background[2], 1.0f});
+    OIIO::ImageBufAlgo::over(front, front, back); // premultiplied A over B, in place
     return out;
 }
 
