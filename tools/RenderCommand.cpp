@@ -28,7 +28,7 @@ Vec3d vec3(const std::vector<double>& v) { return Vec3d(v[0], v[1], v[2]); }
 struct RenderVdbArgs {
     std::string input, output, png, camera = "persp", grid, resolution = "640x360";
     std::vector<double> translate, lookat, up{0, 1, 0}, light{0.3, 0.7, 0.6};
-    double fov = 40.0, frameWidth = 0.0, extinction = 40.0, albedo = 0.8, step = 0.5, shadowStep = 1.0;
+    double fov = 40.0, frameWidth = 0.0, extinction = 40.0, albedo = 0.8, step = 0.5;
     int shadowCache = 2;
     int samples = 4, threads = 0;
     double memoryLimitGiB = 0.0;
@@ -91,7 +91,6 @@ int runRenderVdb(const RenderVdbArgs& args)
     render::RenderSettings settings;
     settings.samples = args.samples;
     settings.stepVoxels = args.step;
-    settings.shadowStepVoxels = args.shadowStep;
     settings.shadowCacheVoxels = args.shadowCache;
     settings.threads = args.threads;
     const auto start = std::chrono::steady_clock::now();
@@ -261,9 +260,8 @@ Command addRenderVdbCommand(CLI::App& app)
     sub->add_option("--light", a->light, "direction toward the light X,Y,Z[,R,G,B] (as vdb_render)")->delimiter(',')
         ->expected(3, 6);
     sub->add_option("--samples", a->samples, "samples per pixel")->check(CLI::Range(1, 65536));
-    sub->add_option("--step", a->step, "ray-march step in voxels")->check(CLI::Range(0.01, 8.0));
-    sub->add_option("--shadow-step", a->shadowStep, "step toward the lights, in voxels")->check(CLI::Range(0.05, 16.0));
-    sub->add_option("--shadow-cache", a->shadowCache, "light transmittance cache spacing, in voxels")
+    sub->add_option("--step", a->step, "longest step of the scattering integral, in voxels (optical depth is exact)")->check(CLI::Range(0.01, 8.0));
+    sub->add_option("--shadow-cache", a->shadowCache, "shadow map (directional) or grid (point light) spacing, in voxels")
         ->check(CLI::Range(1, 16));
     sub->add_option("--threads", a->threads, "threads (0 = all cores)")->check(CLI::Range(0, 1024));
     sub->add_option("--grid", a->grid, "name of the float grid (default: the first)");

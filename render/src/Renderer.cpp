@@ -8,12 +8,15 @@
 #include <openvdb/tools/RayIntersector.h>
 #include <openvdb/tree/LeafManager.h>
 
+#include <tbb/blocked_range.h>
 #include <tbb/blocked_range2d.h>
 #include <tbb/parallel_for.h>
 #include <tbb/task_arena.h>
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
+#include <memory>
 
 namespace volmorph::render {
 namespace {
@@ -69,6 +72,21 @@ openvdb::BoolGrid::Ptr rayMask(const FloatGrid& density, bool levelSet)
     return mask;
 }
 
+/// A copy of `density` in which every leaf whose 512 values are equal is a tile of that value
+/// (interpolation reads values, never active states): walkCells crosses such blocks in one piece.
+FloatGrid::Ptr constantLeavesAsTiles(const FloatGrid& density)
+{
+    FloatGrid::Ptr grid = density.deepCopy();
+    std::vector<std::pair<Coord, float>> constant;
+    for (auto leaf = grid->tree().cbeginLeaf(); leaf; ++leaf) {
+        const float* d = leaf->buffer().data();
+        if (std::all_of(d + 1, d + openvdb::FloatTree::LeafNodeType::SIZE, [d](float v) { return v == d[0]; }))
+            constant.emplace_back(leaf->origin(), d[0]);
+    }
+    for (const auto& [origin, value] : constant) grid->tree().addTile(1, origin, value, true);
+    return grid;
+}
+
 /// Density at index position ip: the fog's value, or 1 inside a level set.
 template <typename Accessor>
 inline float densityAt(const Accessor& acc, const Vec3d& ip, bool levelSet)
@@ -77,25 +95,257 @@ inline float densityAt(const Accessor& acc, const Vec3d& ip, bool levelSet)
     return levelSet ? (v < 0.0f ? 1.0f : 0.0f) : v;
 }
 
-/// Optical depth from world point p along `direction` for up to `distance` world units.
+/// The eight values of `tree` at c + {0, 1}^3 (BoxSampler::getValues' layout). When all eight lie in
+/// one 8^3 block (7 cells in 8 along each axis) they are read straight from its leaf, or are one
+/// tile value if it has none.
+template <typename Accessor, typename Value>
+inline void cornerValues(const Accessor& acc, const Coord& c, Value (&v)[2][2][2])
+{
+    using Leaf = typename Accessor::TreeType::LeafNodeType;
+    if ((c.x() & 7) != 7 && (c.y() & 7) != 7 && (c.z() & 7) != 7) {
+        if (const Leaf* leaf = acc.probeConstLeaf(c)) {
+            const Value* d = leaf->buffer().data() + Leaf::coordToOffset(c);
+            v[0][0][0] = d[0];   v[0][0][1] = d[1];
+            v[0][1][0] = d[8];   v[0][1][1] = d[9];
+            v[1][0][0] = d[64];  v[1][0][1] = d[65];
+            v[1][1][0] = d[72];  v[1][1][1] = d[73];
+        } else {
+            const Value value = acc.getValue(c);
+            v[0][0][0] = v[0][0][1] = v[0][1][0] = v[0][1][1] = value;
+            v[1][0][0] = v[1][0][1] = v[1][1][0] = v[1][1][1] = value;
+        }
+        return;
+    }
+    openvdb::tools::BoxSampler::getValues(v, acc, c);
+}
+
+/// Trilinear interpolation of eight colours at local coordinates u in [0, 1]^3.
+inline Vec3d trilinear(const openvdb::Vec3s (&v)[2][2][2], const Vec3d& u)
+{
+    const double x1 = u.x(), y1 = u.y(), z1 = u.z(), x0 = 1.0 - x1, y0 = 1.0 - y1, z0 = 1.0 - z1;
+    const double w[8] = {x0 * y0 * z0, x0 * y0 * z1, x0 * y1 * z0, x0 * y1 * z1,
+                         x1 * y0 * z0, x1 * y0 * z1, x1 * y1 * z0, x1 * y1 * z1};
+    const openvdb::Vec3s* c = &v[0][0][0];
+    double r = 0.0, g = 0.0, b = 0.0;
+    for (int i = 0; i < 8; ++i) {
+        r += w[i] * c[i].x();
+        g += w[i] * c[i].y();
+        b += w[i] * c[i].z();
+    }
+    return Vec3d(r, g, b);
+}
+
+/// The eight values at the corners of one interpolation cell [c, c + 1]^3 (voxel centres sit at
+/// integer index coordinates) and OpenVDB's trilinear interpolant inside it (BoxSampler's).
+struct Cell {
+    float v[2][2][2];
+    Coord origin;
+    float lo, hi;       ///< smallest and largest corner value
+    bool block = false; ///< one constant value over a whole block crossing (see walkCells)
+
+    __attribute__((always_inline)) double at(const Vec3d& u) const // u: local coordinates in [0, 1]^3
+    {
+        const double x = u.x(), y = u.y(), z = u.z();
+        const double a = v[0][0][0] + (v[0][0][1] - v[0][0][0]) * z;
+        const double b = v[0][1][0] + (v[0][1][1] - v[0][1][0]) * z;
+        const double c = v[1][0][0] + (v[1][0][1] - v[1][0][0]) * z;
+        const double d = v[1][1][0] + (v[1][1][1] - v[1][1][0]) * z;
+        const double e = a + (b - a) * y;
+        const double f = c + (d - c) * y;
+        return e + (f - e) * x;
+    }
+};
+
+/// An index-space ray and the optical "mass" of a medium along it: the integral of density over a
+/// piece [ta, tb] of the ray inside one cell, in voxels times density.
+struct Medium1D {
+    Vec3d eye, dir; ///< index space; dir has unit length, so ray times are in voxels
+    bool levelSet;
+
+    /// The integral of the density along [ta, tb] within `cell`. For a fog whose corners are all
+    /// non-negative the trilinear interpolant is a cubic polynomial along the ray, which two-point
+    /// Gauss-Legendre quadrature integrates exactly. A level set's density is 1 where the
+    /// interpolated distance is negative: the length of that part, with each zero crossing placed
+    /// by linear interpolation between the ends and the midpoint. A fog with negative corners
+    /// (negative densities count as 0): the clamped value at four midpoints.
+    double mass(const Cell& cell, double ta, double tb) const
+    {
+        const double length = tb - ta;
+        const Vec3d base = eye - Vec3d(cell.origin.x(), cell.origin.y(), cell.origin.z());
+        auto local = [&](double t) { return base + dir * t; };
+        if (!levelSet) {
+            if (cell.hi <= 0.0f) return 0.0;
+            if (cell.lo >= 0.0f) {
+                const double mid = 0.5 * (ta + tb), half = 0.5 * length * 0.57735026918962576;
+                return 0.5 * length * (cell.at(local(mid - half)) + cell.at(local(mid + half)));
+            }
+            double sum = 0.0;
+            for (int k = 0; k < 4; ++k) sum += std::max(0.0, cell.at(local(ta + (k + 0.5) * 0.25 * length)));
+            return 0.25 * length * sum;
+        }
+        if (cell.lo >= 0.0f) return 0.0;
+        if (cell.hi < 0.0f) return length;
+        const double f0 = cell.at(local(ta)), f1 = cell.at(local(0.5 * (ta + tb))), f2 = cell.at(local(tb));
+        auto inside = [](double a, double b, double h) { // length of the negative part of a linear piece
+            if (a < 0.0 && b < 0.0) return h;
+            if (a >= 0.0 && b >= 0.0) return 0.0;
+            const double crossing = a / (a - b) * h; // from the start
+            return a < 0.0 ? crossing : h - crossing;
+        };
+        return inside(f0, f1, 0.5 * length) + inside(f1, f2, 0.5 * length);
+    }
+};
+
+/// The density along one piece of a ray inside one cell, as a polynomial in s = t - ta (voxels), for
+/// a fog whose corners are non-negative: the trilinear interpolant restricted to a line is a cubic.
+/// mass(s) is its integral over [0, s]; exact is false for other cells (use Medium1D::mass).
+struct Piece {
+    bool exact = false;
+    double c[4] = {0, 0, 0, 0};
+
+    Piece(const Medium1D& ray, const Cell& cell, double ta)
+    {
+        if (ray.levelSet || cell.lo < 0.0f) return;
+        exact = true;
+        const Vec3d u = ray.eye + ray.dir * ta - Vec3d(cell.origin.x(), cell.origin.y(), cell.origin.z());
+        const Vec3d& d = ray.dir;
+        // Weights of the corners 0 and 1 along each axis, as linear functions w0 + w1 s.
+        const double z[2][2] = {{1.0 - u.z(), -d.z()}, {u.z(), d.z()}};
+        const double y[2][2] = {{1.0 - u.y(), -d.y()}, {u.y(), d.y()}};
+        const double x[2][2] = {{1.0 - u.x(), -d.x()}, {u.x(), d.x()}};
+        double h[2][3]; // along z, then y: a quadratic per x corner
+        for (int i = 0; i < 2; ++i) {
+            h[i][0] = h[i][1] = h[i][2] = 0.0;
+            for (int j = 0; j < 2; ++j) {
+                const double g0 = cell.v[i][j][0] * z[0][0] + cell.v[i][j][1] * z[1][0];
+                const double g1 = cell.v[i][j][0] * z[0][1] + cell.v[i][j][1] * z[1][1];
+                h[i][0] += g0 * y[j][0];
+                h[i][1] += g0 * y[j][1] + g1 * y[j][0];
+                h[i][2] += g1 * y[j][1];
+            }
+        }
+        for (int i = 0; i < 2; ++i) {
+            c[0] += h[i][0] * x[i][0];
+            c[1] += h[i][0] * x[i][1] + h[i][1] * x[i][0];
+            c[2] += h[i][1] * x[i][1] + h[i][2] * x[i][0];
+            c[3] += h[i][2] * x[i][1];
+        }
+    }
+
+    double mass(double s) const { return s * (c[0] + s * (0.5 * c[1] + s * (c[2] * (1.0 / 3.0) + s * 0.25 * c[3]))); }
+};
+
+/// e^-x for x >= 0; a short series where x is small (the common case of one step of a thin medium,
+/// relative error below 1e-10 for x < 0.05).
+inline double expNegative(double x)
+{
+    constexpr double third = 1.0 / 3.0, sixth = 1.0 / 6.0;
+    if (x < 0.05) return 1.0 - x * (1.0 - x * 0.5 * (1.0 - x * third * (1.0 - x * 0.25 * (1.0 - x * 0.2 * (1.0 - x * sixth)))));
+    return std::exp(-x);
+}
+
+/// Walks the interpolation cells that the index ray eye + t dir crosses for t in [ta, tb]
+/// (Amanatides and Woo's 3D DDA), calling visit(cell, t0, t1) for each piece whose cell has a
+/// non-zero density somewhere; stops early when visit returns false. Returns false if stopped.
+/// Where the ray enters an 8^3 block that has no leaf (one tile value, or the background), every
+/// cell within the block's [b, b + 7]^3 is constant: the whole crossing is one piece, marked
+/// Cell::block.
+template <typename Accessor, typename Visit>
+bool walkCells(const Accessor& acc, const Medium1D& ray, double ta, double tb, Visit&& visit)
+{
+    using Leaf = typename Accessor::TreeType::LeafNodeType;
+    int cell[3], step[3];
+    double next[3], delta[3];
+    Cell c;
+    double t = ta;
+    while (t < tb) {
+        const Vec3d start = ray.eye + ray.dir * t;
+        for (int a = 0; a < 3; ++a) {
+            cell[a] = int(std::floor(start[a]));
+            const double d = ray.dir[a];
+            if (d > 0.0) {
+                step[a] = 1;
+                delta[a] = 1.0 / d;
+                next[a] = t + (cell[a] + 1 - start[a]) * delta[a];
+            } else if (d < 0.0) {
+                step[a] = -1;
+                delta[a] = -1.0 / d;
+                next[a] = t + (start[a] - cell[a]) * delta[a];
+            } else {
+                step[a] = 0;
+                delta[a] = std::numeric_limits<double>::infinity();
+                next[a] = std::numeric_limits<double>::infinity();
+            }
+        }
+        bool restart = false;
+        while (t < tb && !restart) {
+            const int a = next[0] < next[1] ? (next[0] < next[2] ? 0 : 2) : (next[1] < next[2] ? 1 : 2);
+            double t1 = std::min(next[a], tb);
+            c.origin = Coord(cell[0], cell[1], cell[2]);
+            c.block = false;
+            if ((cell[0] & 7) != 7 && (cell[1] & 7) != 7 && (cell[2] & 7) != 7) {
+                if (const Leaf* leaf = acc.probeConstLeaf(c.origin)) {
+                    const float* d = leaf->buffer().data() + Leaf::coordToOffset(c.origin);
+                    c.v[0][0][0] = d[0];   c.v[0][0][1] = d[1];
+                    c.v[0][1][0] = d[8];   c.v[0][1][1] = d[9];
+                    c.v[1][0][0] = d[64];  c.v[1][0][1] = d[65];
+                    c.v[1][1][0] = d[72];  c.v[1][1][1] = d[73];
+                } else {
+                    const float value = acc.getValue(c.origin);
+                    for (int i = 0; i < 8; ++i) (&c.v[0][0][0])[i] = value;
+                    // Where the ray leaves the block's constant region [b, b + 7]^3.
+                    double exit = tb;
+                    for (int k = 0; k < 3; ++k) {
+                        const double d = ray.dir[k];
+                        if (d == 0.0) continue;
+                        const double lo = double(cell[k] & ~7), wall = d > 0.0 ? lo + 7.0 : lo;
+                        exit = std::min(exit, (wall - ray.eye[k]) / d);
+                    }
+                    if (exit > t1 + 1e-6) {
+                        t1 = exit;
+                        c.block = true;
+                        restart = true;
+                    }
+                }
+            } else {
+                openvdb::tools::BoxSampler::getValues(c.v, acc, c.origin);
+            }
+            if (t1 > t) {
+                openvdb::tools::BoxSampler::extrema(c.v, c.lo, c.hi);
+                if ((ray.levelSet ? c.lo < 0.0f : c.hi > 0.0f) && !visit(c, t, t1)) return false;
+            }
+            t = t1;
+            if (!restart) {
+                cell[a] += step[a];
+                next[a] += delta[a];
+            }
+        }
+    }
+    return true;
+}
+
+/// Optical depth (index units times sigma) from world point p along `direction` for up to
+/// `distance` world units, integrated cell by cell.
 double opticalDepth(Intersector& inter, bool levelSet, openvdb::tree::ValueAccessor<const openvdb::FloatTree>& acc,
-                    const Vec3d& p, const Vec3d& direction, double distance, double sigmaPerVoxel, double step)
+                    const Vec3d& p, const Vec3d& direction, double distance, double sigmaPerVoxel)
 {
     if (!inter.setWorldRay(VdbRay(p, direction, 0.0, distance))) return 0.0;
+    Medium1D ray{inter.getIndexPos(0.0), inter.getIndexPos(1.0) - inter.getIndexPos(0.0), levelSet};
     double tau = 0.0, t0 = 0.0, t1 = 0.0;
     while (inter.march(t0, t1)) {
-        for (double t = t0 + 0.5 * step; t < t1; t += step) {
-            const float rho = densityAt(acc, inter.getIndexPos(t), levelSet);
-            if (rho > 0.0f) tau += sigmaPerVoxel * rho * step;
-        }
-        if (tau > kMaxOpticalDepth) break;
+        const bool going = walkCells(acc, ray, t0, t1, [&](const Cell& cell, double ta, double tb) {
+            tau += sigmaPerVoxel * ray.mass(cell, ta, tb);
+            return tau <= kMaxOpticalDepth + 2.0;
+        });
+        if (!going) break;
     }
     return tau;
 }
 
-/// Transmittance toward one light, on a coarse grid over the occupied region.
-FloatGrid::Ptr transmittanceCache(const FloatGrid& density, const openvdb::BoolGrid& mask, bool levelSet,
-                                  const Light& light, double sigmaPerVoxel, const RenderSettings& settings)
+/// Transmittance toward a point light, on a coarse grid over the occupied region: one march toward
+/// the light per grid point, sampled trilinearly.
+FloatGrid::Ptr pointLightCache(const FloatGrid& density, const openvdb::BoolGrid& mask, bool levelSet,
+                               const Light& light, double sigmaPerVoxel, const RenderSettings& settings)
 {
     const int factor = std::max(1, settings.shadowCacheVoxels);
     const double voxel = density.voxelSize()[0];
@@ -120,27 +370,166 @@ FloatGrid::Ptr transmittanceCache(const FloatGrid& density, const openvdb::BoolG
     cache->tree().voxelizeActiveTiles();
 
     const Intersector master(mask);
-    const double step = settings.shadowStepVoxels;
-    const Vec3d travel = light.direction.unit();
     openvdb::tree::LeafManager<openvdb::FloatTree> leaves(cache->tree());
     leaves.foreach([&](openvdb::FloatTree::LeafNodeType& leaf, size_t) {
         Intersector inter(master);
         openvdb::tree::ValueAccessor<const openvdb::FloatTree> acc(density.tree());
         for (auto it = leaf.beginValueOn(); it; ++it) {
             const Vec3d p = cache->indexToWorld(it.getCoord());
-            Vec3d toward = -travel;
-            double distance = std::numeric_limits<double>::max();
-            if (light.type == Light::Type::Point) {
-                toward = light.position - p;
-                distance = toward.length();
-                if (distance <= 0.0) continue;
-                toward /= distance;
-            }
-            it.setValue(float(std::exp(-opticalDepth(inter, levelSet, acc, p, toward, distance, sigmaPerVoxel, step))));
+            Vec3d toward = light.position - p;
+            const double distance = toward.length();
+            if (distance <= 0.0) continue;
+            toward /= distance;
+            it.setValue(float(std::exp(-opticalDepth(inter, levelSet, acc, p, toward, distance, sigmaPerVoxel))));
         }
     });
     return cache;
 }
+
+/// Transmittance toward a directional light: a deep shadow map (Lokovic and Veach). A lattice of
+/// columns parallel to the light, `spacing` world units apart, each marched once through the
+/// volume cell by cell, keeping the transmittance every `spacing` along it; looked up by bilinear
+/// interpolation across columns and linear along them. Only the span of each column that crosses
+/// the occupied region is stored.
+class ShadowMap
+{
+public:
+    ShadowMap(const FloatGrid& density, const openvdb::BoolGrid& mask, bool levelSet, const Vec3d& travel,
+              double sigmaPerVoxel, double spacing)
+        : mDensity(density), mSpacing(spacing)
+    {
+        mW = travel.unit();
+        mU = (std::abs(mW.x()) < 0.9 ? Vec3d(1, 0, 0) : Vec3d(0, 1, 0)).cross(mW).unit();
+        mV = mW.cross(mU);
+        const CoordBBox box = mask.evalActiveVoxelBoundingBox();
+        Vec3d lo(std::numeric_limits<double>::max()), hi(-std::numeric_limits<double>::max());
+        for (int i = 0; i < 8; ++i) {
+            const Vec3d corner((i & 1) ? box.max().x() + 1.0 : box.min().x() - 1.0,
+                               (i & 2) ? box.max().y() + 1.0 : box.min().y() - 1.0,
+                               (i & 4) ? box.max().z() + 1.0 : box.min().z() - 1.0);
+            const Vec3d w = density.indexToWorld(corner);
+            const Vec3d l(w.dot(mU), w.dot(mV), w.dot(mW));
+            lo = openvdb::math::minComponent(lo, l);
+            hi = openvdb::math::maxComponent(hi, l);
+        }
+        mOrigin = lo - Vec3d(spacing);
+        // For a linear transform, the lattice coordinates are an affine function of index space.
+        mLinear = density.transform().isLinear();
+        if (mLinear) {
+            const Vec3d w0 = density.indexToWorld(Vec3d(0.0));
+            const Vec3d ex = density.indexToWorld(Vec3d(1, 0, 0)) - w0, ey = density.indexToWorld(Vec3d(0, 1, 0)) - w0,
+                        ez = density.indexToWorld(Vec3d(0, 0, 1)) - w0;
+            const Vec3d* axes[3] = {&mU, &mV, &mW};
+            for (int r = 0; r < 3; ++r) {
+                mRow[r] = Vec3d(ex.dot(*axes[r]), ey.dot(*axes[r]), ez.dot(*axes[r])) / spacing;
+                mOffset[r] = (w0.dot(*axes[r]) - mOrigin[r]) / spacing;
+            }
+        }
+        mCount[0] = int(std::ceil((hi.x() - mOrigin.x()) / spacing)) + 2;
+        mCount[1] = int(std::ceil((hi.y() - mOrigin.y()) / spacing)) + 2;
+        const double length = hi.z() - mOrigin.z() + 2.0 * spacing;
+        const size_t columns = size_t(mCount[0]) * size_t(mCount[1]);
+        mColumns.resize(columns);
+
+        const Intersector master(mask);
+        tbb::parallel_for(tbb::blocked_range<size_t>(0, columns, 64), [&](const tbb::blocked_range<size_t>& range) {
+            Intersector inter(master);
+            openvdb::tree::ValueAccessor<const openvdb::FloatTree> acc(density.tree());
+            for (size_t c = range.begin(); c != range.end(); ++c) {
+                const int i = int(c % size_t(mCount[0])), j = int(c / size_t(mCount[0]));
+                const Vec3d start = mU * (mOrigin.x() + i * spacing) + mV * (mOrigin.y() + j * spacing) +
+                                    mW * mOrigin.z();
+                march(inter, acc, levelSet, start, length, sigmaPerVoxel, mColumns[c]);
+            }
+        });
+    }
+
+    /// Transmittance toward the light at index point ip of the density grid.
+    double lookup(const Vec3d& ip) const
+    {
+        double a, b, c;
+        if (mLinear) {
+            a = mRow[0].dot(ip) + mOffset.x();
+            b = mRow[1].dot(ip) + mOffset.y();
+            c = mRow[2].dot(ip) + mOffset.z();
+        } else {
+            const Vec3d p = mDensity.indexToWorld(ip);
+            a = (p.dot(mU) - mOrigin.x()) / mSpacing;
+            b = (p.dot(mV) - mOrigin.y()) / mSpacing;
+            c = (p.dot(mW) - mOrigin.z()) / mSpacing;
+        }
+        const double fa = std::floor(a), fb = std::floor(b), fc = std::floor(c);
+        const int i = int(fa), j = int(fb), k = int(fc);
+        const double u = a - fa, v = b - fb, w = c - fc;
+        auto column = [&](int ci, int cj) {
+            if (ci < 0 || cj < 0 || ci >= mCount[0] || cj >= mCount[1]) return 1.0;
+            const Column& col = mColumns[size_t(cj) * size_t(mCount[0]) + size_t(ci)];
+            return (1.0 - w) * col.at(k) + w * col.at(k + 1);
+        };
+        return (1.0 - v) * ((1.0 - u) * column(i, j) + u * column(i + 1, j)) +
+               v * ((1.0 - u) * column(i, j + 1) + u * column(i + 1, j + 1));
+    }
+
+private:
+    struct Column {
+        int first = 0;           ///< lattice index of values[0]; before it the transmittance is 1
+        float last = 1.0f;       ///< the transmittance after the stored span
+        std::vector<float> values;
+        double at(int k) const
+        {
+            if (k < first) return 1.0;
+            const size_t i = size_t(k - first);
+            return i < values.size() ? double(values[i]) : double(last);
+        }
+    };
+
+    void march(Intersector& inter, openvdb::tree::ValueAccessor<const openvdb::FloatTree>& acc, bool levelSet,
+               const Vec3d& start, double length, double sigmaPerVoxel, Column& column) const
+    {
+        if (!inter.setWorldRay(VdbRay(start, mW, 0.0, length))) return;
+        const Medium1D ray{inter.getIndexPos(0.0), inter.getIndexPos(1.0) - inter.getIndexPos(0.0), levelSet};
+        // Index time per lattice step (the index ray has unit speed in voxels).
+        const double h = inter.getWorldTime(1.0) > 0.0 ? mSpacing / inter.getWorldTime(1.0) : mSpacing;
+        double tau = 0.0, t0 = 0.0, t1 = 0.0;
+        int k = -1; // the last lattice index stored
+        auto push = [&] { column.values.push_back(float(std::exp(-tau))); ++k; };
+        bool going = true;
+        while (going && inter.march(t0, t1)) {
+            if (k < 0) { // nothing is absorbed before the first span: the column starts there
+                column.first = int(std::floor(t0 / h));
+                k = column.first - 1;
+            }
+            going = walkCells(acc, ray, t0, t1, [&](const Cell& cell, double ta, double tb) {
+                // Split the piece at the lattice points inside it.
+                for (double tk = (k + 1) * h; tk <= tb; tk = (k + 1) * h) {
+                    if (tk > ta) {
+                        tau += sigmaPerVoxel * ray.mass(cell, ta, tk);
+                        ta = tk;
+                    }
+                    push();
+                }
+                tau += sigmaPerVoxel * ray.mass(cell, ta, tb);
+                return tau <= kMaxOpticalDepth + 2.0;
+            });
+            while ((k + 1) * h <= t1) push();
+        }
+        column.last = float(std::exp(-tau));
+    }
+
+    const FloatGrid& mDensity;
+    Vec3d mU, mV, mW, mOrigin; ///< light frame; origin in its coordinates (world units)
+    double mSpacing;
+    bool mLinear = false;
+    Vec3d mRow[3], mOffset;    ///< index space to lattice coordinates, for a linear transform
+    int mCount[2];
+    std::vector<Column> mColumns;
+};
+
+/// One light's shadow: a deep shadow map for a directional light, a grid of marches for a point light.
+struct Shadow {
+    std::unique_ptr<ShadowMap> map;
+    FloatGrid::Ptr cache;
+};
 
 } // namespace
 
@@ -159,21 +548,30 @@ Image renderVolume(const FloatGrid& density, const openvdb::Vec3SGrid* color, co
     const int samples = std::max(1, settings.samples);
     const int strata = int(std::ceil(std::sqrt(double(samples))));
     const double inverseFactor = 1.0 / double(std::max(1, settings.shadowCacheVoxels));
+    const double h = settings.stepVoxels > 0.0 ? settings.stepVoxels : 0.5;
 
     auto body = [&] {
         const openvdb::BoolGrid::Ptr mask = rayMask(density, levelSet);
-        std::vector<FloatGrid::Ptr> caches;
-        for (const Light& light : lights)
-            caches.push_back(transmittanceCache(density, *mask, levelSet, light, sigmaPerVoxel, settings));
+        const FloatGrid::Ptr blocks = constantLeavesAsTiles(density);
+        std::vector<Shadow> shadows(lights.size());
+        for (size_t l = 0; l < lights.size(); ++l) {
+            if (lights[l].type == Light::Type::Directional)
+                shadows[l].map = std::make_unique<ShadowMap>(*blocks, *mask, levelSet, lights[l].direction,
+                    sigmaPerVoxel, voxel * std::max(1, settings.shadowCacheVoxels));
+            else
+                shadows[l].cache = pointLightCache(*blocks, *mask, levelSet, lights[l], sigmaPerVoxel, settings);
+        }
         const Intersector master(*mask);
         tbb::parallel_for(tbb::blocked_range2d<int>(0, image.height, 16, 0, image.width, 16),
                           [&](const tbb::blocked_range2d<int>& tile) {
             Intersector inter(master);
-            openvdb::tree::ValueAccessor<const openvdb::FloatTree> acc(density.tree());
+            openvdb::tree::ValueAccessor<const openvdb::FloatTree> acc(blocks->tree());
             std::unique_ptr<openvdb::tree::ValueAccessor<const openvdb::Vec3STree>> colors;
             if (color) colors = std::make_unique<openvdb::tree::ValueAccessor<const openvdb::Vec3STree>>(color->tree());
-            std::vector<openvdb::tree::ValueAccessor<const openvdb::FloatTree>> cacheAcc;
-            for (const auto& c : caches) cacheAcc.emplace_back(c->tree());
+            std::vector<std::unique_ptr<openvdb::tree::ValueAccessor<const openvdb::FloatTree>>> cacheAcc(lights.size());
+            for (size_t l = 0; l < lights.size(); ++l)
+                if (shadows[l].cache)
+                    cacheAcc[l] = std::make_unique<openvdb::tree::ValueAccessor<const openvdb::FloatTree>>(shadows[l].cache->tree());
             std::vector<Vec3d> perRay(lights.size());
             for (int y = tile.rows().begin(); y != tile.rows().end(); ++y) {
                 for (int x = tile.cols().begin(); x != tile.cols().end(); ++x) {
@@ -186,7 +584,6 @@ Image renderVolume(const FloatGrid& density, const openvdb::Vec3SGrid* color, co
                         const double sx = samples == 1 ? 0.5 : ((s % strata) + jx) / strata;
                         const double sy = samples == 1 ? 0.5 : ((s / strata) % strata + jy) / strata;
                         const Ray ray = camera.ray(x + sx, y + sy);
-                        const double jitter = random.next();
                         double T = 1.0;
                         Vec3d L(0.0);
                         if (inter.setWorldRay(VdbRay(ray.origin, ray.direction))) {
@@ -196,42 +593,103 @@ Image renderVolume(const FloatGrid& density, const openvdb::Vec3SGrid* color, co
                                 perRay[l] = light.color * (light.intensity *
                                     henyeyGreenstein(light.direction.unit().dot(-ray.direction), medium.anisotropy));
                             }
-                            const double h = settings.stepVoxels;
-                            double t0 = 0, t1 = 0;
-                            while (T > kMinTransmittance && inter.march(t0, t1)) {
-                                // Samples on one lattice along the whole ray: t_k = (k + jitter) h.
-                                for (double t = (std::ceil(t0 / h - jitter) + jitter) * h; t < t1; t += h) {
-                                    const Vec3d ip = inter.getIndexPos(t);
-                                    const float rho = densityAt(acc, ip, levelSet);
-                                    if (!(rho > 0.0f)) continue;
-                                    const double transmitted = std::exp(-sigmaPerVoxel * rho * h);
-                                    const double absorbed = T * (1.0 - transmitted);
-                                    Vec3d albedo(medium.albedo);
-                                    if (colors) {
-                                        const openvdb::Vec3s c = openvdb::tools::BoxSampler::sample(*colors, ip);
-                                        albedo = Vec3d(c.x(), c.y(), c.z()) * medium.albedo;
+                            const Medium1D line{inter.getIndexPos(0.0), inter.getIndexPos(1.0) - inter.getIndexPos(0.0), levelSet};
+                            // Each piece of the ray inside one interpolation cell is cut into n equal
+                            // steps of at most h voxels. Each step's optical depth is exact (the
+                            // integral of the trilinear density, see Piece). The source (emission plus
+                            // the light scattered toward the camera) is evaluated where the ray enters
+                            // and leaves the cell and taken linearly in between, at each step's middle.
+                            openvdb::Vec3s colorCorners[2][2][2];
+                            Vec3d cellOrigin(0.0);
+                            bool cornersValid = false; // colorCorners hold the current cell's colours
+                            auto sourceAt = [&](double t) {
+                                const Vec3d ip = line.eye + line.dir * t;
+                                Vec3d albedo(medium.albedo);
+                                if (colors) {
+                                    if (!cornersValid) {
+                                        cellOrigin = Vec3d(std::floor(ip.x()), std::floor(ip.y()), std::floor(ip.z()));
+                                        cornerValues(*colors, Coord::floor(ip), colorCorners);
                                     }
-                                    Vec3d source = medium.emission;
-                                    // The caches share the density's origin, at `factor` times its voxel.
-                                    const Vec3d cacheIndex = ip * inverseFactor;
-                                    for (size_t l = 0; l < lights.size(); ++l) {
-                                        const Light& light = lights[l];
-                                        Vec3d c = perRay[l];
-                                        if (light.type == Light::Type::Point) {
-                                            Vec3d travel = inter.getWorldPos(t) - light.position;
-                                            const double d2 = travel.lengthSqr();
-                                            travel /= std::sqrt(d2);
-                                            c = light.color * (light.intensity / d2 *
-                                                henyeyGreenstein(travel.dot(-ray.direction), medium.anisotropy));
-                                        }
-                                        const double Tl = openvdb::tools::BoxSampler::sample(cacheAcc[l], cacheIndex);
-                                        source += Vec3d(albedo.x() * c.x(), albedo.y() * c.y(), albedo.z() * c.z()) * Tl;
-                                    }
-                                    L += absorbed * source;
-                                    T *= transmitted;
-                                    if (T <= kMinTransmittance) break;
+                                    albedo = trilinear(colorCorners, ip - cellOrigin) * medium.albedo;
                                 }
-                            }
+                                Vec3d source = medium.emission;
+                                for (size_t l = 0; l < lights.size(); ++l) {
+                                    const Light& light = lights[l];
+                                    Vec3d c = perRay[l];
+                                    double Tl;
+                                    if (light.type == Light::Type::Point) {
+                                        Vec3d travel = density.indexToWorld(ip) - light.position;
+                                        const double d2 = travel.lengthSqr();
+                                        travel /= std::sqrt(d2);
+                                        c = light.color * (light.intensity / d2 *
+                                            henyeyGreenstein(travel.dot(-ray.direction), medium.anisotropy));
+                                        // The cache shares the density's origin, at `factor` times its voxel.
+                                        Tl = openvdb::tools::BoxSampler::sample(*cacheAcc[l], ip * inverseFactor);
+                                    } else {
+                                        Tl = shadows[l].map->lookup(ip);
+                                    }
+                                    source += Vec3d(albedo.x() * c.x(), albedo.y() * c.y(), albedo.z() * c.z()) * Tl;
+                                }
+                                return source;
+                            };
+                            double lastEnd = -1.0; // where the previous piece ended, and its source there
+                            Vec3d lastSource(0.0);
+                            auto shade = [&](const Cell& cell, double ta, double tb) {
+                                if (cell.block) {
+                                    // Constant density across a block: pieces of at most 2 voxels
+                                    // (the source's spacing in cells), steps of at most h.
+                                    cornersValid = false;
+                                    const double rho = levelSet ? (cell.lo < 0.0f ? 1.0 : 0.0) : double(cell.hi);
+                                    const int m = std::max(1, int(std::ceil((tb - ta) * 0.5 - 1e-9)));
+                                    const double length = (tb - ta) / m;
+                                    const int n = std::max(1, int(std::ceil(length / h - 1e-9)));
+                                    const double transmitted = expNegative(sigmaPerVoxel * rho * (length / n));
+                                    for (int j = 0; j < m; ++j) {
+                                        const double pa = ta + j * length, pb = j + 1 == m ? tb : pa + length;
+                                        const Vec3d sourceIn = pa == lastEnd ? lastSource : sourceAt(pa);
+                                        const Vec3d sourceOut = sourceAt(pb);
+                                        lastEnd = pb;
+                                        lastSource = sourceOut;
+                                        for (int k = 0; k < n; ++k) {
+                                            const double w = (k + 0.5) / n;
+                                            L += (T * (1.0 - transmitted)) * (sourceIn + (sourceOut - sourceIn) * w);
+                                            T *= transmitted;
+                                            if (T <= kMinTransmittance) return false;
+                                        }
+                                    }
+                                    return true;
+                                }
+                                if (colors) cornerValues(*colors, cell.origin, colorCorners);
+                                cornersValid = true;
+                                cellOrigin = Vec3d(cell.origin.x(), cell.origin.y(), cell.origin.z());
+                                const Vec3d sourceIn = ta == lastEnd ? lastSource : sourceAt(ta);
+                                const Vec3d sourceOut = sourceAt(tb);
+                                lastEnd = tb;
+                                lastSource = sourceOut;
+                                const int n = std::max(1, int(std::ceil((tb - ta) / h - 1e-9)));
+                                const double dt = (tb - ta) / n;
+                                const Piece piece(line, cell, ta);
+                                double before = 0.0; // piece.mass at the start of step k
+                                for (int k = 0; k < n; ++k) {
+                                    double tau;
+                                    if (piece.exact) {
+                                        const double after = piece.mass((k + 1) * dt);
+                                        tau = sigmaPerVoxel * (after - before);
+                                        before = after;
+                                    } else {
+                                        tau = sigmaPerVoxel * line.mass(cell, ta + k * dt, ta + (k + 1) * dt);
+                                    }
+                                    if (!(tau > 0.0)) continue;
+                                    const double transmitted = expNegative(tau);
+                                    const double w = (k + 0.5) / n;
+                                    L += (T * (1.0 - transmitted)) * (sourceIn + (sourceOut - sourceIn) * w);
+                                    T *= transmitted;
+                                    if (T <= kMinTransmittance) return false;
+                                }
+                                return true;
+                            };
+                            double t0 = 0, t1 = 0;
+                            while (inter.march(t0, t1) && walkCells(acc, line, t0, t1, shade)) {}
                         }
                         r += L.x();
                         g += L.y();

@@ -21,7 +21,7 @@ camera="-translate 0,5,25 -lookat 0,4.8,0 -fov 40 -res 640x360"
 vdb="vdb_render $out/bunny.vdb $camera -absorb $absorb,$absorb,$absorb -scatter $scatter,$scatter,$scatter
      -light 0.3,0.7,0.6,1,1,1 -name density -cutoff 1e-7"
 vm="$volmorph render-vdb $out/bunny.vdb --translate 0,5,25 --lookat 0,4.8,0 --fov 40 --res 640x360
-    --extinction 1 --albedo 0.8 --light 0.3,0.7,0.6 --samples 1 --grid density"
+    --extinction 1 --albedo 0.8 --light 0.3,0.7,0.6 --samples 1 --grid density --float"
 
 $vdb "$out/ref.exr" -step 0.05 -shadowstep 20 >/dev/null
 
@@ -35,6 +35,7 @@ time_runs() { # command... ; prints the median wall time in seconds
 alpha_error() { oiiotool "$1" --ch A "$out/ref.exr" --ch A --diff 2>&1 | grep -E "Mean error|Max error" | tr -s ' ' | tr '\n' ' '; }
 
 t_vdb=$(time_runs $vdb "$out/vdb.exr")
+oiiotool --info -v "$out/vdb.exr" | grep -i -E "channel|format" | head -3
 t_vm=$(time_runs $vm -o "$out/vm.exr")
 echo "vdb_render (step 1, shadow step 3): median ${t_vdb} s; alpha: $(alpha_error "$out/vdb.exr")"
 echo "volmorph   (step 0.5, shadows cached every 2 voxels, step 1): median ${t_vm} s; alpha: $(alpha_error "$out/vm.exr")"

@@ -2,17 +2,31 @@
 // directional and point lights, with shadows.
 //
 // Units: extinction is per world unit at density 1, so re-voxelizing a shape does not change how it
-// looks; steps are in voxels. Along each ray OpenVDB's VolumeRayIntersector (hierarchical DDA)
-// skips empty space, and the ray is sampled at a jittered lattice of step h (one random offset per
-// ray, seeded by pixel, sample, frame and seed: no banding, and bit-identical for any thread count).
-// Each step of optical depth tau adds T (1 - e^-tau) albedo S and multiplies T by e^-tau (the source
-// S held constant over the step); marching stops when T < 1e-4.
+// looks; steps are in voxels (index units). Along each ray OpenVDB's VolumeRayIntersector
+// (hierarchical DDA) skips empty space; inside the occupied spans a 3D DDA visits every
+// interpolation cell the ray crosses (the cube between eight voxel centres, where OpenVDB's
+// BoxSampler is trilinear). Along one cell the density is a cubic polynomial of the distance, so
+// its optical depth is integrated exactly: alpha has no step error, no sample lattice and so no
+// banding, whatever the step. Cells inside an 8^3 block of one value (a tile, or a leaf whose
+// values are all equal) are crossed as one piece.
+// Each piece is cut into equal steps of at most `stepVoxels`; each step adds T (1 - e^-tau) S and
+// multiplies T by e^-tau, tau being the step's exact optical depth and S the source (emission plus
+// albedo times the light reaching the point), evaluated where the ray enters and leaves each cell
+// (every 2 voxels at most inside a constant block) and taken linearly in between. That is the only
+// approximation along the ray: second order in the cell size, on a quantity that the shadow
+// lookup already smooths over `shadowCacheVoxels`. Marching stops when T < 1e-4.
 //
-// Shadows: a transmittance cache per light, computed once per image at every `shadowCacheVoxels`-th
-// voxel of the occupied region by marching toward the light with step `shadowStepVoxels`, and
-// sampled trilinearly. Its error is the trilinear interpolation of transmittance over the cache
-// spacing (smooth fields: second order; at a sharp shadow edge the edge is blurred over that
-// spacing). The tests measure it against a closed form.
+// Shadows: for a directional light, a deep shadow map (Lokovic and Veach 2000): columns parallel to
+// the light every `shadowCacheVoxels` voxels, each integrated exactly cell by cell through the
+// volume once per image, keeping the transmittance every `shadowCacheVoxels` along it, and looked
+// up with trilinear interpolation in the light's frame. For a point light, a grid of the same
+// spacing over the occupied region, one exact march toward the light per grid point. The error of
+// both is the interpolation of transmittance over that spacing (smooth fields: second order; a
+// sharp shadow edge is blurred over the spacing); the tests measure it against a closed form.
+//
+// Sampling: one ray through each pixel centre for samples = 1; otherwise stratified, jittered
+// positions seeded by pixel, sample, frame and seed. Nothing depends on the thread count, so
+// images are bit-identical for any --threads.
 #pragma once
 
 #include <volmorph/render/Camera.h>
@@ -47,8 +61,7 @@ struct Medium {
 
 struct RenderSettings {
     int samples = 4;               ///< per pixel, stratified and jittered; 1 = through the pixel centre
-    double stepVoxels = 0.5;       ///< primary ray step
-    double shadowStepVoxels = 1.0; ///< step toward the lights
+    double stepVoxels = 0.5;       ///< longest step of the scattering integral along a primary ray
     int shadowCacheVoxels = 2;     ///< cache spacing, in voxels (1 = every voxel)
     unsigned seed = 0;
     int frame = 0;                 ///< part of the sampling seed
