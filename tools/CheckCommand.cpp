@@ -126,6 +126,8 @@ int runCheck(const std::string& scenePath)
     else
         std::printf("camera  orthographic, eye %s, lookat %s, width %s world units\n",
                     fmt(c.eye).c_str(), fmt(c.lookat).c_str(), fmt(c.orthoWidth).c_str());
+    if (!c.keys.empty()) std::printf("        animated: %zu keys, frames %d to %d\n", c.keys.size(), c.keys.front().frame, c.keys.back().frame);
+    if (r.emission != Vec3d(0.0)) std::printf("emission %s per unit optical depth\n", fmt(r.emission).c_str());
     for (const LightSpec& l : r.lights) {
         if (l.type == LightType::Directional)
             std::printf("light   directional, travelling %s, colour %s, intensity %s\n",
@@ -133,6 +135,8 @@ int runCheck(const std::string& scenePath)
         else
             std::printf("light   point at %s, colour %s, intensity %s\n", fmt(l.position).c_str(),
                         fmt(l.color).c_str(), fmt(l.intensity).c_str());
+        if (!l.keys.empty())
+            std::printf("        animated: %zu keys, frames %d to %d\n", l.keys.size(), l.keys.front().frame, l.keys.back().frame);
     }
     const FramesSpec& f = scene.frames;
     std::printf("frames  %d-%d (%d frames) -> %s\n", f.first, f.last, f.count(),

@@ -129,7 +129,7 @@ int runPreview(const PreviewArgs& args)
         if (drawPairs) {
             // Features are drawn at the image's own size (a frame read from disk keeps its size).
             const SceneRender atSize(scene, 0, image.width);
-            labelsDrawn = drawFeatures(image, atSize.camera, scene, t, args.sides) && labelsDrawn;
+            labelsDrawn = drawFeatures(image, atSize.camera(frame), scene, t, args.sides) && labelsDrawn;
         }
         char label[64];
         std::snprintf(label, sizeof label, "frame %d  t=%.3f", frame, t);
@@ -143,9 +143,9 @@ int runPreview(const PreviewArgs& args)
 
     if (args.contactSheet) {
         const render::Image sheet = render::contactSheet(images, labels, args.columns, args.tileWidth, kBackground);
-        writeImage(sheet, args.output, view.camera, frames.front());
+        writeImage(sheet, args.output, view.camera(frames.front()), frames.front());
     } else {
-        writeImage(render::overBackground(images.front(), kBackground), args.output, view.camera, frames.front());
+        writeImage(render::overBackground(images.front(), kBackground), args.output, view.camera(frames.front()), frames.front());
     }
     if (!args.quiet) std::printf("wrote %s (%zu frame%s)\n", args.output.c_str(), frames.size(), frames.size() == 1 ? "" : "s");
     return 0;

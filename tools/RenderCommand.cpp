@@ -27,7 +27,7 @@ Vec3d vec3(const std::vector<double>& v) { return Vec3d(v[0], v[1], v[2]); }
 
 struct RenderVdbArgs {
     std::string input, output, png, camera = "persp", grid, resolution = "640x360";
-    std::vector<double> translate, lookat, up{0, 1, 0}, light{0.3, 0.7, 0.6};
+    std::vector<double> translate, lookat, up{0, 1, 0}, light{0.3, 0.7, 0.6}, emission;
     double fov = 40.0, frameWidth = 0.0, extinction = 40.0, albedo = 0.8, step = 0.5;
     int shadowCache = 2;
     int samples = 4, threads = 0;
@@ -88,6 +88,7 @@ int runRenderVdb(const RenderVdbArgs& args)
     render::Medium medium;
     medium.extinction = args.extinction;
     medium.albedo = args.albedo;
+    if (!args.emission.empty()) medium.emission = vec3(args.emission);
     render::RenderSettings settings;
     settings.samples = args.samples;
     settings.stepVoxels = args.step;
@@ -152,7 +153,6 @@ int runRenderScene(const RenderSceneArgs& args)
                           morphOptions);
 
     const SceneRender renderer(scene, args.threads);
-    const render::Camera& camera = renderer.camera;
 
     int failed = 0;
     // Two steps per frame (morph, render), so the progress moves within long frames too.
@@ -180,7 +180,7 @@ int runRenderScene(const RenderSceneArgs& args)
         exr.metadata["volmorph:t"] = fmt(scene.frames.t(frame));
         try {
             if (file.has_parent_path()) std::filesystem::create_directories(file.parent_path());
-            render::writeExr(image, camera, file, exr);
+            render::writeExr(image, renderer.camera(frame), file, exr);
         } catch (const std::exception& e) {
             std::fprintf(stderr, "%s: cannot write frame %d (%s)\n", file.string().c_str(), frame, e.what());
             ++failed;
@@ -201,9 +201,8 @@ int runRenderScene(const RenderSceneArgs& args)
 
 namespace {
 
-render::Camera sceneCamera(const RenderSpec& r, int width)
+render::Camera sceneCamera(const CameraSpec& c, const RenderSpec& r, int width)
 {
-    const CameraSpec& c = r.camera;
     const int w = width > 0 ? width : r.width;
     const int h = width > 0 ? std::max(1, int(std::lround(double(r.height) * w / r.width))) : r.height;
     return render::Camera(c.projection == Projection::Orthographic ? render::Camera::Projection::Orthographic
@@ -213,10 +212,26 @@ render::Camera sceneCamera(const RenderSpec& r, int width)
 
 } // namespace
 
-SceneRender::SceneRender(const Scene& scene, int threads, int width) : camera(sceneCamera(scene.render, width))
+SceneRender::SceneRender(const Scene& scene, int threads, int width) : mSpec(scene.render), mWidth(width)
 {
     const RenderSpec& r = scene.render;
-    for (const LightSpec& l : r.lights) {
+    medium.extinction = r.extinction;
+    medium.albedo = r.albedo;
+    medium.anisotropy = r.anisotropy;
+    medium.emission = r.emission;
+    settings.samples = r.samples;
+    settings.stepVoxels = r.stepVoxels;
+    settings.seed = r.seed;
+    settings.threads = threads;
+}
+
+render::Camera SceneRender::camera(int frame) const { return sceneCamera(mSpec.camera.at(frame), mSpec, mWidth); }
+
+std::vector<render::Light> SceneRender::lights(int frame) const
+{
+    std::vector<render::Light> lights;
+    for (const LightSpec& spec : mSpec.lights) {
+        const LightSpec l = spec.at(frame);
         render::Light light;
         light.type = l.type == LightType::Point ? render::Light::Type::Point : render::Light::Type::Directional;
         light.direction = l.direction;
@@ -225,20 +240,14 @@ SceneRender::SceneRender(const Scene& scene, int threads, int width) : camera(sc
         light.intensity = l.intensity;
         lights.push_back(light);
     }
-    medium.extinction = r.extinction;
-    medium.albedo = r.albedo;
-    medium.anisotropy = r.anisotropy;
-    settings.samples = r.samples;
-    settings.stepVoxels = r.stepVoxels;
-    settings.seed = r.seed;
-    settings.threads = threads;
+    return lights;
 }
 
 render::Image SceneRender::renderFrame(const VolumeSet& volumes, int frame) const
 {
     render::RenderSettings s = settings;
     s.frame = frame;
-    return render::renderVolume(*volumes.density, volumes.color.get(), camera, lights, medium, s);
+    return render::renderVolume(*volumes.density, volumes.color.get(), camera(frame), lights(frame), medium, s);
 }
 
 Command addRenderVdbCommand(CLI::App& app)
@@ -257,6 +266,8 @@ Command addRenderVdbCommand(CLI::App& app)
     sub->add_option("--res", a->resolution, "image size WIDTHxHEIGHT");
     sub->add_option("--extinction", a->extinction, "extinction per world unit at density 1")->check(CLI::NonNegativeNumber);
     sub->add_option("--albedo", a->albedo, "scattering albedo 0..1")->check(CLI::Range(0.0, 1.0));
+    sub->add_option("--emission", a->emission, "emitted radiance per unit optical depth R,G,B (linear, >= 0)")
+        ->delimiter(',')->expected(3)->check(CLI::NonNegativeNumber);
     sub->add_option("--light", a->light, "direction toward the light X,Y,Z[,R,G,B] (as vdb_render)")->delimiter(',')
         ->expected(3, 6);
     sub->add_option("--samples", a->samples, "samples per pixel")->check(CLI::Range(1, 65536));

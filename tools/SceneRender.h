@@ -11,16 +11,22 @@
 namespace volmorph::cli {
 
 struct SceneRender {
-    render::Camera camera;
-    std::vector<render::Light> lights;
     render::Medium medium;
     render::RenderSettings settings; ///< frame left 0: set it per frame
 
     /// `width` overrides the scene's image width in pixels (the height follows the aspect ratio).
     SceneRender(const Scene& scene, int threads, int width = 0);
 
+    /// The camera and lights at `frame` (their keys interpolated).
+    render::Camera camera(int frame) const;
+    std::vector<render::Light> lights(int frame) const;
+
     /// Renders frame `frame` of the morph, `volumes` being that frame's in-between.
     render::Image renderFrame(const VolumeSet& volumes, int frame) const;
+
+private:
+    RenderSpec mSpec;
+    int mWidth;
 };
 
 } // namespace volmorph::cli

@@ -201,3 +201,41 @@ TEST(Render, ExrRoundTripAndAtomicWrite)
     EXPECT_FALSE(std::filesystem::exists(dir / "missing"));
     std::filesystem::remove_all(dir);
 }
+
+TEST(Render, EmissionIsAlphaTimesTheEmittedRadiance)
+{
+    // Closed form for an emitting, non-scattering medium: L = integral of T sigma rho E ds
+    // = E (1 - T_total) = E alpha, per pixel, whatever the density profile along the ray.
+    const auto fog = sphereFog(48);
+    render::Medium medium;
+    medium.extinction = 3.0;
+    medium.albedo = 0.0;
+    medium.emission = Vec3d(0.5, 2.0, 0.0);
+    render::RenderSettings settings;
+    settings.samples = 1;
+    const render::Image image = render::renderVolume(*fog, nullptr, orthoDown(1.2, 64), {}, medium, settings);
+    int covered = 0;
+    for (int y = 0; y < 64; ++y)
+        for (int x = 0; x < 64; ++x) {
+            const float* p = image.at(x, y);
+            if (p[3] > 0.01f) ++covered;
+            EXPECT_NEAR(p[0], 0.5 * p[3], 1e-5) << x << "," << y;
+            EXPECT_NEAR(p[1], 2.0 * p[3], 1e-5) << x << "," << y;
+            EXPECT_EQ(p[2], 0.0f);
+        }
+    EXPECT_GT(covered, 1500); // the sphere covers about 55% of the 4096 pixels
+}
+
+TEST(Render, ExactOpticalDepthDoesNotDependOnTheStep)
+{
+    // Optical depth is integrated exactly per interpolation cell, so alpha cannot change with the
+    // step (only the scattering quadrature uses it).
+    const auto fog = sphereFog(40);
+    const Camera camera(Camera::Projection::Perspective, Vec3d(0.3, 0.2, 3), Vec3d(0, 0, 0), Vec3d(0, 1, 0), 30.0, 1.0,
+                        48, 48);
+    const render::Image fine = absorbOnly(*fog, camera, 5.0, 1, render::Medium::Kind::Fog, 0.1);
+    const render::Image coarse = absorbOnly(*fog, camera, 5.0, 1, render::Medium::Kind::Fog, 4.0);
+    double worst = 0.0;
+    for (size_t i = 3; i < fine.pixels.size(); i += 4) worst = std::max(worst, double(std::abs(fine.pixels[i] - coarse.pixels[i])));
+    EXPECT_LT(worst, 1e-6);
+}

@@ -436,3 +436,58 @@ TEST(Scene, CommentedExampleInScenesReadmeParses)
     EXPECT_EQ(s.render.lights.size(), 2u);
     EXPECT_EQ(s.frames.count(), 24);
 }
+
+TEST(SceneAnimation, CameraKeysInterpolateLinearlyAndHoldOutside)
+{
+    const Scene s = parse(std::string(kMinimal) + R"(
+[render]
+emission = [0.5, 0.25, 0]
+camera = { eye = [0, 0, 5], lookat = [0, 0, 0], fov = 40, keys = [
+    { frame = 10, eye = [0, 0, 5] },
+    { frame = 20, eye = [10, 0, 5], fov = 60, lookat = [2, 0, 0] } ] }
+)");
+    EXPECT_EQ(s.render.emission, Vec3d(0.5, 0.25, 0.0));
+    ASSERT_EQ(s.render.camera.keys.size(), 2u);
+    // Values a key leaves out come from the camera.
+    EXPECT_DOUBLE_EQ(s.render.camera.keys[0].fovDegrees, 40.0);
+    const CameraSpec before = s.render.camera.at(1), middle = s.render.camera.at(15), after = s.render.camera.at(99);
+    EXPECT_EQ(before.eye, Vec3d(0, 0, 5));
+    EXPECT_EQ(after.eye, Vec3d(10, 0, 5));
+    EXPECT_DOUBLE_EQ(after.fovDegrees, 60.0);
+    EXPECT_NEAR(middle.eye.x(), 5.0, 1e-12);
+    EXPECT_NEAR(middle.lookat.x(), 1.0, 1e-12);
+    EXPECT_NEAR(middle.fovDegrees, 50.0, 1e-12);
+    EXPECT_NEAR(middle.up.length(), 1.0, 1e-12);
+    EXPECT_TRUE(middle.keys.empty());
+}
+
+TEST(SceneAnimation, LightKeysTurnTheDirectionAndFadeTheIntensity)
+{
+    const Scene s = parse(std::string(kMinimal) + R"(
+[render]
+lights = [ { type = "directional", direction = [0, -1, 0], intensity = 2, keys = [
+    { frame = 1 },
+    { frame = 3, direction = [1, 0, 0], intensity = 0, color = [1, 0, 0] } ] } ]
+)");
+    ASSERT_EQ(s.render.lights.size(), 1u);
+    const LightSpec middle = s.render.lights[0].at(2);
+    EXPECT_NEAR(middle.direction.x(), std::sqrt(0.5), 1e-12); // halfway between -y and +x, unit length
+    EXPECT_NEAR(middle.direction.y(), -std::sqrt(0.5), 1e-12);
+    EXPECT_NEAR(middle.intensity, 1.0, 1e-12);
+    EXPECT_NEAR(middle.color.y(), 0.5, 1e-12);
+    EXPECT_EQ(s.render.lights[0].at(0).intensity, 2.0);
+}
+
+TEST(SceneAnimation, KeyErrorsNameTheirPlace)
+{
+    const std::string base = std::string(kMinimal) + "[render]\n";
+    expectError(base + "camera = { keys = [ { frame = 5 }, { frame = 5 } ] }\n", 9, 46,
+                "render.camera.keys[2].frame: frames must increase from key to key (the key before is frame 5)");
+    expectError(base + "camera = { keys = [ { eye = [1, 2, 3] } ] }\n", 9, 21,
+                "missing render.camera.keys[1].frame");
+    expectError(base + "camera = { keys = [ { frame = 1, lookat = [0, 0, 5] } ] }\n", 9, 21,
+                "render.camera.keys[1]: eye and lookat are the same point");
+    expectError(base + "lights = [ { type = \"point\", position = [0, 1, 0], keys = [ { frame = 1, direction = [0, 1, 0] } ] } ]\n",
+                9, 86, "render.lights[1].keys[1].direction: a point light has a position, not a direction");
+    expectError(base + "emission = [1, -1, 0]\n", 9, 12, "render.emission");
+}

@@ -105,6 +105,13 @@ struct BlendSpec {
 
 enum class Projection { Perspective, Orthographic };
 
+/// The camera at one key frame: every value, those the key leaves out copied from the camera.
+struct CameraKey {
+    int frame = 0;
+    Vec3d eye, lookat, up;
+    double fovDegrees = 40.0, orthoWidth = 2.0;
+};
+
 struct CameraSpec {
     Projection projection = Projection::Perspective;
     Vec3d eye{0.0, 0.0, 5.0};
@@ -112,9 +119,21 @@ struct CameraSpec {
     Vec3d up{0.0, 1.0, 0.0};
     double fovDegrees = 40.0;            ///< horizontal, perspective only
     double orthoWidth = 2.0;             ///< world units, orthographic only
+    std::vector<CameraKey> keys;         ///< animation, by increasing frame; empty: still
+
+    /// The camera at `frame`: values interpolated linearly between the keys around it (up
+    /// renormalized), held before the first key and after the last.
+    CameraSpec at(int frame) const;
 };
 
 enum class LightType { Directional, Point };
+
+/// A light at one key frame: every value, those the key leaves out copied from the light.
+struct LightKey {
+    int frame = 0;
+    Vec3d direction, position, color;
+    double intensity = 1.0;
+};
 
 struct LightSpec {
     LightType type = LightType::Directional;
@@ -122,6 +141,11 @@ struct LightSpec {
     Vec3d position{0.0, 0.0, 0.0};       ///< point: world units
     Vec3d color{1.0, 1.0, 1.0};
     double intensity = 1.0;
+    std::vector<LightKey> keys;          ///< animation, by increasing frame; empty: still
+
+    /// The light at `frame`: values interpolated linearly between the keys around it (direction
+    /// renormalized), held before the first key and after the last.
+    LightSpec at(int frame) const;
 };
 
 struct RenderSpec {
@@ -131,6 +155,7 @@ struct RenderSpec {
     double extinction = 40.0;            ///< per world unit at density 1
     double albedo = 0.8;                 ///< single-scattering albedo, 0..1
     double anisotropy = 0.0;             ///< Henyey-Greenstein g, -1 < g < 1
+    Vec3d emission{0.0, 0.0, 0.0};       ///< radiance emitted per unit optical depth, linear RGB
     unsigned seed = 0;
     CameraSpec camera;
     std::vector<LightSpec> lights;       ///< default: one directional light from above-front

@@ -6,6 +6,8 @@
 #include <volmorph/Frames.h>
 #include <volmorph/Scene.h>
 
+#include <optional>
+
 #include "TomlReader.h"
 
 #include <toml++/toml.h>
@@ -35,9 +37,12 @@ const std::vector<std::string> kElementKeys = {"origin", "axes", "scale"};
 const std::vector<std::string> kWarpKeys = {"epsilon", "tolerance", "weighting", "a", "b", "p"};
 const std::vector<std::string> kBlendKeys = {"mode", "density", "color", "sdf", "min_island"};
 const std::vector<std::string> kRenderKeys = {"resolution", "samples", "step", "extinction",
-                                              "albedo", "anisotropy", "seed", "camera", "lights"};
-const std::vector<std::string> kCameraKeys = {"projection", "eye", "lookat", "up", "fov", "width"};
-const std::vector<std::string> kLightKeys = {"type", "direction", "position", "color", "intensity"};
+                                              "albedo", "anisotropy", "seed", "camera", "lights",
+                                              "emission"};
+const std::vector<std::string> kCameraKeys = {"projection", "eye", "lookat", "up", "fov", "width", "keys"};
+const std::vector<std::string> kCameraKeyKeys = {"frame", "eye", "lookat", "up", "fov", "width"};
+const std::vector<std::string> kLightKeys = {"type", "direction", "position", "color", "intensity", "keys"};
+const std::vector<std::string> kLightKeyKeys = {"frame", "direction", "position", "color", "intensity"};
 const std::vector<std::string> kFramesKeys = {"range", "output"};
 
 // ------------------------------------------------------------------------------------------------
@@ -371,11 +376,74 @@ private:
                                     std::numeric_limits<double>::max(),
                                     "an orthographic width > 0 in world units"))
                 c.orthoWidth = *v;
-        const Vec3d view = c.lookat - c.eye;
+        checkView(node, "render.camera", c.eye, c.lookat, c.up);
+        if (const toml::node* n = t->get("keys")) {
+            forEachKey(*n, "render.camera.keys", [&](const toml::table& k, const toml::node& where, const std::string& path,
+                                                     int frame) {
+                r.checkKeys(k, path, kCameraKeyKeys);
+                CameraKey key{frame, c.eye, c.lookat, c.up, c.fovDegrees, c.orthoWidth};
+                if (const toml::node* e = k.get("eye"))
+                    if (auto v = r.vec3(*e, path + ".eye")) key.eye = *v;
+                if (const toml::node* e = k.get("lookat"))
+                    if (auto v = r.vec3(*e, path + ".lookat")) key.lookat = *v;
+                if (const toml::node* e = k.get("up"))
+                    if (auto v = r.direction(*e, path + ".up")) key.up = *v;
+                if (const toml::node* e = k.get("fov"))
+                    if (auto v = r.numberIn(*e, path + ".fov", 0.0, false, 179.0,
+                                            "a horizontal field of view in degrees, 0 < fov <= 179"))
+                        key.fovDegrees = *v;
+                if (const toml::node* e = k.get("width"))
+                    if (auto v = r.numberIn(*e, path + ".width", 0.0, false, std::numeric_limits<double>::max(),
+                                            "an orthographic width > 0 in world units"))
+                        key.orthoWidth = *v;
+                checkView(where, path, key.eye, key.lookat, key.up);
+                if (!c.keys.empty() && key.up.unit().dot(c.keys.back().up.unit()) < -1.0 + 1e-9)
+                    r.error(r.at(where), path + ".up: opposite to the previous key's up (the turn between them is undefined)");
+                c.keys.push_back(key);
+            });
+        }
+    }
+
+    void checkView(const toml::node& where, const std::string& path, const Vec3d& eye, const Vec3d& lookat, const Vec3d& up)
+    {
+        const Vec3d view = lookat - eye;
         if (view.length() < 1e-12) {
-            r.error(r.at(node), "render.camera: eye and lookat are the same point");
-        } else if (std::abs(view.unit().dot(c.up.unit())) > 1.0 - 1e-9) {
-            r.error(r.at(node), "render.camera: up is parallel to the view direction (eye to lookat)");
+            r.error(r.at(where), path + ": eye and lookat are the same point");
+        } else if (std::abs(view.unit().dot(up.unit())) > 1.0 - 1e-9) {
+            r.error(r.at(where), path + ": up is parallel to the view direction (eye to lookat)");
+        }
+    }
+
+    /// Calls f(table, node, path, frame) for each key table of the array `node`, checking that
+    /// every key has an integer frame and that frames increase.
+    template <typename F>
+    void forEachKey(const toml::node& node, const std::string& path, F&& f)
+    {
+        const toml::array* a = node.as_array();
+        if (!a || a->empty()) {
+            r.error(r.at(node), path + ": expected an array of key tables, each with a frame");
+            return;
+        }
+        std::optional<int> previous;
+        for (size_t i = 0; i < a->size(); ++i) {
+            const std::string keyPath = path + "[" + std::to_string(i + 1) + "]";
+            const toml::node& item = *a->get(i);
+            const toml::table* k = r.table(item, keyPath);
+            if (!k) continue;
+            const toml::node* frameNode = k->get("frame");
+            if (!frameNode) {
+                r.missing(item, keyPath + ".frame", "the frame number of this key");
+                continue;
+            }
+            const auto frame = r.integerIn(*frameNode, keyPath + ".frame", -100000000, 100000000);
+            if (!frame) continue;
+            if (previous && *frame <= *previous) {
+                r.error(r.at(*frameNode), keyPath + ".frame: frames must increase from key to key (the key before is frame " +
+                                              std::to_string(*previous) + ")");
+                continue;
+            }
+            previous = int(*frame);
+            f(*k, item, keyPath, int(*frame));
         }
     }
 
@@ -414,6 +482,34 @@ private:
             if (auto v = r.numberIn(*n, path + ".intensity", 0.0, true,
                                     std::numeric_limits<double>::max(), "an intensity >= 0"))
                 light.intensity = *v;
+        if (const toml::node* n = t->get("keys")) {
+            forEachKey(*n, path + ".keys", [&](const toml::table& k, const toml::node& where, const std::string& keyPath,
+                                               int frame) {
+                r.checkKeys(k, keyPath, kLightKeyKeys);
+                LightKey key{frame, light.direction, light.position, light.color, light.intensity};
+                if (const toml::node* e = k.get("direction")) {
+                    if (light.type != LightType::Directional)
+                        r.error(r.at(*e), keyPath + ".direction: a point light has a position, not a direction");
+                    else if (auto v = r.direction(*e, keyPath + ".direction"))
+                        key.direction = *v;
+                }
+                if (const toml::node* e = k.get("position")) {
+                    if (light.type != LightType::Point)
+                        r.error(r.at(*e), keyPath + ".position: a directional light has a direction, not a position");
+                    else if (auto v = r.vec3(*e, keyPath + ".position"))
+                        key.position = *v;
+                }
+                if (const toml::node* e = k.get("color"))
+                    if (auto v = r.nonNegativeVec3(*e, keyPath + ".color")) key.color = *v;
+                if (const toml::node* e = k.get("intensity"))
+                    if (auto v = r.numberIn(*e, keyPath + ".intensity", 0.0, true, std::numeric_limits<double>::max(),
+                                            "an intensity >= 0"))
+                        key.intensity = *v;
+                if (!light.keys.empty() && key.direction.unit().dot(light.keys.back().direction.unit()) < -1.0 + 1e-9)
+                    r.error(r.at(where), keyPath + ".direction: opposite to the previous key's direction (the turn between them is undefined)");
+                light.keys.push_back(key);
+            });
+        }
         mScene.render.lights.push_back(light);
     }
 
@@ -457,6 +553,8 @@ private:
         if (const toml::node* n = t->get("seed"))
             if (auto v = r.integerIn(*n, "render.seed", 0, std::numeric_limits<uint32_t>::max()))
                 rs.seed = unsigned(*v);
+        if (const toml::node* n = t->get("emission"))
+            if (auto v = r.nonNegativeVec3(*n, "render.emission")) rs.emission = *v;
         if (const toml::node* n = t->get("camera")) parseCamera(*n);
         if (const toml::node* n = t->get("lights")) {
             if (const toml::array* a = n->as_array()) {
