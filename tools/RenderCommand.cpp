@@ -55,15 +55,20 @@ int runRenderVdb(const RenderVdbArgs& args)
     try {
         openvdb::io::File file(args.input);
         file.open();
+        // Only the two grids used are read (a voxelized mesh also holds its sdf).
+        std::string densityName, colorName;
         for (auto it = file.beginName(); it != file.endName(); ++it) {
-            openvdb::GridBase::Ptr g = file.readGrid(it.gridName());
-            if (!color && g->getName() == "Cd") color = openvdb::gridPtrCast<openvdb::Vec3SGrid>(g);
-            if (density) continue;
-            if (!args.grid.empty() ? g->getName() == args.grid : bool(openvdb::gridPtrCast<openvdb::FloatGrid>(g))) {
-                density = openvdb::gridPtrCast<openvdb::FloatGrid>(g);
-                if (!density) throw UserError(SourceLocation{args.input}, "grid \"" + args.grid + "\" is not a float grid");
+            const openvdb::GridBase::Ptr g = file.readGridMetadata(it.gridName());
+            if (colorName.empty() && g->getName() == "Cd" && g->isType<openvdb::Vec3SGrid>()) colorName = it.gridName();
+            if (!densityName.empty()) continue;
+            if (!args.grid.empty() ? g->getName() == args.grid : g->isType<openvdb::FloatGrid>()) {
+                if (!g->isType<openvdb::FloatGrid>())
+                    throw UserError(SourceLocation{args.input}, "grid \"" + args.grid + "\" is not a float grid");
+                densityName = it.gridName();
             }
         }
+        if (!densityName.empty()) density = openvdb::gridPtrCast<openvdb::FloatGrid>(file.readGrid(densityName));
+        if (!colorName.empty()) color = openvdb::gridPtrCast<openvdb::Vec3SGrid>(file.readGrid(colorName));
         file.close();
     } catch (const openvdb::Exception& e) {
         throw UserError(SourceLocation{args.input}, std::string("cannot read volume file (") + e.what() + ")");

@@ -17,6 +17,7 @@
 #include <cmath>
 #include <limits>
 #include <memory>
+#include <unordered_map>
 
 namespace volmorph::render {
 namespace {
@@ -85,38 +86,6 @@ FloatGrid::Ptr constantLeavesAsTiles(const FloatGrid& density)
     }
     for (const auto& [origin, value] : constant) grid->tree().addTile(1, origin, value, true);
     return grid;
-}
-
-/// Density at index position ip: the fog's value, or 1 inside a level set.
-template <typename Accessor>
-inline float densityAt(const Accessor& acc, const Vec3d& ip, bool levelSet)
-{
-    const float v = openvdb::tools::BoxSampler::sample(acc, ip);
-    return levelSet ? (v < 0.0f ? 1.0f : 0.0f) : v;
-}
-
-/// The eight values of `tree` at c + {0, 1}^3 (BoxSampler::getValues' layout). When all eight lie in
-/// one 8^3 block (7 cells in 8 along each axis) they are read straight from its leaf, or are one
-/// tile value if it has none.
-template <typename Accessor, typename Value>
-inline void cornerValues(const Accessor& acc, const Coord& c, Value (&v)[2][2][2])
-{
-    using Leaf = typename Accessor::TreeType::LeafNodeType;
-    if ((c.x() & 7) != 7 && (c.y() & 7) != 7 && (c.z() & 7) != 7) {
-        if (const Leaf* leaf = acc.probeConstLeaf(c)) {
-            const Value* d = leaf->buffer().data() + Leaf::coordToOffset(c);
-            v[0][0][0] = d[0];   v[0][0][1] = d[1];
-            v[0][1][0] = d[8];   v[0][1][1] = d[9];
-            v[1][0][0] = d[64];  v[1][0][1] = d[65];
-            v[1][1][0] = d[72];  v[1][1][1] = d[73];
-        } else {
-            const Value value = acc.getValue(c);
-            v[0][0][0] = v[0][0][1] = v[0][1][0] = v[0][1][1] = value;
-            v[1][0][0] = v[1][0][1] = v[1][1][0] = v[1][1][1] = value;
-        }
-        return;
-    }
-    openvdb::tools::BoxSampler::getValues(v, acc, c);
 }
 
 /// Trilinear interpolation of eight colours at local coordinates u in [0, 1]^3.
@@ -244,16 +213,154 @@ inline double expNegative(double x)
     return std::exp(-x);
 }
 
+/// Each leaf's values plus one more layer on its +x, +y and +z sides (read from the neighbours):
+/// the eight corners of every cell whose origin lies in the leaf, so that reading them is eight
+/// loads, also for cells that straddle two, four or eight leaves.
+class PaddedLeaves
+{
+public:
+    using Leaf = openvdb::FloatTree::LeafNodeType;
+    static constexpr int kSide = Leaf::DIM + 1, kSize = kSide * kSide * kSide;
+
+    explicit PaddedLeaves(const openvdb::FloatTree& tree)
+    {
+        std::vector<const Leaf*> leaves;
+        leaves.reserve(tree.leafCount());
+        for (auto it = tree.cbeginLeaf(); it; ++it) leaves.push_back(&*it);
+        mValues.resize(leaves.size() * kSize);
+        tbb::parallel_for(tbb::blocked_range<size_t>(0, leaves.size(), 16), [&](const tbb::blocked_range<size_t>& r) {
+            openvdb::tree::ValueAccessor<const openvdb::FloatTree> acc(tree);
+            for (size_t i = r.begin(); i != r.end(); ++i) {
+                const Leaf& leaf = *leaves[i];
+                const float* d = leaf.buffer().data();
+                float* out = &mValues[i * kSize];
+                for (int x = 0; x < kSide; ++x)
+                    for (int y = 0; y < kSide; ++y)
+                        for (int z = 0; z < kSide; ++z)
+                            out[(x * kSide + y) * kSide + z] = x < 8 && y < 8 && z < 8
+                                ? d[(x << 6) | (y << 3) | z]
+                                : acc.getValue(leaf.origin().offsetBy(x, y, z));
+            }
+        });
+        mIndex.reserve(leaves.size());
+        for (size_t i = 0; i < leaves.size(); ++i) mIndex.emplace(leaves[i], &mValues[i * kSize]);
+    }
+
+    const float* find(const Leaf* leaf) const
+    {
+        const auto it = mIndex.find(leaf);
+        return it == mIndex.end() ? nullptr : it->second;
+    }
+
+private:
+    std::vector<float> mValues;
+    std::unordered_map<const Leaf*, const float*> mIndex;
+};
+
+/// One thread's trilinear reader of a colour grid, remembering the last 8^3 block: inside a block
+/// without a leaf the colour is its tile value, inside a leaf the corners are read from its buffer.
+struct ColorReader {
+    using Tree = openvdb::Vec3STree;
+    using Leaf = Tree::LeafNodeType;
+    openvdb::tree::ValueAccessor<const Tree> acc;
+    Coord block{std::numeric_limits<int>::max()};
+    const Leaf* leaf = nullptr;
+    openvdb::Vec3s tile;
+
+    explicit ColorReader(const Tree& tree) : acc(tree) {}
+
+    Vec3d at(const Vec3d& ip)
+    {
+        const Coord c = Coord::floor(ip);
+        const Coord b(c.x() & ~7, c.y() & ~7, c.z() & ~7);
+        if (b != block) {
+            block = b;
+            leaf = acc.probeConstLeaf(c);
+            if (!leaf) tile = acc.getValue(c);
+        }
+        openvdb::Vec3s v[2][2][2];
+        if ((c.x() & 7) != 7 && (c.y() & 7) != 7 && (c.z() & 7) != 7) {
+            if (!leaf) return Vec3d(tile.x(), tile.y(), tile.z());
+            const openvdb::Vec3s* d = leaf->buffer().data() + Leaf::coordToOffset(c);
+            v[0][0][0] = d[0];   v[0][0][1] = d[1];
+            v[0][1][0] = d[8];   v[0][1][1] = d[9];
+            v[1][0][0] = d[64];  v[1][0][1] = d[65];
+            v[1][1][0] = d[72];  v[1][1][1] = d[73];
+        } else {
+            openvdb::tools::BoxSampler::getValues(v, acc, c);
+        }
+        return trilinear(v, ip - Vec3d(c.x(), c.y(), c.z()));
+    }
+};
+
+/// One thread's reader of a cell's eight density values: the padded copy of the cell's leaf, or the
+/// tile value of a block without a leaf (remembered per 8^3 block).
+struct DensityReader {
+    openvdb::tree::ValueAccessor<const openvdb::FloatTree> acc;
+    const PaddedLeaves& padded;
+    /// A direct-mapped cache of 8^3 blocks: a block's padded values, or its tile value if it has
+    /// no leaf.
+    struct Block {
+        Coord origin{std::numeric_limits<int>::max()};
+        const float* values = nullptr;
+        float tile = 0.0f;
+    };
+    Block cache[64];
+    float tile = 0.0f; ///< the value of the last cell's block, when cell() returned false
+
+    DensityReader(const openvdb::FloatTree& tree, const PaddedLeaves& p) : acc(tree), padded(p) {}
+
+    const Block& blockAt(const Coord& b) // b: a block origin (multiples of 8)
+    {
+        Block& e = cache[((b.x() >> 3) & 3) | (((b.y() >> 3) & 3) << 2) | (((b.z() >> 3) & 3) << 4)];
+        if (e.origin != b) {
+            e.origin = b;
+            const PaddedLeaves::Leaf* leaf = acc.probeConstLeaf(b);
+            e.values = leaf ? padded.find(leaf) : nullptr;
+            if (!e.values) e.tile = acc.getValue(b);
+        }
+        return e;
+    }
+
+    /// Fills `v` for the cell at `c` and returns true, or returns false (filling nothing, `tile` set)
+    /// if c's block has no leaf and c lies inside it (not on its +x, +y or +z face layer).
+    bool cell(const Coord& c, float (&v)[2][2][2])
+    {
+        const Coord b(c.x() & ~7, c.y() & ~7, c.z() & ~7);
+        const Block& own = blockAt(b);
+        if (own.values) {
+            constexpr int s = PaddedLeaves::kSide;
+            const float* p = own.values + ((c.x() & 7) * s + (c.y() & 7)) * s + (c.z() & 7);
+            v[0][0][0] = p[0];         v[0][0][1] = p[1];
+            v[0][1][0] = p[s];         v[0][1][1] = p[s + 1];
+            v[1][0][0] = p[s * s];     v[1][0][1] = p[s * s + 1];
+            v[1][1][0] = p[s * s + s]; v[1][1][1] = p[s * s + s + 1];
+            return true;
+        }
+        tile = own.tile;
+        const int edge[3] = {(c.x() & 7) == 7, (c.y() & 7) == 7, (c.z() & 7) == 7};
+        if (!edge[0] && !edge[1] && !edge[2]) return false;
+        // A cell straddling blocks: each corner from its own block (a tile value, or a leaf value).
+        for (int i = 0; i < 2; ++i)
+            for (int j = 0; j < 2; ++j)
+                for (int k = 0; k < 2; ++k) {
+                    const Coord corner = c.offsetBy(i, j, k);
+                    const Block& e = blockAt(Coord(corner.x() & ~7, corner.y() & ~7, corner.z() & ~7));
+                    v[i][j][k] = e.values ? acc.getValue(corner) : e.tile;
+                }
+        return true;
+    }
+};
+
 /// Walks the interpolation cells that the index ray eye + t dir crosses for t in [ta, tb]
 /// (Amanatides and Woo's 3D DDA), calling visit(cell, t0, t1) for each piece whose cell has a
 /// non-zero density somewhere; stops early when visit returns false. Returns false if stopped.
 /// Where the ray enters an 8^3 block that has no leaf (one tile value, or the background), every
 /// cell within the block's [b, b + 7]^3 is constant: the whole crossing is one piece, marked
 /// Cell::block.
-template <typename Accessor, typename Visit>
-bool walkCells(const Accessor& acc, const Medium1D& ray, double ta, double tb, Visit&& visit)
+template <typename Visit>
+bool walkCells(DensityReader& reader, const Medium1D& ray, double ta, double tb, Visit&& visit)
 {
-    using Leaf = typename Accessor::TreeType::LeafNodeType;
     int cell[3], step[3];
     double next[3], delta[3];
     Cell c;
@@ -283,15 +390,9 @@ bool walkCells(const Accessor& acc, const Medium1D& ray, double ta, double tb, V
             double t1 = std::min(next[a], tb);
             c.origin = Coord(cell[0], cell[1], cell[2]);
             c.block = false;
-            if ((cell[0] & 7) != 7 && (cell[1] & 7) != 7 && (cell[2] & 7) != 7) {
-                if (const Leaf* leaf = acc.probeConstLeaf(c.origin)) {
-                    const float* d = leaf->buffer().data() + Leaf::coordToOffset(c.origin);
-                    c.v[0][0][0] = d[0];   c.v[0][0][1] = d[1];
-                    c.v[0][1][0] = d[8];   c.v[0][1][1] = d[9];
-                    c.v[1][0][0] = d[64];  c.v[1][0][1] = d[65];
-                    c.v[1][1][0] = d[72];  c.v[1][1][1] = d[73];
-                } else {
-                    const float value = acc.getValue(c.origin);
+            if (!reader.cell(c.origin, c.v)) {
+                {
+                    const float value = reader.tile;
                     for (int i = 0; i < 8; ++i) (&c.v[0][0][0])[i] = value;
                     // Where the ray leaves the block's constant region [b, b + 7]^3.
                     double exit = tb;
@@ -307,8 +408,6 @@ bool walkCells(const Accessor& acc, const Medium1D& ray, double ta, double tb, V
                         restart = true;
                     }
                 }
-            } else {
-                openvdb::tools::BoxSampler::getValues(c.v, acc, c.origin);
             }
             if (t1 > t) {
                 openvdb::tools::BoxSampler::extrema(c.v, c.lo, c.hi);
@@ -326,7 +425,7 @@ bool walkCells(const Accessor& acc, const Medium1D& ray, double ta, double tb, V
 
 /// Optical depth (index units times sigma) from world point p along `direction` for up to
 /// `distance` world units, integrated cell by cell.
-double opticalDepth(Intersector& inter, bool levelSet, openvdb::tree::ValueAccessor<const openvdb::FloatTree>& acc,
+double opticalDepth(Intersector& inter, bool levelSet, DensityReader& acc,
                     const Vec3d& p, const Vec3d& direction, double distance, double sigmaPerVoxel)
 {
     if (!inter.setWorldRay(VdbRay(p, direction, 0.0, distance))) return 0.0;
@@ -344,7 +443,7 @@ double opticalDepth(Intersector& inter, bool levelSet, openvdb::tree::ValueAcces
 
 /// Transmittance toward a point light, on a coarse grid over the occupied region: one march toward
 /// the light per grid point, sampled trilinearly.
-FloatGrid::Ptr pointLightCache(const FloatGrid& density, const openvdb::BoolGrid& mask, bool levelSet,
+FloatGrid::Ptr pointLightCache(const FloatGrid& density, const PaddedLeaves& padded, const openvdb::BoolGrid& mask, bool levelSet,
                                const Light& light, double sigmaPerVoxel, const RenderSettings& settings)
 {
     const int factor = std::max(1, settings.shadowCacheVoxels);
@@ -373,7 +472,7 @@ FloatGrid::Ptr pointLightCache(const FloatGrid& density, const openvdb::BoolGrid
     openvdb::tree::LeafManager<openvdb::FloatTree> leaves(cache->tree());
     leaves.foreach([&](openvdb::FloatTree::LeafNodeType& leaf, size_t) {
         Intersector inter(master);
-        openvdb::tree::ValueAccessor<const openvdb::FloatTree> acc(density.tree());
+        DensityReader acc(density.tree(), padded);
         for (auto it = leaf.beginValueOn(); it; ++it) {
             const Vec3d p = cache->indexToWorld(it.getCoord());
             Vec3d toward = light.position - p;
@@ -394,7 +493,7 @@ FloatGrid::Ptr pointLightCache(const FloatGrid& density, const openvdb::BoolGrid
 class ShadowMap
 {
 public:
-    ShadowMap(const FloatGrid& density, const openvdb::BoolGrid& mask, bool levelSet, const Vec3d& travel,
+    ShadowMap(const FloatGrid& density, const PaddedLeaves& padded, const openvdb::BoolGrid& mask, bool levelSet, const Vec3d& travel,
               double sigmaPerVoxel, double spacing)
         : mDensity(density), mSpacing(spacing)
     {
@@ -429,19 +528,29 @@ public:
         mCount[1] = int(std::ceil((hi.y() - mOrigin.y()) / spacing)) + 2;
         const double length = hi.z() - mOrigin.z() + 2.0 * spacing;
         const size_t columns = size_t(mCount[0]) * size_t(mCount[1]);
-        mColumns.resize(columns);
+        std::vector<Column> columnsBuilt(columns);
 
         const Intersector master(mask);
         tbb::parallel_for(tbb::blocked_range<size_t>(0, columns, 64), [&](const tbb::blocked_range<size_t>& range) {
             Intersector inter(master);
-            openvdb::tree::ValueAccessor<const openvdb::FloatTree> acc(density.tree());
+            DensityReader acc(density.tree(), padded);
             for (size_t c = range.begin(); c != range.end(); ++c) {
                 const int i = int(c % size_t(mCount[0])), j = int(c / size_t(mCount[0]));
                 const Vec3d start = mU * (mOrigin.x() + i * spacing) + mV * (mOrigin.y() + j * spacing) +
                                     mW * mOrigin.z();
-                march(inter, acc, levelSet, start, length, sigmaPerVoxel, mColumns[c]);
+                march(inter, acc, levelSet, start, length, sigmaPerVoxel, columnsBuilt[c]);
             }
         });
+        // One contiguous array for lookups.
+        size_t total = 0;
+        for (const Column& c : columnsBuilt) total += c.values.size();
+        mData.reserve(total);
+        mSpans.resize(columns);
+        for (size_t c = 0; c < columns; ++c) {
+            const Column& col = columnsBuilt[c];
+            mSpans[c] = Span{col.first, int(col.values.size()), col.last, uint32_t(mData.size())};
+            mData.insert(mData.end(), col.values.begin(), col.values.end());
+        }
     }
 
     /// Transmittance toward the light at index point ip of the density grid.
@@ -461,10 +570,15 @@ public:
         const double fa = std::floor(a), fb = std::floor(b), fc = std::floor(c);
         const int i = int(fa), j = int(fb), k = int(fc);
         const double u = a - fa, v = b - fb, w = c - fc;
-        auto column = [&](int ci, int cj) {
+        auto column = [&](int ci, int cj) __attribute__((always_inline)) {
             if (ci < 0 || cj < 0 || ci >= mCount[0] || cj >= mCount[1]) return 1.0;
-            const Column& col = mColumns[size_t(cj) * size_t(mCount[0]) + size_t(ci)];
-            return (1.0 - w) * col.at(k) + w * col.at(k + 1);
+            const Span& span = mSpans[size_t(cj) * size_t(mCount[0]) + size_t(ci)];
+            const float* data = mData.data() + span.offset;
+            auto at = [&](int kk) {
+                const int i = kk - span.first;
+                return i < 0 ? 1.0 : i < span.count ? double(data[i]) : double(span.last);
+            };
+            return (1.0 - w) * at(k) + w * at(k + 1);
         };
         return (1.0 - v) * ((1.0 - u) * column(i, j) + u * column(i + 1, j)) +
                v * ((1.0 - u) * column(i, j + 1) + u * column(i + 1, j + 1));
@@ -483,7 +597,7 @@ private:
         }
     };
 
-    void march(Intersector& inter, openvdb::tree::ValueAccessor<const openvdb::FloatTree>& acc, bool levelSet,
+    void march(Intersector& inter, DensityReader& acc, bool levelSet,
                const Vec3d& start, double length, double sigmaPerVoxel, Column& column) const
     {
         if (!inter.setWorldRay(VdbRay(start, mW, 0.0, length))) return;
@@ -522,7 +636,13 @@ private:
     bool mLinear = false;
     Vec3d mRow[3], mOffset;    ///< index space to lattice coordinates, for a linear transform
     int mCount[2];
-    std::vector<Column> mColumns;
+    struct Span {         ///< a column in mData
+        int first, count; ///< lattice index of its first value, and how many
+        float last;       ///< the transmittance past its last value
+        uint32_t offset;
+    };
+    std::vector<Span> mSpans;
+    std::vector<float> mData;
 };
 
 /// One light's shadow: a deep shadow map for a directional light, a grid of marches for a point light.
@@ -553,21 +673,22 @@ Image renderVolume(const FloatGrid& density, const openvdb::Vec3SGrid* color, co
     auto body = [&] {
         const openvdb::BoolGrid::Ptr mask = rayMask(density, levelSet);
         const FloatGrid::Ptr blocks = constantLeavesAsTiles(density);
+        const PaddedLeaves padded(blocks->tree());
         std::vector<Shadow> shadows(lights.size());
         for (size_t l = 0; l < lights.size(); ++l) {
             if (lights[l].type == Light::Type::Directional)
-                shadows[l].map = std::make_unique<ShadowMap>(*blocks, *mask, levelSet, lights[l].direction,
+                shadows[l].map = std::make_unique<ShadowMap>(*blocks, padded, *mask, levelSet, lights[l].direction,
                     sigmaPerVoxel, voxel * std::max(1, settings.shadowCacheVoxels));
             else
-                shadows[l].cache = pointLightCache(*blocks, *mask, levelSet, lights[l], sigmaPerVoxel, settings);
+                shadows[l].cache = pointLightCache(*blocks, padded, *mask, levelSet, lights[l], sigmaPerVoxel, settings);
         }
         const Intersector master(*mask);
         tbb::parallel_for(tbb::blocked_range2d<int>(0, image.height, 16, 0, image.width, 16),
                           [&](const tbb::blocked_range2d<int>& tile) {
             Intersector inter(master);
-            openvdb::tree::ValueAccessor<const openvdb::FloatTree> acc(blocks->tree());
-            std::unique_ptr<openvdb::tree::ValueAccessor<const openvdb::Vec3STree>> colors;
-            if (color) colors = std::make_unique<openvdb::tree::ValueAccessor<const openvdb::Vec3STree>>(color->tree());
+            DensityReader acc(blocks->tree(), padded);
+            std::unique_ptr<ColorReader> colors;
+            if (color) colors = std::make_unique<ColorReader>(color->tree());
             std::vector<std::unique_ptr<openvdb::tree::ValueAccessor<const openvdb::FloatTree>>> cacheAcc(lights.size());
             for (size_t l = 0; l < lights.size(); ++l)
                 if (shadows[l].cache)
@@ -594,24 +715,18 @@ Image renderVolume(const FloatGrid& density, const openvdb::Vec3SGrid* color, co
                                     henyeyGreenstein(light.direction.unit().dot(-ray.direction), medium.anisotropy));
                             }
                             const Medium1D line{inter.getIndexPos(0.0), inter.getIndexPos(1.0) - inter.getIndexPos(0.0), levelSet};
-                            // Each piece of the ray inside one interpolation cell is cut into n equal
-                            // steps of at most h voxels. Each step's optical depth is exact (the
-                            // integral of the trilinear density, see Piece). The source (emission plus
-                            // the light scattered toward the camera) is evaluated where the ray enters
-                            // and leaves the cell and taken linearly in between, at each step's middle.
-                            openvdb::Vec3s colorCorners[2][2][2];
-                            Vec3d cellOrigin(0.0);
-                            bool cornersValid = false; // colorCorners hold the current cell's colours
+                            // Each piece of the ray inside one interpolation cell (or constant block) is
+                            // cut into equal steps of at most h voxels. Each step's optical depth is
+                            // exact (the integral of the trilinear density, see Piece). The source S
+                            // (emission plus albedo times the light reaching the point) is evaluated at
+                            // knots along the ray, at the first step end at least one voxel after the
+                            // previous knot (so 1 to 1 + h voxels apart), and taken linearly in between:
+                            // each step adds a = T (1 - e^-tau) times S at its middle. A and B sum a and
+                            // a (t - knot) until the next knot, which closes them.
                             auto sourceAt = [&](double t) {
                                 const Vec3d ip = line.eye + line.dir * t;
                                 Vec3d albedo(medium.albedo);
-                                if (colors) {
-                                    if (!cornersValid) {
-                                        cellOrigin = Vec3d(std::floor(ip.x()), std::floor(ip.y()), std::floor(ip.z()));
-                                        cornerValues(*colors, Coord::floor(ip), colorCorners);
-                                    }
-                                    albedo = trilinear(colorCorners, ip - cellOrigin) * medium.albedo;
-                                }
+                                if (colors) albedo = colors->at(ip) * medium.albedo;
                                 Vec3d source = medium.emission;
                                 for (size_t l = 0; l < lights.size(); ++l) {
                                     const Light& light = lights[l];
@@ -632,64 +747,65 @@ Image renderVolume(const FloatGrid& density, const openvdb::Vec3SGrid* color, co
                                 }
                                 return source;
                             };
-                            double lastEnd = -1.0; // where the previous piece ended, and its source there
-                            Vec3d lastSource(0.0);
-                            auto shade = [&](const Cell& cell, double ta, double tb) {
-                                if (cell.block) {
-                                    // Constant density across a block: pieces of at most 2 voxels
-                                    // (the source's spacing in cells), steps of at most h.
-                                    cornersValid = false;
-                                    const double rho = levelSet ? (cell.lo < 0.0f ? 1.0 : 0.0) : double(cell.hi);
-                                    const int m = std::max(1, int(std::ceil((tb - ta) * 0.5 - 1e-9)));
-                                    const double length = (tb - ta) / m;
-                                    const int n = std::max(1, int(std::ceil(length / h - 1e-9)));
-                                    const double transmitted = expNegative(sigmaPerVoxel * rho * (length / n));
-                                    for (int j = 0; j < m; ++j) {
-                                        const double pa = ta + j * length, pb = j + 1 == m ? tb : pa + length;
-                                        const Vec3d sourceIn = pa == lastEnd ? lastSource : sourceAt(pa);
-                                        const Vec3d sourceOut = sourceAt(pb);
-                                        lastEnd = pb;
-                                        lastSource = sourceOut;
-                                        for (int k = 0; k < n; ++k) {
-                                            const double w = (k + 0.5) / n;
-                                            L += (T * (1.0 - transmitted)) * (sourceIn + (sourceOut - sourceIn) * w);
-                                            T *= transmitted;
-                                            if (T <= kMinTransmittance) return false;
-                                        }
-                                    }
-                                    return true;
+                            bool open = false;     // a knot is placed and steps since it are pending
+                            double knot = 0.0, A = 0.0, B = 0.0, lastEnd = -1.0;
+                            Vec3d knotSource(0.0);
+                            auto close = [&](double t) { // a knot at t: settle the steps since the last
+                                const Vec3d next = sourceAt(t);
+                                if (A > 0.0) L += knotSource * A + (next - knotSource) * (t > knot ? B / (t - knot) : 0.0);
+                                knot = t;
+                                knotSource = next;
+                                A = B = 0.0;
+                            };
+                            // Steps of one piece [ta, tb]: n steps of length dt, optical depth from tauOf.
+                            auto march = [&](double ta, double tb, int n, auto&& tauOf) {
+                                if (!open || ta != lastEnd) { // a gap: settle the run before it
+                                    if (open) close(lastEnd);
+                                    knot = ta;
+                                    knotSource = sourceAt(ta);
+                                    A = B = 0.0;
+                                    open = true;
                                 }
-                                if (colors) cornerValues(*colors, cell.origin, colorCorners);
-                                cornersValid = true;
-                                cellOrigin = Vec3d(cell.origin.x(), cell.origin.y(), cell.origin.z());
-                                const Vec3d sourceIn = ta == lastEnd ? lastSource : sourceAt(ta);
-                                const Vec3d sourceOut = sourceAt(tb);
-                                lastEnd = tb;
-                                lastSource = sourceOut;
-                                const int n = std::max(1, int(std::ceil((tb - ta) / h - 1e-9)));
                                 const double dt = (tb - ta) / n;
+                                for (int k = 0; k < n; ++k) {
+                                    const double tau = tauOf(k, dt);
+                                    const double end = k + 1 == n ? tb : ta + (k + 1) * dt;
+                                    if (tau > 0.0) {
+                                        const double transmitted = expNegative(tau);
+                                        const double a = T * (1.0 - transmitted);
+                                        A += a;
+                                        B += a * (end - 0.5 * dt - knot);
+                                        T *= transmitted;
+                                    }
+                                    if (T <= kMinTransmittance) {
+                                        close(end);
+                                        open = false;
+                                        return false;
+                                    }
+                                    if (end - knot >= 1.0) close(end);
+                                }
+                                lastEnd = tb;
+                                return true;
+                            };
+                            auto shade = [&](const Cell& cell, double ta, double tb) {
+                                const int n = std::max(1, int(std::ceil((tb - ta) / h - 1e-9)));
+                                if (cell.block) {
+                                    const double rho = levelSet ? (cell.lo < 0.0f ? 1.0 : 0.0) : double(cell.hi);
+                                    return march(ta, tb, n, [&](int, double dt) { return sigmaPerVoxel * rho * dt; });
+                                }
                                 const Piece piece(line, cell, ta);
                                 double before = 0.0; // piece.mass at the start of step k
-                                for (int k = 0; k < n; ++k) {
-                                    double tau;
-                                    if (piece.exact) {
-                                        const double after = piece.mass((k + 1) * dt);
-                                        tau = sigmaPerVoxel * (after - before);
-                                        before = after;
-                                    } else {
-                                        tau = sigmaPerVoxel * line.mass(cell, ta + k * dt, ta + (k + 1) * dt);
-                                    }
-                                    if (!(tau > 0.0)) continue;
-                                    const double transmitted = expNegative(tau);
-                                    const double w = (k + 0.5) / n;
-                                    L += (T * (1.0 - transmitted)) * (sourceIn + (sourceOut - sourceIn) * w);
-                                    T *= transmitted;
-                                    if (T <= kMinTransmittance) return false;
-                                }
-                                return true;
+                                return march(ta, tb, n, [&](int k, double dt) {
+                                    if (!piece.exact) return sigmaPerVoxel * line.mass(cell, ta + k * dt, ta + (k + 1) * dt);
+                                    const double after = piece.mass((k + 1) * dt);
+                                    const double tau = sigmaPerVoxel * (after - before);
+                                    before = after;
+                                    return tau;
+                                });
                             };
                             double t0 = 0, t1 = 0;
                             while (inter.march(t0, t1) && walkCells(acc, line, t0, t1, shade)) {}
+                            if (open) close(lastEnd);
                         }
                         r += L.x();
                         g += L.y();

@@ -9,12 +9,13 @@
 // its optical depth is integrated exactly: alpha has no step error, no sample lattice and so no
 // banding, whatever the step. Cells inside an 8^3 block of one value (a tile, or a leaf whose
 // values are all equal) are crossed as one piece.
-// Each piece is cut into equal steps of at most `stepVoxels`; each step adds T (1 - e^-tau) S and
-// multiplies T by e^-tau, tau being the step's exact optical depth and S the source (emission plus
-// albedo times the light reaching the point), evaluated where the ray enters and leaves each cell
-// (every 2 voxels at most inside a constant block) and taken linearly in between. That is the only
-// approximation along the ray: second order in the cell size, on a quantity that the shadow
-// lookup already smooths over `shadowCacheVoxels`. Marching stops when T < 1e-4.
+// Each piece is cut into equal steps of at most `stepVoxels`; each step adds T (1 - e^-tau) S at its
+// middle and multiplies T by e^-tau, tau being the step's exact optical depth. The source S
+// (emission plus albedo times the light reaching the point) is evaluated at knots along the ray,
+// the first step end at least one voxel after the previous knot (so knots are 1 to 1 + step voxels
+// apart), and taken linearly in between. That is the only approximation along the ray: second
+// order in the knot spacing, on a quantity that the shadow lookup already smooths over
+// `shadowCacheVoxels`. Marching stops when T < 1e-4.
 //
 // Shadows: for a directional light, a deep shadow map (Lokovic and Veach 2000): columns parallel to
 // the light every `shadowCacheVoxels` voxels, each integrated exactly cell by cell through the
