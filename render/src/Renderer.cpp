@@ -356,14 +356,18 @@ struct DensityReader {
 /// (Amanatides and Woo's 3D DDA), calling visit(cell, t0, t1) for each piece whose cell has a
 /// non-zero density somewhere; stops early when visit returns false. Returns false if stopped.
 /// Where the ray enters an 8^3 block that has no leaf (one tile value, or the background), every
-/// cell within the block's [b, b + 7]^3 is constant: the whole crossing is one piece, marked
-/// Cell::block.
+/// cell within the block's [b, b + 7]^3 is constant: the whole crossing is one piece. Consecutive
+/// pieces of one constant density (such blocks, cells of one value, level-set cells wholly inside)
+/// are visited as one piece marked Cell::block.
 template <typename Visit>
 bool walkCells(DensityReader& reader, const Medium1D& ray, double ta, double tb, Visit&& visit)
 {
     int cell[3], step[3];
     double next[3], delta[3];
-    Cell c;
+    Cell c, run;
+    bool pending = false; // a run of constant pieces not yet visited: [runStart, pendingEnd]
+    double runStart = 0.0, pendingEnd = 0.0;
+    float pendingRho = 0.0f;
     double t = ta;
     while (t < tb) {
         const Vec3d start = ray.eye + ray.dir * t;
@@ -411,7 +415,28 @@ bool walkCells(DensityReader& reader, const Medium1D& ray, double ta, double tb,
             }
             if (t1 > t) {
                 openvdb::tools::BoxSampler::extrema(c.v, c.lo, c.hi);
-                if ((ray.levelSet ? c.lo < 0.0f : c.hi > 0.0f) && !visit(c, t, t1)) return false;
+                const bool empty = ray.levelSet ? c.lo >= 0.0f : c.hi <= 0.0f;
+                // Constant density along the piece: a fog cell of one value, a level-set cell
+                // wholly inside.
+                const bool constant = c.block || (ray.levelSet ? c.hi < 0.0f : c.lo == c.hi);
+                const float rho = ray.levelSet ? 1.0f : c.hi;
+                if (pending && !(constant && !empty && rho == pendingRho && t == pendingEnd)) {
+                    pending = false;
+                    if (!visit(run, runStart, pendingEnd)) return false;
+                }
+                if (constant && !empty) {
+                    // Runs of constant pieces of one density are visited as one piece.
+                    if (!pending) {
+                        pending = true;
+                        run = c;
+                        run.block = true;
+                        runStart = t;
+                        pendingRho = rho;
+                    }
+                    pendingEnd = t1;
+                } else if (!empty && !visit(c, t, t1)) {
+                    return false;
+                }
             }
             t = t1;
             if (!restart) {
@@ -420,7 +445,7 @@ bool walkCells(DensityReader& reader, const Medium1D& ray, double ta, double tb,
             }
         }
     }
-    return true;
+    return !pending || visit(run, runStart, pendingEnd);
 }
 
 /// Optical depth (index units times sigma) from world point p along `direction` for up to
@@ -767,11 +792,15 @@ Image renderVolume(const FloatGrid& density, const openvdb::Vec3SGrid* color, co
                                     open = true;
                                 }
                                 const double dt = (tb - ta) / n;
+                                double lastTau = -1.0, transmitted = 1.0;
                                 for (int k = 0; k < n; ++k) {
                                     const double tau = tauOf(k, dt);
                                     const double end = k + 1 == n ? tb : ta + (k + 1) * dt;
                                     if (tau > 0.0) {
-                                        const double transmitted = expNegative(tau);
+                                        if (tau != lastTau) { // equal steps of a constant piece: once
+                                            lastTau = tau;
+                                            transmitted = expNegative(tau);
+                                        }
                                         const double a = T * (1.0 - transmitted);
                                         A += a;
                                         B += a * (end - 0.5 * dt - knot);
