@@ -73,21 +73,6 @@ openvdb::BoolGrid::Ptr rayMask(const FloatGrid& density, bool levelSet)
     return mask;
 }
 
-/// A copy of `density` in which every leaf whose 512 values are equal is a tile of that value
-/// (interpolation reads values, never active states): walkCells crosses such blocks in one piece.
-FloatGrid::Ptr constantLeavesAsTiles(const FloatGrid& density)
-{
-    FloatGrid::Ptr grid = density.deepCopy();
-    std::vector<std::pair<Coord, float>> constant;
-    for (auto leaf = grid->tree().cbeginLeaf(); leaf; ++leaf) {
-        const float* d = leaf->buffer().data();
-        if (std::all_of(d + 1, d + openvdb::FloatTree::LeafNodeType::SIZE, [d](float v) { return v == d[0]; }))
-            constant.emplace_back(leaf->origin(), d[0]);
-    }
-    for (const auto& [origin, value] : constant) grid->tree().addTile(1, origin, value, true);
-    return grid;
-}
-
 /// Trilinear interpolation of eight colours at local coordinates u in [0, 1]^3.
 inline Vec3d trilinear(const openvdb::Vec3s (&v)[2][2][2], const Vec3d& u)
 {
@@ -132,37 +117,12 @@ struct Medium1D {
     bool levelSet;
 
     /// The integral of the density along [ta, tb] within `cell`. For a fog whose corners are all
-    /// non-negative the trilinear interpolant is a cubic polynomial along the ray, which two-point
-    /// Gauss-Legendre quadrature integrates exactly. A level set's density is 1 where the
+    /// non-negative the trilinear interpolant is a cubic polynomial along the ray, integrated in
+    /// closed form (Piece). A level set's density is 1 where the
     /// interpolated distance is negative: the length of that part, with each zero crossing placed
     /// by linear interpolation between the ends and the midpoint. A fog with negative corners
     /// (negative densities count as 0): the clamped value at four midpoints.
-    double mass(const Cell& cell, double ta, double tb) const
-    {
-        const double length = tb - ta;
-        const Vec3d base = eye - Vec3d(cell.origin.x(), cell.origin.y(), cell.origin.z());
-        auto local = [&](double t) { return base + dir * t; };
-        if (!levelSet) {
-            if (cell.hi <= 0.0f) return 0.0;
-            if (cell.lo >= 0.0f) {
-                const double mid = 0.5 * (ta + tb), half = 0.5 * length * 0.57735026918962576;
-                return 0.5 * length * (cell.at(local(mid - half)) + cell.at(local(mid + half)));
-            }
-            double sum = 0.0;
-            for (int k = 0; k < 4; ++k) sum += std::max(0.0, cell.at(local(ta + (k + 0.5) * 0.25 * length)));
-            return 0.25 * length * sum;
-        }
-        if (cell.lo >= 0.0f) return 0.0;
-        if (cell.hi < 0.0f) return length;
-        const double f0 = cell.at(local(ta)), f1 = cell.at(local(0.5 * (ta + tb))), f2 = cell.at(local(tb));
-        auto inside = [](double a, double b, double h) { // length of the negative part of a linear piece
-            if (a < 0.0 && b < 0.0) return h;
-            if (a >= 0.0 && b >= 0.0) return 0.0;
-            const double crossing = a / (a - b) * h; // from the start
-            return a < 0.0 ? crossing : h - crossing;
-        };
-        return inside(f0, f1, 0.5 * length) + inside(f1, f2, 0.5 * length);
-    }
+    double mass(const Cell& cell, double ta, double tb) const;
 };
 
 /// The density along one piece of a ray inside one cell, as a polynomial in s = t - ta (voxels), for
@@ -204,6 +164,30 @@ struct Piece {
     double mass(double s) const { return s * (c[0] + s * (0.5 * c[1] + s * (c[2] * (1.0 / 3.0) + s * 0.25 * c[3]))); }
 };
 
+double Medium1D::mass(const Cell& cell, double ta, double tb) const
+{
+    const double length = tb - ta;
+    const Vec3d base = eye - Vec3d(cell.origin.x(), cell.origin.y(), cell.origin.z());
+    auto local = [&](double t) { return base + dir * t; };
+    if (!levelSet) {
+        if (cell.hi <= 0.0f) return 0.0;
+        if (cell.lo >= 0.0f) return Piece(*this, cell, ta).mass(length);
+        double sum = 0.0;
+        for (int k = 0; k < 4; ++k) sum += std::max(0.0, cell.at(local(ta + (k + 0.5) * 0.25 * length)));
+        return 0.25 * length * sum;
+    }
+    if (cell.lo >= 0.0f) return 0.0;
+    if (cell.hi < 0.0f) return length;
+    const double f0 = cell.at(local(ta)), f1 = cell.at(local(0.5 * (ta + tb))), f2 = cell.at(local(tb));
+    auto inside = [](double a, double b, double h) { // length of the negative part of a linear piece
+        if (a < 0.0 && b < 0.0) return h;
+        if (a >= 0.0 && b >= 0.0) return 0.0;
+        const double crossing = a / (a - b) * h; // from the start
+        return a < 0.0 ? crossing : h - crossing;
+    };
+    return inside(f0, f1, 0.5 * length) + inside(f1, f2, 0.5 * length);
+}
+
 /// e^-x for x >= 0; a short series where x is small (the common case of one step of a thin medium,
 /// relative error below 1e-10 for x < 0.05).
 inline double expNegative(double x)
@@ -215,7 +199,9 @@ inline double expNegative(double x)
 
 /// Each leaf's values plus one more layer on its +x, +y and +z sides (read from the neighbours):
 /// the eight corners of every cell whose origin lies in the leaf, so that reading them is eight
-/// loads, also for cells that straddle two, four or eight leaves.
+/// loads, also for cells that straddle two, four or eight leaves. A leaf whose 512 values are equal
+/// is left out: readers treat it as a tile of that value (interpolation reads values, never active
+/// states), which walkCells crosses in one piece.
 class PaddedLeaves
 {
 public:
@@ -226,7 +212,10 @@ public:
     {
         std::vector<const Leaf*> leaves;
         leaves.reserve(tree.leafCount());
-        for (auto it = tree.cbeginLeaf(); it; ++it) leaves.push_back(&*it);
+        for (auto it = tree.cbeginLeaf(); it; ++it) {
+            const float* d = it->buffer().data();
+            if (!std::all_of(d + 1, d + Leaf::SIZE, [d](float v) { return v == d[0]; })) leaves.push_back(&*it);
+        }
         mValues.resize(leaves.size() * kSize);
         tbb::parallel_for(tbb::blocked_range<size_t>(0, leaves.size(), 16), [&](const tbb::blocked_range<size_t>& r) {
             openvdb::tree::ValueAccessor<const openvdb::FloatTree> acc(tree);
@@ -294,12 +283,12 @@ struct ColorReader {
 };
 
 /// One thread's reader of a cell's eight density values: the padded copy of the cell's leaf, or the
-/// tile value of a block without a leaf (remembered per 8^3 block).
+/// one value of a block that has none (a tile, the background, or a constant leaf).
 struct DensityReader {
     openvdb::tree::ValueAccessor<const openvdb::FloatTree> acc;
     const PaddedLeaves& padded;
-    /// A direct-mapped cache of 8^3 blocks: a block's padded values, or its tile value if it has
-    /// no leaf.
+    /// A direct-mapped cache of 8^3 blocks: a block's padded values, or its one value if it has
+    /// none.
     struct Block {
         Coord origin{std::numeric_limits<int>::max()};
         const float* values = nullptr;
@@ -323,7 +312,7 @@ struct DensityReader {
     }
 
     /// Fills `v` for the cell at `c` and returns true, or returns false (filling nothing, `tile` set)
-    /// if c's block has no leaf and c lies inside it (not on its +x, +y or +z face layer).
+    /// if c's block has one value and c lies inside it (not on its +x, +y or +z face layer).
     bool cell(const Coord& c, float (&v)[2][2][2])
     {
         const Coord b(c.x() & ~7, c.y() & ~7, c.z() & ~7);
@@ -355,7 +344,7 @@ struct DensityReader {
 /// Walks the interpolation cells that the index ray eye + t dir crosses for t in [ta, tb]
 /// (Amanatides and Woo's 3D DDA), calling visit(cell, t0, t1) for each piece whose cell has a
 /// non-zero density somewhere; stops early when visit returns false. Returns false if stopped.
-/// Where the ray enters an 8^3 block that has no leaf (one tile value, or the background), every
+/// Where the ray enters an 8^3 block of one value (a tile, the background, a constant leaf), every
 /// cell within the block's [b, b + 7]^3 is constant: the whole crossing is one piece. Consecutive
 /// pieces of one constant density (such blocks, cells of one value, level-set cells wholly inside)
 /// are visited as one piece marked Cell::block.
@@ -697,21 +686,20 @@ Image renderVolume(const FloatGrid& density, const openvdb::Vec3SGrid* color, co
 
     auto body = [&] {
         const openvdb::BoolGrid::Ptr mask = rayMask(density, levelSet);
-        const FloatGrid::Ptr blocks = constantLeavesAsTiles(density);
-        const PaddedLeaves padded(blocks->tree());
+        const PaddedLeaves padded(density.tree());
         std::vector<Shadow> shadows(lights.size());
         for (size_t l = 0; l < lights.size(); ++l) {
             if (lights[l].type == Light::Type::Directional)
-                shadows[l].map = std::make_unique<ShadowMap>(*blocks, padded, *mask, levelSet, lights[l].direction,
+                shadows[l].map = std::make_unique<ShadowMap>(density, padded, *mask, levelSet, lights[l].direction,
                     sigmaPerVoxel, voxel * std::max(1, settings.shadowCacheVoxels));
             else
-                shadows[l].cache = pointLightCache(*blocks, padded, *mask, levelSet, lights[l], sigmaPerVoxel, settings);
+                shadows[l].cache = pointLightCache(density, padded, *mask, levelSet, lights[l], sigmaPerVoxel, settings);
         }
         const Intersector master(*mask);
         tbb::parallel_for(tbb::blocked_range2d<int>(0, image.height, 16, 0, image.width, 16),
                           [&](const tbb::blocked_range2d<int>& tile) {
             Intersector inter(master);
-            DensityReader acc(blocks->tree(), padded);
+            DensityReader acc(density.tree(), padded);
             std::unique_ptr<ColorReader> colors;
             if (color) colors = std::make_unique<ColorReader>(color->tree());
             std::vector<std::unique_ptr<openvdb::tree::ValueAccessor<const openvdb::FloatTree>>> cacheAcc(lights.size());
