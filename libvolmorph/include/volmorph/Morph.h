@@ -9,8 +9,15 @@
 // of two clamped values, (1 - tau)(-w) + tau(+w), changes sign at tau = 1/2 everywhere at once: every
 // voxel inside one object and a few voxels outside the other would flip in one frame (the shape
 // snaps instead of morphing). So the Morpher first extends both distance fields over the box of
-// source and target together, plus a margin (OpenVDB's fast sweeping, tools::maskSdf), once; only
-// farther than that margin are distances clamped, where both sides are outside anyway.
+// source and target together, plus a margin, once: the band's own values near the surface, beyond
+// them a field at twice the voxel size filled in by OpenVDB's fast sweeping (tools::maskSdf).
+//
+// A frame evaluates the blend only where its band can be. The blend's gradient is at most the
+// warp's stretch G (distances change by at most one per unit), so a leaf or a quarter of a leaf
+// whose centre value is farther from zero than G times its reach plus the band is inside or outside
+// as a whole, judged from that one value. In the rest, dust is removed (blend.min_island), the
+// band is rebuilt to first order (|b| / |grad b|, never beyond an edge's zero crossing), and the
+// fog is derived from it. frameOverBox() evaluates every voxel instead: the tests' reference.
 #pragma once
 
 #include <volmorph/Interrupter.h>
@@ -25,6 +32,7 @@ namespace volmorph {
 
 namespace detail {
 class Occupancy;
+class ExtendedDistance;
 }
 
 struct MorphOptions {
@@ -45,6 +53,7 @@ struct MorphStats {
     uint64_t candidateLeaves = 0;      ///< output leaves evaluated
     uint64_t outputLeaves = 0;         ///< output leaves kept (non-empty)
     uint64_t activeVoxels = 0;         ///< of the density grid, tiles included
+    uint64_t blendSamples = 0;         ///< sdf mode: points where the blend was evaluated
 };
 
 class Morpher {
@@ -71,10 +80,15 @@ public:
 private:
     VolumeSet run(double t, const openvdb::CoordBBox& box, bool prune, double tolerance, MorphStats* stats,
                   Interrupter* interrupter) const;
+    VolumeSet runSdf(double t, const openvdb::CoordBBox& box, bool prune, double tolerance, MorphStats* stats,
+                     Interrupter* interrupter) const;
+    template <typename Sampler>
+    VolumeSet runSdf(double t, const openvdb::CoordBBox& box, bool prune, double tolerance, MorphStats* stats,
+                     Interrupter* interrupter) const;
 
     VolumeSet mSource, mTarget;
     /// sdf mode: the source's and target's distances extended over both objects' box (see above).
-    openvdb::FloatGrid::Ptr mWideSdfSource, mWideSdfTarget;
+    std::shared_ptr<const detail::ExtendedDistance> mFarSource, mFarTarget;
     /// Which 8^3 blocks of source and target are occupied; they do not change with t.
     std::shared_ptr<const detail::Occupancy> mSourceBlocks, mTargetBlocks;
     std::vector<FeaturePairSpec> mPairs;

@@ -89,6 +89,7 @@ struct AdaptiveWarp::Context {
     const Occupancy* source;
     const Occupancy* target;
     const LeafFunction* fn;
+    const CellFilter* wanted;
     WarpLeaf leaf;
     double maxError = 0.0;
     uint64_t evaluations = 0, leaves = 0;
@@ -187,7 +188,8 @@ CoordBBox imageBox(const Vec3d points[27], double margin)
 
 void AdaptiveWarp::cell(Context& ctx, const Coord& origin, int size, const Corners& corners, bool locked) const
 {
-    if (!ctx.box.hasOverlap(CoordBBox::createCube(origin, size))) return;
+    const CoordBBox cube = CoordBBox::createCube(origin, size);
+    if (!ctx.box.hasOverlap(cube) || (ctx.wanted && !(*ctx.wanted)(cube))) return;
     auto map = [this](const Vec3d& p, Vec3d& s, Vec3d& t) { mWarp.map(p, s, t); };
     Context::Lattice l;
     const double error = evaluateLattice(map, origin, size, corners.s, corners.t, locked, l.s, l.t, ctx.evaluations);
@@ -216,7 +218,9 @@ void AdaptiveWarp::cell(Context& ctx, const Coord& origin, int size, const Corne
     }
     ctx.leaf.origin = origin;
     ++ctx.leaves;
-    if (mTolerance == 0.0) {
+    if (mWarp.pairCount() == 0) {
+        fillIdentity(ctx, origin);
+    } else if (mTolerance == 0.0) {
         exactBlock(ctx, origin, 8);
     } else if (lock) {
         fillTrilinear(ctx, origin, 8, corners);
@@ -246,6 +250,17 @@ void AdaptiveWarp::exactBlock(Context& ctx, const Coord& origin, int size) const
                 ctx.leaf.target[n] = Vec3f(t);
             }
     ctx.evaluations += uint64_t(size) * size * size;
+}
+
+void AdaptiveWarp::fillIdentity(Context& ctx, const Coord& origin) const
+{
+    for (int i = 0; i < 8; ++i)
+        for (int j = 0; j < 8; ++j)
+            for (int k = 0; k < 8; ++k) {
+                const Vec3f p(float(origin.x() + i), float(origin.y() + j), float(origin.z() + k));
+                ctx.leaf.source[(i * 8 + j) * 8 + k] = p;
+                ctx.leaf.target[(i * 8 + j) * 8 + k] = p;
+            }
 }
 
 void AdaptiveWarp::fillTrilinear(Context& ctx, const Coord& origin, int size, const Corners& corners) const
@@ -281,7 +296,8 @@ void AdaptiveWarp::quarter(Context& ctx, const Coord& origin, const Corners& cor
 }
 
 void AdaptiveWarp::forEachLeaf(const CoordBBox& box, const Occupancy* source, const Occupancy* target,
-                               const LeafFunction& fn, AdaptiveWarpStats* stats, Interrupter* interrupter) const
+                               const LeafFunction& fn, AdaptiveWarpStats* stats, Interrupter* interrupter,
+                               const CellFilter* wanted) const
 {
     if (box.empty()) return;
     auto down = [](int v) { return v >= 0 ? v / kTopCell * kTopCell : -((-v + kTopCell - 1) / kTopCell) * kTopCell; };
@@ -299,6 +315,7 @@ void AdaptiveWarp::forEachLeaf(const CoordBBox& box, const Occupancy* source, co
         ctx->source = source;
         ctx->target = target;
         ctx->fn = &fn;
+        ctx->wanted = wanted;
         for (size_t i = r.begin(); i != r.end(); ++i) {
             if (stopped || (interrupter && interrupter->wasInterrupted(int(100 * i / tops.size())))) {
                 stopped = true;

@@ -71,13 +71,17 @@ public:
     AdaptiveWarp(const InverseWarp& warp, double toleranceVoxels, double epsilonVoxels);
 
     using LeafFunction = std::function<void(const WarpLeaf&)>;
+    /// "Is any leaf of this cell (output index space) wanted?"; cells answered no are skipped
+    /// before any of their points is evaluated.
+    using CellFilter = std::function<bool(const openvdb::CoordBBox&)>;
 
     /// Calls fn, in parallel, for every leaf in `box` (output index space) that may be non-empty
-    /// by the occupancies (nullptr on both: every leaf of the box). Deterministic: each leaf's
-    /// positions depend only on the leaf, not on threads or order.
+    /// by the occupancies (nullptr on both: every leaf of the box) and that `wanted` (if given)
+    /// accepts. Deterministic: each leaf's positions depend only on the leaf, not on threads or
+    /// order.
     void forEachLeaf(const openvdb::CoordBBox& box, const Occupancy* source, const Occupancy* target,
                      const LeafFunction& fn, AdaptiveWarpStats* stats = nullptr,
-                     Interrupter* interrupter = nullptr) const;
+                     Interrupter* interrupter = nullptr, const CellFilter* wanted = nullptr) const;
 
     /// Every top cell is this many voxels on a side.
     static constexpr int kTopCell = 64;
@@ -91,6 +95,8 @@ private:
     void quarter(Context& ctx, const openvdb::Coord& origin, const Corners& corners) const;
     void exactBlock(Context& ctx, const openvdb::Coord& origin, int size) const;
     void fillTrilinear(Context& ctx, const openvdb::Coord& origin, int size, const Corners& corners) const;
+    /// No pairs: the warp is the identity on both sides.
+    void fillIdentity(Context& ctx, const openvdb::Coord& origin) const;
     /// True when the cell is too large next to some element to be interpolated, whatever the
     /// lattice check says.
     bool nearElement(const openvdb::Coord& origin, int size) const;
