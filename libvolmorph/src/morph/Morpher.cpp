@@ -425,18 +425,15 @@ class SdfFrame {
 public:
     SdfFrame(const VolumeSet& source, const VolumeSet& target, const detail::ExtendedDistance& farSource,
              const detail::ExtendedDistance& farTarget, const InverseWarp& warp, float tauSdf, float tauColor,
-             Vec3f background)
+             Vec3f background, double toleranceVoxels)
         : mSource(source), mTarget(target), mFarSource(farSource), mFarTarget(farTarget), mWarp(warp), mTau(tauSdf),
           mTauColor(tauColor), mBackground(background), mVoxel(float(source.voxelSize())),
           mWidth(std::min(source.sdf->background(), target.sdf->background()) / mVoxel),
-          mSlack(std::max(farSource.transitionError(), farTarget.transitionError()) + 0.5f)
+          // The extended fields' slack, and the approximated warp's error: leaves are judged with
+          // the exact warp at their centres, their voxels evaluated with the approximated one.
+          mSlack(std::max(farSource.transitionError(), farTarget.transitionError()) + 0.5f + float(toleranceVoxels))
     {
     }
-
-    /// The blend at p' (output index space), world units, and the warped points.
-    struct Sample {
-        openvdb::Vec3R source, target;
-    };
 
     /// Classifies the leaves of `box`. With `prune` false every leaf is evaluated (the reference).
     void classify(const CoordBBox& box, bool prune)
@@ -857,7 +854,7 @@ VolumeSet Morpher::runSdf(double t, const CoordBBox& box, bool prune, double tol
     const float tauC = float(mBlend.color.evaluate(t)), tauS = float(mBlend.sdf.evaluate(t));
     const Vec3f background = (1.0f - tauC) * mSource.color->background() + tauC * mTarget.color->background();
 
-    SdfFrame<Sampler> blend(mSource, mTarget, *mFarSource, *mFarTarget, warp, tauS, tauC, background);
+    SdfFrame<Sampler> blend(mSource, mTarget, *mFarSource, *mFarTarget, warp, tauS, tauC, background, tolerance);
     blend.classify(box, prune);
     const float band = blend.computeBand();
     LeafCollector leaves(t, mOptions.memoryLimitBytes, background);
