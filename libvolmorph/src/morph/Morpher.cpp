@@ -414,10 +414,6 @@ struct BlockClasses {
     }
 };
 
-} // namespace
-
-namespace {
-
 /// One sdf-mode frame: the blend of the two extended distances through their warps, evaluated
 /// only in the blocks that can hold its narrow band, redistanced there, with colour on the band.
 template <typename Sampler>
