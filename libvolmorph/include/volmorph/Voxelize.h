@@ -20,6 +20,8 @@
 //   barycentrically at the closest point on it.
 #pragma once
 
+#include <algorithm>
+
 #include <volmorph/Interrupter.h>
 #include <volmorph/Mesh.h>
 #include <volmorph/VolumeSet.h>
@@ -56,8 +58,16 @@ struct VoxelizeStats {
     uint64_t densityActiveVoxels = 0;   ///< including voxels of active tiles
 };
 
-/// A fog from a level set (world units): density = smoothstep of -sdf across [-ramp, +ramp] world
-/// units (0.5 on the surface), 1 in the interior as active tiles, 0 outside.
+/// The fog of a signed distance d (world units): smoothstep of -d across [-ramp, +ramp], 0.5 on
+/// the surface.
+inline float fogRamp(float d, float rampWorld)
+{
+    const float x = std::clamp(0.5f - d / (2.0f * rampWorld), 0.0f, 1.0f);
+    return x * x * (3.0f - 2.0f * x);
+}
+
+/// A fog from a level set (world units): density = fogRamp(sdf) on the band, 1 in the interior as
+/// active tiles, 0 outside.
 openvdb::FloatGrid::Ptr fogFromLevelSet(const openvdb::FloatGrid& sdf, float rampWorld);
 
 /// The voxel size the options give for `mesh` (world units).

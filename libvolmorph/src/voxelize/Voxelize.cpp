@@ -174,15 +174,11 @@ FloatGrid::Ptr fogFromLevelSet(const FloatGrid& sdf, float rampWorld)
 {
     FloatGrid::Ptr density = sdf.deepCopy();
     FloatTree& tree = density->tree();
-    auto ramp = [rampWorld](float d) {
-        const float x = std::clamp(0.5f - d / (2.0f * rampWorld), 0.0f, 1.0f);
-        return x * x * (3.0f - 2.0f * x);
-    };
     openvdb::tree::LeafManager<FloatTree> leaves(tree);
     leaves.foreach([&](FloatTree::LeafNodeType& leaf, size_t) {
         for (auto it = leaf.beginValueAll(); it; ++it) {
             const float d = *it;
-            const float value = it.isValueOn() ? ramp(d) : (d < 0.0f ? 1.0f : 0.0f);
+            const float value = it.isValueOn() ? fogRamp(d, rampWorld) : (d < 0.0f ? 1.0f : 0.0f);
             it.setValue(value);
             it.setValueOn(value > 0.0f);
         }
