@@ -140,27 +140,6 @@ size_t dropIslands(openvdb::FloatGrid& values, int minVoxels, float outside, int
     return changed;
 }
 
-/// Makes `sdf` a level set of half width `width` (world units), in place: voxels at or beyond it
-/// become inactive with value +/- width, and constant leaves collapse into tiles.
-void narrowBand(openvdb::FloatGrid& sdf, float width)
-{
-    openvdb::tree::LeafManager<FloatTree> leaves(sdf.tree());
-    leaves.foreach([width](FloatTree::LeafNodeType& leaf, size_t) {
-        for (auto it = leaf.beginValueAll(); it; ++it)
-            if (!(std::abs(*it) < width) || !it.isValueOn()) {
-                it.setValue(*it < 0.0f ? -width : width);
-                it.setValueOff();
-            }
-    });
-    for (auto it = sdf.tree().beginValueOn(); it; ++it) // active tiles, if any: deep inside or outside
-        if (!it.isVoxelValue()) {
-            it.setValue(*it < 0.0f ? -width : width);
-            it.setValueOff();
-        }
-    openvdb::tools::changeLevelSetBackground(sdf.tree(), width);
-    openvdb::tools::pruneLevelSet(sdf.tree());
-}
-
 /// Colour weighted by each side's density (premultiplied), so an empty side contributes no colour.
 template <typename Sampler>
 struct ColorBlend {
@@ -578,37 +557,69 @@ public:
         return anyInside && !anyOutside ? -1 : (anyOutside && !anyInside ? 1 : 0);
     }
 
-    /// Rebuilds the band from the blend in place: each band voxel gets its distance to the blend's
-    /// zero set to first order, |b| / |grad b| by central differences, and never more than the
-    /// distance to a zero crossing on one of its six edges (found by linear interpolation, as
-    /// OpenVDB's fast sweeping seeds its front). Then the band is cut to the output width.
-    void redistance(openvdb::FloatGrid& values) const
+    /// Rebuilds the band from the blend in place and returns the fog derived from it, in one pass
+    /// over the leaves. Each band voxel gets its distance to the blend's zero set to first order,
+    /// |b| / |grad b| by central differences, and never more than the distance to a zero crossing
+    /// on one of its six edges (found by linear interpolation, as OpenVDB's fast sweeping seeds
+    /// its front). The band is then cut to the output width (voxels at or beyond it inactive,
+    /// +/- the width), and the fog is fogFromLevelSet's of the result: fogRamp(d, ramp) on the
+    /// band, 1 (active) inside, 0 outside.
+    openvdb::FloatGrid::Ptr redistance(openvdb::FloatGrid& values, float ramp) const
     {
+        using Leaf = FloatTree::LeafNodeType;
         openvdb::tree::LeafManager<FloatTree> leaves(values.tree(), 1);
         const float keep = mKeepBand, width = mWidth * mVoxel;
-        leaves.foreach([&](FloatTree::LeafNodeType& leaf, size_t index) {
+        std::vector<Leaf::NodeMaskType> bands(leaves.leafCount());
+        std::vector<std::unique_ptr<Leaf>> fogs(leaves.leafCount());
+        leaves.foreach([&](Leaf& leaf, size_t index) {
             openvdb::math::GradStencil<openvdb::FloatGrid> stencil(values);
             float* out = leaves.getBuffer(index, 1).data();
-            for (auto it = leaf.beginValueOn(); it; ++it) {
-                const float b = *it;
-                if (!(std::abs(b) < keep)) {
-                    out[it.pos()] = b < 0.0f ? -width : width;
-                    continue;
+            auto fog = std::make_unique<Leaf>(leaf.origin(), 0.0f, false);
+            Leaf::NodeMaskType& band = bands[index];
+            for (openvdb::Index n = 0; n < Leaf::SIZE; ++n) {
+                const float b = leaf.getValue(n);
+                float dist = width;
+                if (leaf.isValueOn(n) && std::abs(b) < keep) {
+                    stencil.moveTo(leaf.offsetToGlobalCoord(n), b);
+                    const float g = float(stencil.gradient().length()); // world-space, 1 for a distance
+                    if (g > 1e-6f) dist = std::abs(b) / g;
+                    const float e[6] = {stencil.template getValue<1, 0, 0>(), stencil.template getValue<-1, 0, 0>(),
+                                        stencil.template getValue<0, 1, 0>(), stencil.template getValue<0, -1, 0>(),
+                                        stencil.template getValue<0, 0, 1>(), stencil.template getValue<0, 0, -1>()};
+                    for (float v : e)
+                        if ((v < 0.0f) != (b < 0.0f)) dist = std::min(dist, mVoxel * std::abs(b) / (std::abs(b) + std::abs(v)));
+                    dist = std::min(dist, width);
                 }
-                stencil.moveTo(it.getCoord(), b);
-                const float g = float(stencil.gradient().length()); // world-space, 1 for a distance
-                float dist = g > 1e-6f ? std::abs(b) / g : width;
-                const float n[6] = {stencil.getValue<1, 0, 0>(), stencil.getValue<-1, 0, 0>(),
-                                    stencil.getValue<0, 1, 0>(), stencil.getValue<0, -1, 0>(),
-                                    stencil.getValue<0, 0, 1>(), stencil.getValue<0, 0, -1>()};
-                for (float v : n)
-                    if ((v < 0.0f) != (b < 0.0f)) dist = std::min(dist, mVoxel * std::abs(b) / (std::abs(b) + std::abs(v)));
-                dist = std::min(dist, width);
-                out[it.pos()] = b < 0.0f ? -dist : dist;
+                const float d = b < 0.0f ? -dist : dist;
+                const bool on = dist < width;
+                out[n] = d;
+                band.set(n, on);
+                const float density = on ? fogRamp(d, ramp) : (d < 0.0f ? 1.0f : 0.0f);
+                if (density > 0.0f) fog->setValueOn(n, density);
             }
+            fogs[index] = std::move(fog);
         });
         leaves.swapLeafBuffer(1);
-        narrowBand(values, width);
+        leaves.foreach([&bands](Leaf& leaf, size_t index) { leaf.setValueMask(bands[index]); });
+        FloatTree& tree = values.tree();
+        auto tiles = [](auto it) {
+            it.setMaxDepth(it.getLeafDepth() - 1);
+            return it;
+        };
+        for (auto it = tiles(tree.beginValueOn()); it; ++it) { // active tiles, if any: deep inside or outside
+            it.setValue(*it < 0.0f ? -width : width);
+            it.setValueOff();
+        }
+        openvdb::tools::changeLevelSetBackground(tree, width);
+
+        openvdb::FloatGrid::Ptr density = openvdb::FloatGrid::create(0.0f);
+        FloatTree& fog = density->tree();
+        for (auto& leaf : fogs) fog.addLeaf(leaf.release());
+        for (auto it = tiles(tree.cbeginValueAll()); it; ++it)
+            if (*it < 0.0f) fog.addTile(it.getLevel(), it.getCoord(), 1.0f, true);
+        openvdb::tools::prune(fog);
+        openvdb::tools::pruneLevelSet(tree);
+        return density;
     }
 
 private:
@@ -875,10 +886,9 @@ VolumeSet Morpher::runSdf(double t, const CoordBBox& box, bool prune, double tol
     const size_t kept = leaves.size();
     leaves.moveInto(values->tree(), out.color->tree(), -band);
     dropIslands(*values, mBlend.minIslandVoxels, band, blend.deepVoxels());
-    blend.redistance(*values);
+    out.density = blend.redistance(*values, kSdfRampVoxels * float(voxel));
     out.sdf = values;
     out.sdf->setName(kSdfGridName);
-    out.density = fogFromLevelSet(*out.sdf, kSdfRampVoxels * float(voxel));
     finish(out, mSource.density->transform(), stats, warpStats, kept);
     if (stats) stats->blendSamples = blend.samples();
     return out;
