@@ -19,6 +19,7 @@
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
+#include <tbb/parallel_invoke.h>
 #include <tbb/parallel_reduce.h>
 
 #include <atomic>
@@ -122,13 +123,17 @@ size_t dropIslands(openvdb::FloatGrid& values, int minVoxels, float outside, int
             }
         return false;
     };
-    const std::vector<openvdb::BoolTree::Ptr> islands = pieces(true);
+    // Both segmentations at once (each is partly serial); the exterior's again only when
+    // removing islands changed the values it was taken from.
+    std::vector<openvdb::BoolTree::Ptr> islands, gaps;
+    tbb::parallel_invoke([&] { islands = pieces(true); }, [&] { gaps = pieces(false); });
     for (size_t i = anyDeep ? 0 : 1; i < islands.size(); ++i)
         if (islands[i]->activeVoxelCount() < openvdb::Index64(minVoxels) && !(anyDeep && touchesDeep(*islands[i]))) {
             set(*islands[i], outside);
             ++changed;
         }
-    for (const openvdb::BoolTree::Ptr& gap : pieces(false)) {
+    if (changed > 0) gaps = pieces(false);
+    for (const openvdb::BoolTree::Ptr& gap : gaps) {
         if (gap->activeVoxelCount() >= openvdb::Index64(minVoxels)) continue;
         bool enclosed = true;
         for (auto it = gap->cbeginValueOn(); it && enclosed; ++it)
