@@ -6,6 +6,9 @@
 
 #include "warp/AdaptiveWarp.h" // private to the library; tested directly
 
+#include <openvdb/tools/Composite.h>
+#include <openvdb/tools/LevelSetSphere.h>
+
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -596,4 +599,43 @@ TEST(Morph, SdfModeDefaultSceneIsOneSurfaceChangingSmoothly)
     for (size_t i = 0; i + 1 < v.size(); ++i)
         EXPECT_LE(std::abs(v[i + 1] - v[i]), 3.0 * mean) << "between frames " << scene.frames.first + int(i)
                                                          << " and " << scene.frames.first + int(i) + 1;
+}
+
+// Dust removal (blend.min_island) in sdf mode, on a shape built by OpenVDB's own level-set tools:
+// a ball of radius 0.3 with a cavity of radius 1.5 voxels at its centre, and apart from it a speck
+// of radius 1.5 voxels (19 voxel centres inside each, fewer than the default 27). With identical
+// sides the blend is the shape itself: the speck must go and the cavity be filled; with
+// min_island 0 both stay.
+TEST(Morph, SdfModeDropsSpecksAndFillsBubbles)
+{
+    namespace tools = openvdb::tools;
+    const float voxel = 0.01f, width = 3.0f;
+    auto sphere = [&](float radius, const openvdb::Vec3f& centre) {
+        return tools::createLevelSetSphere<openvdb::FloatGrid>(radius, centre, voxel, width);
+    };
+    openvdb::FloatGrid::Ptr shape = sphere(0.3f, openvdb::Vec3f(0.0f));
+    tools::csgDifference(*shape, *sphere(1.5f * voxel, openvdb::Vec3f(0.0f)));
+    tools::csgUnion(*shape, *sphere(1.5f * voxel, openvdb::Vec3f(0.5f, 0.0f, 0.0f)));
+    VolumeSet side;
+    side.sdf = shape;
+    side.density = fogFromLevelSet(*shape, 1.5f * voxel);
+    side.color = openvdb::Vec3SGrid::create(openvdb::Vec3s(0.5f));
+    side.color->setTransform(shape->transform().copy());
+    const openvdb::Coord speck(50, 0, 0), cavity(0, 0, 0);
+    ASSERT_LT(shape->tree().getValue(speck), 0.0f);
+    ASSERT_GT(shape->tree().getValue(cavity), 0.0f);
+
+    BlendSpec blend;
+    blend.mode = BlendMode::Sdf;
+    ASSERT_EQ(blend.minIslandVoxels, 27);
+    const VolumeSet cleaned = Morpher(side, side, {}, WarpSpec{}, blend).frame(0.5);
+    EXPECT_GT(cleaned.sdf->tree().getValue(speck), 0.0f) << "the speck is dust";
+    EXPECT_LT(cleaned.sdf->tree().getValue(cavity), 0.0f) << "the cavity is a bubble";
+    EXPECT_EQ(surfaceMesh(cleaned).report.components, 1u);
+
+    blend.minIslandVoxels = 0;
+    const VolumeSet kept = Morpher(side, side, {}, WarpSpec{}, blend).frame(0.5);
+    EXPECT_LT(kept.sdf->tree().getValue(speck), 0.0f);
+    EXPECT_GT(kept.sdf->tree().getValue(cavity), 0.0f);
+    EXPECT_EQ(surfaceMesh(kept).report.components, 3u);
 }
