@@ -727,8 +727,9 @@ Morpher::Morpher(VolumeSet source, VolumeSet target, std::vector<FeaturePairSpec
             const int margin = std::max(8, std::max({dim.x(), dim.y(), dim.z()}) / 8);
             box.expand(margin);
         }
-        mFarSource = std::make_shared<const detail::ExtendedDistance>(mSource.sdf, box);
-        mFarTarget = std::make_shared<const detail::ExtendedDistance>(mTarget.sdf, box);
+        // Both at once: fast sweeping is partly serial.
+        tbb::parallel_invoke([&] { mFarSource = std::make_shared<const detail::ExtendedDistance>(mSource.sdf, box); },
+                             [&] { mFarTarget = std::make_shared<const detail::ExtendedDistance>(mTarget.sdf, box); });
     }
 }
 
