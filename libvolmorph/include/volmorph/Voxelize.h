@@ -66,8 +66,15 @@ inline float fogRamp(float d, float rampWorld)
     return x * x * (3.0f - 2.0f * x);
 }
 
-/// A fog from a level set (world units): density = fogRamp(sdf) on the band, 1 in the interior as
-/// active tiles, 0 outside.
+/// The fog of one level-set value d (world units): fogRamp on the band (`active`), 1 inside it, 0
+/// outside.
+inline float fogOfLevelSet(float d, bool active, float rampWorld)
+{
+    return active ? fogRamp(d, rampWorld) : (d < 0.0f ? 1.0f : 0.0f);
+}
+
+/// A fog from a level set (world units): fogOfLevelSet of every value, the interior as active
+/// tiles of 1.
 openvdb::FloatGrid::Ptr fogFromLevelSet(const openvdb::FloatGrid& sdf, float rampWorld);
 
 /// The voxel size the options give for `mesh` (world units).

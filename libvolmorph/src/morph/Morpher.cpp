@@ -657,7 +657,7 @@ public:
                 const bool on = dist < width;
                 out[n] = d;
                 band.set(n, on);
-                const float density = on ? fogRamp(d, ramp) : (d < 0.0f ? 1.0f : 0.0f);
+                const float density = fogOfLevelSet(d, on, ramp);
                 if (density > 0.0f) fog->setValueOn(n, density);
             }
             fogs[index] = std::move(fog);

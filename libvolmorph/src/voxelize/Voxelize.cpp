@@ -178,13 +178,14 @@ FloatGrid::Ptr fogFromLevelSet(const FloatGrid& sdf, float rampWorld)
     leaves.foreach([&](FloatTree::LeafNodeType& leaf, size_t) {
         for (auto it = leaf.beginValueAll(); it; ++it) {
             const float d = *it;
-            const float value = it.isValueOn() ? fogRamp(d, rampWorld) : (d < 0.0f ? 1.0f : 0.0f);
+            const float value = fogOfLevelSet(d, it.isValueOn(), rampWorld);
             it.setValue(value);
             it.setValueOn(value > 0.0f);
         }
     });
-    for (auto it = tree.beginValueAll(); it; ++it) {
-        if (it.isVoxelValue()) continue;
+    auto tiles = tree.beginValueAll();
+    tiles.setMaxDepth(tiles.getLeafDepth() - 1); // tiles only, not every voxel
+    for (auto it = tiles; it; ++it) {
         const bool inside = *it < 0.0f;
         it.setValue(inside ? 1.0f : 0.0f);
         it.setActiveState(inside);
