@@ -18,6 +18,9 @@
 // as a whole, judged from that one value. In the rest, dust is removed (blend.min_island), the
 // band is rebuilt to first order (|b| / |grad b|, never beyond an edge's zero crossing), and the
 // fog is derived from it. frameOverBox() evaluates every voxel instead: the tests' reference.
+// With no feature pairs the warp is the identity at every t: both extended distances at a voxel
+// are then the same in every frame, and are kept per leaf from the first frame that needs them
+// (the frames are the same bit for bit; only the blend's weight changes with t).
 #pragma once
 
 #include <volmorph/Interrupter.h>
@@ -33,6 +36,7 @@ namespace volmorph {
 namespace detail {
 class Occupancy;
 class ExtendedDistance;
+class IdentityDistances;
 }
 
 struct MorphOptions {
@@ -89,6 +93,9 @@ private:
     VolumeSet mSource, mTarget;
     /// sdf mode: the source's and target's distances extended over both objects' box (see above).
     std::shared_ptr<const detail::ExtendedDistance> mFarSource, mFarTarget;
+    /// sdf mode with no pairs: both extended distances at the output voxels, kept per leaf across
+    /// frames (the identity warp does not change with t). Bounded by a quarter of the memory limit.
+    std::shared_ptr<detail::IdentityDistances> mIdentity;
     /// Which 8^3 blocks of source and target are occupied; they do not change with t.
     std::shared_ptr<const detail::Occupancy> mSourceBlocks, mTargetBlocks;
     std::vector<FeaturePairSpec> mPairs;

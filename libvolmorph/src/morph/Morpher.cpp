@@ -10,7 +10,6 @@
 #include <openvdb/tools/FastSweeping.h>
 #include <openvdb/tools/Interpolation.h>
 #include <openvdb/tools/LevelSetUtil.h>
-#include <openvdb/tools/ChangeBackground.h>
 #include <openvdb/tools/Prune.h>
 #include <openvdb/tree/LeafManager.h>
 #include <openvdb/math/Mat3.h>
@@ -198,6 +197,21 @@ struct ColorBlend {
         const Vec3f ca = wa > 0.0f ? Vec3f(sample<Sampler>(cs, ps)) : Vec3f(0.0f);
         const Vec3f cb = wb > 0.0f ? Vec3f(sample<Sampler>(ct, pt)) : Vec3f(0.0f);
         return (wa * ca + wb * cb) / (wa + wb);
+    }
+    /// The same at voxel ijk of both sides (the identity warp). Trilinear weights there are 1 and
+    /// 0, so BoxSampler's value is the voxel's own: read it directly.
+    Vec3f atVoxel(const Coord& ijk, float a, float b)
+    {
+        if constexpr (!std::is_same_v<Sampler, openvdb::tools::BoxSampler>) {
+            const openvdb::Vec3R p(Vec3f(float(ijk.x()), float(ijk.y()), float(ijk.z())));
+            return (*this)(p, p, a, b);
+        } else {
+            const float wa = (1.0f - tau) * std::max(a, 0.0f), wb = tau * std::max(b, 0.0f);
+            if (!(wa + wb > 0.0f)) return background;
+            const Vec3f ca = wa > 0.0f ? cs.getValue(ijk) : Vec3f(0.0f);
+            const Vec3f cb = wb > 0.0f ? ct.getValue(ijk) : Vec3f(0.0f);
+            return (wa * ca + wb * cb) / (wa + wb);
+        }
     }
 };
 
@@ -400,6 +414,80 @@ private:
     float mVoxel = 1.0f;
 };
 
+/// With no feature pairs the warp is the identity at every t, so the two extended distances at a
+/// voxel are the same in every frame; only the blend's weight changes. This keeps them per output
+/// leaf, computed the first time a frame needs the leaf, for the frames after it. The values are
+/// the ones a frame would sample itself (the same reads at the same points), so frames are the
+/// same bit for bit with or without the cache. Safe for frames made at once on several threads:
+/// a leaf computed twice at the same time is kept once. Beyond `maxLeaves` cached leaves, or
+/// outside its box, leaves are computed and not kept.
+class IdentityDistances {
+public:
+    struct Leaf {
+        float source[512], target[512]; ///< world units, OpenVDB's voxel order
+    };
+
+    /// `box`: output index space, the leaves to keep.
+    IdentityDistances(const CoordBBox& box, size_t maxLeaves)
+        : mLeaves(box >> size_t(3)), mMax(maxLeaves)
+    {
+        if (!box.empty()) {
+            const size_t n = size_t(mLeaves.dim().x()) * mLeaves.dim().y() * mLeaves.dim().z();
+            mSlots = std::make_unique<std::atomic<Leaf*>[]>(n);
+            for (size_t i = 0; i < n; ++i) mSlots[i].store(nullptr, std::memory_order_relaxed);
+            mSlotCount = n;
+        }
+    }
+    ~IdentityDistances()
+    {
+        for (size_t i = 0; i < mSlotCount; ++i) delete mSlots[i].load(std::memory_order_relaxed);
+    }
+    IdentityDistances(const IdentityDistances&) = delete;
+    IdentityDistances& operator=(const IdentityDistances&) = delete;
+
+    /// The distances at the voxels of the leaf at `origin`: the kept ones, or computed with `a`
+    /// and `b` (into `scratch` when they are not to be kept). `computed` counts the samples taken.
+    template <typename Sampler>
+    const Leaf& get(const Coord& origin, ExtendedDistance::Reader<Sampler>& a, ExtendedDistance::Reader<Sampler>& b,
+                    Leaf& scratch, uint64_t& computed)
+    {
+        const Coord leaf = origin >> 3;
+        std::atomic<Leaf*>* slot = nullptr;
+        if (mSlotCount && mLeaves.isInside(leaf)) {
+            const Coord d = leaf - mLeaves.min(), n = mLeaves.dim();
+            slot = &mSlots[(size_t(d.x()) * n.y() + d.y()) * n.z() + d.z()];
+            if (const Leaf* kept = slot->load(std::memory_order_acquire)) return *kept;
+        }
+        const bool keep = slot && mCount.load(std::memory_order_relaxed) < mMax;
+        std::unique_ptr<Leaf> fresh = keep ? std::make_unique<Leaf>() : nullptr;
+        Leaf& out = keep ? *fresh : scratch;
+        for (int i = 0; i < 8; ++i)
+            for (int j = 0; j < 8; ++j)
+                for (int k = 0; k < 8; ++k) {
+                    // The point as the identity warp gives it (single precision, as WarpLeaf holds it).
+                    const openvdb::Vec3R p(Vec3f(float(origin.x() + i), float(origin.y() + j), float(origin.z() + k)));
+                    const int n = (i * 8 + j) * 8 + k;
+                    out.source[n] = a(p);
+                    out.target[n] = b(p);
+                }
+        computed += 1024;
+        if (!keep) return out;
+        Leaf* expected = nullptr;
+        if (slot->compare_exchange_strong(expected, fresh.get(), std::memory_order_acq_rel)) {
+            mCount.fetch_add(1, std::memory_order_relaxed);
+            return *fresh.release();
+        }
+        return *expected; // another frame kept the same values first
+    }
+
+private:
+    CoordBBox mLeaves; ///< leaf coordinates (index >> 3)
+    size_t mMax;
+    size_t mSlotCount = 0;
+    std::unique_ptr<std::atomic<Leaf*>[]> mSlots;
+    std::atomic<size_t> mCount{0};
+};
+
 } // namespace detail
 
 namespace {
@@ -540,6 +628,32 @@ public:
     /// Inactive values lie at least this many voxels from the zero set (compute band / G).
     int deepVoxels() const { return int(mWidth + 1.0f); }
 
+    /// What a leaf's voxels turned out to be.
+    struct Seen {
+        bool on = false, inside = false, outside = false;
+        /// -1 when every value is inside and none active, +1 when every value is outside and
+        /// none active, 0 otherwise (keep the leaf).
+        int whole() const { return on ? 0 : (inside && !outside ? -1 : (outside && !inside ? 1 : 0)); }
+    };
+
+    /// Blends voxel n from its two distances: active within the compute band, +/- the band
+    /// (inactive) beyond it; its colour, colorAt(), within the band that is kept.
+    template <typename ColorAt>
+    void blendVoxel(openvdb::Index n, float da, float db, FloatTree::LeafNodeType& value,
+                    Vec3STree::LeafNodeType& color, Seen& seen, const ColorAt& colorAt) const
+    {
+        const float d = (1.0f - mTau) * da + mTau * db;
+        seen.inside = seen.inside || d < 0.0f;
+        seen.outside = seen.outside || !(d < 0.0f);
+        if (!(std::abs(d) < mComputeBand)) {
+            value.setValueOff(n, d < 0.0f ? -mComputeBand : mComputeBand);
+            return;
+        }
+        value.setValueOn(n, d);
+        seen.on = true;
+        if (std::abs(d) < mKeepBand) color.setValueOn(n, colorAt());
+    }
+
     /// Fills one leaf: the blend within the compute band (active), +/- the compute band beyond
     /// (inactive); colour where the band may be. Returns -1 when every value is inside and none
     /// active, +1 when every value is outside and none active, 0 otherwise (keep the leaf).
@@ -550,7 +664,7 @@ public:
         // Each side's colour weight is its fog at the warped point, derived from its distance
         // with the output's ramp: what "empty there" means for a surface.
         const float ramp = kSdfRampVoxels * mVoxel;
-        bool anyOn = false, anyInside = false, anyOutside = false;
+        Seen seen;
         uint64_t samples = 0;
         // Each 4^3 quarter of the leaf is first judged by its voxel (2, 2, 2), at most 2 sqrt(3)
         // voxels from the others, then each of its 2^3 blocks by the blend at the mean of its
@@ -565,7 +679,7 @@ public:
             for (int i = x0; i < x0 + size; ++i)
                 for (int j = y0; j < y0 + size; ++j)
                     for (int k = z0; k < z0 + size; ++k) value.setValueOff(openvdb::Index((i * 8 + j) * 8 + k), v);
-            (d < 0.0f ? anyInside : anyOutside) = true;
+            (d < 0.0f ? seen.inside : seen.outside) = true;
         };
         for (int q = 0; q < 8; ++q) {
             const int qx = (q & 1) * 4, qy = ((q >> 1) & 1) * 4, qz = ((q >> 2) & 1) * 4;
@@ -600,25 +714,37 @@ public:
                             const openvdb::Index n = openvdb::Index((i * 8 + j) * 8 + k);
                             const openvdb::Vec3R ps(w.source[n]), pt(w.target[n]);
                             const float da = a(ps), db = b(pt);
-                            const float d = (1.0f - mTau) * da + mTau * db;
                             ++samples;
-                            anyInside = anyInside || d < 0.0f;
-                            anyOutside = anyOutside || !(d < 0.0f);
-                            if (!(std::abs(d) < mComputeBand)) {
-                                value.setValueOff(n, d < 0.0f ? -mComputeBand : mComputeBand);
-                                continue;
-                            }
-                            value.setValueOn(n, d);
-                            anyOn = true;
-                            if (std::abs(d) < mKeepBand)
-                                color.setValueOn(n, colors(ps, pt, fogRamp(da, ramp), fogRamp(db, ramp)));
+                            blendVoxel(n, da, db, value, color, seen, [&] {
+                                return colors(ps, pt, fogRamp(da, ramp), fogRamp(db, ramp));
+                            });
                         }
             }
         }
         mSamples += samples;
-        if (anyOn) return 0;
-        return anyInside && !anyOutside ? -1 : (anyOutside && !anyInside ? 1 : 0);
+        return seen.whole();
     }
+
+    /// Fills one leaf as operator() does, from the two distances at its voxels (the identity
+    /// warp's points, cached across frames). Every voxel is blended: from distances at hand that is
+    /// cheaper than judging quarters and blocks, and gives the same leaf (what those judgements
+    /// skip is beyond the compute band, with their sign).
+    int operator()(const Coord& origin, const detail::IdentityDistances::Leaf& distances,
+                   FloatTree::LeafNodeType& value, Vec3STree::LeafNodeType& color) const
+    {
+        ColorBlend<Sampler> colors(mSource, mTarget, mTauColor, mBackground);
+        const float ramp = kSdfRampVoxels * mVoxel;
+        Seen seen;
+        for (openvdb::Index n = 0; n < 512; ++n) {
+            const float da = distances.source[n], db = distances.target[n];
+            blendVoxel(n, da, db, value, color, seen, [&] {
+                return colors.atVoxel(origin + value.offsetToLocalCoord(n), fogRamp(da, ramp), fogRamp(db, ramp));
+            });
+        }
+        return seen.whole();
+    }
+
+    void addSamples(uint64_t n) const { mSamples += n; }
 
     /// Rebuilds the band from the blend in place and returns the fog derived from it, in one pass
     /// over the leaves. Each band voxel gets its distance to the blend's zero set to first order,
@@ -634,21 +760,33 @@ public:
         const float keep = mKeepBand, width = mWidth * mVoxel;
         std::vector<Leaf::NodeMaskType> bands(leaves.leafCount());
         std::vector<std::unique_ptr<Leaf>> fogs(leaves.leafCount());
+        // Central differences as math::GradStencil takes them; the six neighbours are read from
+        // the leaf's buffer when they lie in it, through the stencil's accessor otherwise.
+        const float inv2dx = float(0.5 / values.voxelSize()[0]);
         leaves.foreach([&](Leaf& leaf, size_t index) {
             openvdb::math::GradStencil<openvdb::FloatGrid> stencil(values);
+            const float* in = leaf.buffer().data();
             float* out = leaves.getBuffer(index, 1).data();
             auto fog = std::make_unique<Leaf>(leaf.origin(), 0.0f, false);
             Leaf::NodeMaskType& band = bands[index];
             for (openvdb::Index n = 0; n < Leaf::SIZE; ++n) {
-                const float b = leaf.getValue(n);
+                const float b = in[n];
                 float dist = width;
                 if (leaf.isValueOn(n) && std::abs(b) < keep) {
-                    stencil.moveTo(leaf.offsetToGlobalCoord(n), b);
-                    const float g = float(stencil.gradient().length()); // world-space, 1 for a distance
+                    float e[6]; // +x, -x, +y, -y, +z, -z
+                    const openvdb::Index i = n >> 6, j = (n >> 3) & 7, k = n & 7;
+                    if (i - 1 < 6 && j - 1 < 6 && k - 1 < 6) { // 1..6 on every axis
+                        e[0] = in[n + 64], e[1] = in[n - 64], e[2] = in[n + 8], e[3] = in[n - 8], e[4] = in[n + 1],
+                        e[5] = in[n - 1];
+                    } else {
+                        stencil.moveTo(leaf.offsetToGlobalCoord(n), b);
+                        e[0] = stencil.template getValue<1, 0, 0>(), e[1] = stencil.template getValue<-1, 0, 0>();
+                        e[2] = stencil.template getValue<0, 1, 0>(), e[3] = stencil.template getValue<0, -1, 0>();
+                        e[4] = stencil.template getValue<0, 0, 1>(), e[5] = stencil.template getValue<0, 0, -1>();
+                    }
+                    const Vec3f gradient = Vec3f(e[0] - e[1], e[2] - e[3], e[4] - e[5]) * inv2dx;
+                    const float g = gradient.length(); // world-space, 1 for a distance
                     if (g > 1e-6f) dist = std::abs(b) / g;
-                    const float e[6] = {stencil.template getValue<1, 0, 0>(), stencil.template getValue<-1, 0, 0>(),
-                                        stencil.template getValue<0, 1, 0>(), stencil.template getValue<0, -1, 0>(),
-                                        stencil.template getValue<0, 0, 1>(), stencil.template getValue<0, 0, -1>()};
                     for (float v : e)
                         if ((v < 0.0f) != (b < 0.0f)) dist = std::min(dist, mVoxel * std::abs(b) / (std::abs(b) + std::abs(v)));
                     dist = std::min(dist, width);
@@ -664,23 +802,23 @@ public:
         });
         leaves.swapLeafBuffer(1);
         leaves.foreach([&bands](Leaf& leaf, size_t index) { leaf.setValueMask(bands[index]); });
-        FloatTree& tree = values.tree();
-        auto tiles = [](auto it) {
-            it.setMaxDepth(it.getLeafDepth() - 1);
-            return it;
-        };
-        for (auto it = tiles(tree.beginValueOn()); it; ++it) { // active tiles, if any: deep inside or outside
-            it.setValue(*it < 0.0f ? -width : width);
-            it.setValueOff();
-        }
-        openvdb::tools::changeLevelSetBackground(tree, width);
-
+        // Every leaf value is now in the band or +/- the width. The tiles (deep inside or outside,
+        // active or not) become +/- the width and inactive, as changeLevelSetBackground would make
+        // them, and those inside are the fog's interior tiles.
         openvdb::FloatGrid::Ptr density = openvdb::FloatGrid::create(0.0f);
         FloatTree& fog = density->tree();
         for (auto& leaf : fogs) fog.addLeaf(leaf.release());
-        for (auto it = tiles(tree.cbeginValueAll()); it; ++it)
-            if (*it < 0.0f) fog.addTile(it.getLevel(), it.getCoord(), 1.0f, true);
-        openvdb::tools::prune(fog);
+        FloatTree& tree = values.tree();
+        auto tile = tree.beginValueAll();
+        tile.setMaxDepth(tile.getLeafDepth() - 1);
+        for (; tile; ++tile) {
+            const bool inside = *tile < 0.0f;
+            tile.setValue(inside ? -width : width);
+            tile.setValueOff();
+            if (inside) fog.addTile(tile.getLevel(), tile.getCoord(), 1.0f, true);
+        }
+        tree.root().setBackground(width, /*updateChildNodes*/ false);
+         openvdb::tools::prune(fog);
         openvdb::tools::pruneLevelSet(tree);
         return density;
     }
@@ -730,6 +868,11 @@ Morpher::Morpher(VolumeSet source, VolumeSet target, std::vector<FeaturePairSpec
         // Both at once: fast sweeping is partly serial.
         tbb::parallel_invoke([&] { mFarSource = std::make_shared<const detail::ExtendedDistance>(mSource.sdf, box); },
                              [&] { mFarTarget = std::make_shared<const detail::ExtendedDistance>(mTarget.sdf, box); });
+        if (mPairs.empty()) {
+            const uint64_t limit = mOptions.memoryLimitBytes ? mOptions.memoryLimitBytes : defaultMemoryLimitBytes();
+            mIdentity = std::make_shared<detail::IdentityDistances>(
+                candidateBounds(0.0), size_t(limit / 4 / sizeof(detail::IdentityDistances::Leaf)));
+        }
     }
 }
 
@@ -924,14 +1067,42 @@ VolumeSet Morpher::runSdf(double t, const CoordBBox& box, bool prune, double tol
     const float band = blend.computeBand();
     LeafCollector leaves(t, mOptions.memoryLimitBytes, background);
     const BlockClasses& classes = blend.classes();
+    // With no pairs, the leaves to evaluate are read from the distances kept across frames.
+    const bool identity = prune && mIdentity && warp.pairCount() == 0;
+    std::vector<Coord> evaluate;
     for (int x = classes.leaves.min().x(); x <= classes.leaves.max().x(); ++x)
         for (int y = classes.leaves.min().y(); y <= classes.leaves.max().y(); ++y)
-            for (int z = classes.leaves.min().z(); z <= classes.leaves.max().z(); ++z)
-                if (classes.at(Coord(x, y, z)) < 0) leaves.insideTile(Coord(x * 8, y * 8, z * 8));
+            for (int z = classes.leaves.min().z(); z <= classes.leaves.max().z(); ++z) {
+                const int8_t kind = classes.at(Coord(x, y, z));
+                if (kind < 0) leaves.insideTile(Coord(x * 8, y * 8, z * 8));
+                else if (kind == 0 && identity) evaluate.emplace_back(x * 8, y * 8, z * 8);
+            }
     const detail::AdaptiveWarp::CellFilter wanted = [&classes](const CoordBBox& cells) {
         return classes.anyToEvaluate(cells);
     };
     detail::AdaptiveWarpStats warpStats;
+   if (identity) {
+        std::atomic<bool> stopped{false};
+        tbb::parallel_for(tbb::blocked_range<size_t>(0, evaluate.size(), 8), [&](const tbb::blocked_range<size_t>& r) {
+            if (stopped || (interrupter && interrupter->wasInterrupted(int(100 * r.begin() / evaluate.size())))) {
+                stopped = true;
+                return;
+            }
+            typename detail::ExtendedDistance::template Reader<Sampler> a(*mFarSource), b(*mFarTarget);
+            auto scratch = std::make_unique<detail::IdentityDistances::Leaf>();
+            uint64_t computed = 0;
+            for (size_t i = r.begin(); i != r.end(); ++i) {
+                const auto& distances = mIdentity->get<Sampler>(evaluate[i], a, b, *scratch, computed);
+                auto [value, color] = leaves.make(evaluate[i], band);
+                const int whole = blend(evaluate[i], distances, *value, *color);
+                if (whole == 0) leaves.keep(std::move(value), std::move(color));
+                else if (whole < 0) leaves.insideTile(evaluate[i]);
+            }
+            blend.addSamples(computed);
+        });
+        if (stopped) throw Interrupted();
+        warpStats.leaves = evaluate.size();
+    } else
     adaptive.forEachLeaf(
         box, nullptr, nullptr,
         [&](const detail::WarpLeaf& w) {
