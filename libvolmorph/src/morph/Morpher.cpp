@@ -13,7 +13,6 @@
 #include <openvdb/tools/Prune.h>
 #include <openvdb/tree/LeafManager.h>
 #include <openvdb/math/Mat3.h>
-#include <openvdb/math/Stencils.h>
 #include <openvdb/util/Util.h>
 
 #include <tbb/blocked_range.h>
@@ -98,8 +97,11 @@ size_t dropIslands(openvdb::FloatGrid& values, int minVoxels, float outside, int
             leaves.foreach([&values, negative](openvdb::BoolTree::LeafNodeType& leaf, size_t) {
                 const auto* source = values.tree().probeConstLeaf(leaf.origin());
                 if (!source) return;
-                for (auto it = leaf.beginValueOn(); it; ++it)
-                    if ((source->getValue(it.pos()) < 0.0f) != negative) it.setValueOff();
+                const float* v = source->buffer().data();
+                openvdb::BoolTree::LeafNodeType::NodeMaskType sign; // on where negative
+                for (openvdb::Index n = 0; n < openvdb::BoolTree::LeafNodeType::SIZE; ++n)
+                    if (v[n] < 0.0f) sign.setOn(n);
+                leaf.setValueMask(leaf.getValueMask() & (negative ? sign : !sign));
             });
             if (negative)
                 for (auto it = values.tree().cbeginValueOff(); it && !anyDeep; ++it) anyDeep = *it < 0.0f;
@@ -760,29 +762,44 @@ public:
         const float keep = mKeepBand, width = mWidth * mVoxel;
         std::vector<Leaf::NodeMaskType> bands(leaves.leafCount());
         std::vector<std::unique_ptr<Leaf>> fogs(leaves.leafCount());
-        // Central differences as math::GradStencil takes them; the six neighbours are read from
-        // the leaf's buffer when they lie in it, through the stencil's accessor otherwise.
+        // Central differences as math::GradStencil takes them. The six neighbours are read from
+        // the leaf's buffer, or from the buffer of the neighbouring leaf across that face, or,
+        // where there is none (a tile), through an accessor. Only the aux buffers are written
+        // here, so every read sees the blend.
         const float inv2dx = float(0.5 / values.voxelSize()[0]);
         leaves.foreach([&](Leaf& leaf, size_t index) {
-            openvdb::math::GradStencil<openvdb::FloatGrid> stencil(values);
+            auto acc = values.getConstAccessor();
+            const Coord origin = leaf.origin();
+            // Per face (+x, -x, +y, -y, +z, -z): the neighbouring leaf's values, and the step of
+            // the voxel index inside a leaf and across the face.
+            const float* across[6];
+            constexpr int kStep[6] = {64, -64, 8, -8, 1, -1}, kWrap[6] = {-448, 448, -56, 56, -7, 7};
+            for (int f = 0; f < 6; ++f) {
+                const int axis = f / 2, sign = f % 2 ? -1 : 1;
+                Coord o = origin;
+                o[axis] += 8 * sign;
+                const Leaf* next = acc.probeConstLeaf(o);
+                across[f] = next ? next->buffer().data() : nullptr;
+            }
             const float* in = leaf.buffer().data();
             float* out = leaves.getBuffer(index, 1).data();
-            auto fog = std::make_unique<Leaf>(leaf.origin(), 0.0f, false);
+            auto fog = std::make_unique<Leaf>(origin, 0.0f, false);
             Leaf::NodeMaskType& band = bands[index];
             for (openvdb::Index n = 0; n < Leaf::SIZE; ++n) {
                 const float b = in[n];
                 float dist = width;
                 if (leaf.isValueOn(n) && std::abs(b) < keep) {
+                    const int ijk[3] = {int(n >> 6), int((n >> 3) & 7), int(n & 7)};
                     float e[6]; // +x, -x, +y, -y, +z, -z
-                    const openvdb::Index i = n >> 6, j = (n >> 3) & 7, k = n & 7;
-                    if (i - 1 < 6 && j - 1 < 6 && k - 1 < 6) { // 1..6 on every axis
-                        e[0] = in[n + 64], e[1] = in[n - 64], e[2] = in[n + 8], e[3] = in[n - 8], e[4] = in[n + 1],
-                        e[5] = in[n - 1];
-                    } else {
-                        stencil.moveTo(leaf.offsetToGlobalCoord(n), b);
-                        e[0] = stencil.template getValue<1, 0, 0>(), e[1] = stencil.template getValue<-1, 0, 0>();
-                        e[2] = stencil.template getValue<0, 1, 0>(), e[3] = stencil.template getValue<0, -1, 0>();
-                        e[4] = stencil.template getValue<0, 0, 1>(), e[5] = stencil.template getValue<0, 0, -1>();
+                    for (int f = 0; f < 6; ++f) {
+                        const int c = ijk[f / 2];
+                        if (f % 2 ? c > 0 : c < 7) e[f] = in[int(n) + kStep[f]];
+                        else if (across[f]) e[f] = across[f][int(n) + kWrap[f]];
+                        else {
+                            Coord q = origin.offsetBy(ijk[0], ijk[1], ijk[2]);
+                            q[f / 2] += f % 2 ? -1 : 1;
+                            e[f] = acc.getValue(q);
+                        }
                     }
                     const Vec3f gradient = Vec3f(e[0] - e[1], e[2] - e[3], e[4] - e[5]) * inv2dx;
                     const float g = gradient.length(); // world-space, 1 for a distance
@@ -860,9 +877,13 @@ Morpher::Morpher(VolumeSet source, VolumeSet target, std::vector<FeaturePairSpec
         CoordBBox box = mSource.sdf->evalActiveVoxelBoundingBox();
         box.expand(mTarget.sdf->evalActiveVoxelBoundingBox());
         if (!box.empty()) {
-            // A margin for warped points that leave the box: an eighth of its size, at least 8 voxels.
+            // A margin for warped points that leave the box: an eighth of its size, at least 8
+            // voxels. With no pairs the points are the output's voxels: the blend's zero set lies
+            // within the objects' box, and 8 voxels hold its compute band (beyond the box a read
+            // takes the nearest face's value, which underestimates a distance outside: leaves there
+            // are judged, if anything, too near).
             const Coord dim = box.dim();
-            const int margin = std::max(8, std::max({dim.x(), dim.y(), dim.z()}) / 8);
+            const int margin = mPairs.empty() ? 8 : std::max(8, std::max({dim.x(), dim.y(), dim.z()}) / 8);
             box.expand(margin);
         }
         // Both at once: fast sweeping is partly serial.
