@@ -819,23 +819,36 @@ public:
         });
         leaves.swapLeafBuffer(1);
         leaves.foreach([&bands](Leaf& leaf, size_t index) { leaf.setValueMask(bands[index]); });
-        // Every leaf value is now in the band or +/- the width. The tiles (deep inside or outside,
-        // active or not) become +/- the width and inactive, as changeLevelSetBackground would make
-        // them, and those inside are the fog's interior tiles.
+        // Every leaf value is now in the band or +/- the width. Inactive tiles hold +/- the width
+        // already (the grid was made so); active ones, if any, are deep inside or outside and
+        // become so too. The tiles inside are the fog's interior tiles: they are looked for in
+        // each internal node's own tile table, which is much cheaper than the tree's iterator.
         openvdb::FloatGrid::Ptr density = openvdb::FloatGrid::create(0.0f);
         FloatTree& fog = density->tree();
         for (auto& leaf : fogs) fog.addLeaf(leaf.release());
         FloatTree& tree = values.tree();
-        auto tile = tree.beginValueAll();
-        tile.setMaxDepth(tile.getLeafDepth() - 1);
-        for (; tile; ++tile) {
-            const bool inside = *tile < 0.0f;
-            tile.setValue(inside ? -width : width);
-            tile.setValueOff();
-            if (inside) fog.addTile(tile.getLevel(), tile.getCoord(), 1.0f, true);
+        if (!openvdb::math::isExactlyEqual(tree.background(), width))
+            throw std::logic_error("SdfFrame::redistance: the grid's background must be the band's width");
+        auto active = tree.beginValueOn();
+        active.setMaxDepth(active.getLeafDepth() - 1);
+        for (; active; ++active) {
+            active.setValue(*active < 0.0f ? -width : width);
+            active.setValueOff();
         }
-        tree.root().setBackground(width, /*updateChildNodes*/ false);
-         openvdb::tools::prune(fog);
+        auto insideTiles = [&fog](const auto& nodes) {
+            for (const auto* node : nodes)
+                for (auto it = node->cbeginValueAll(); it; ++it) // tiles, not children
+                    if (*it < 0.0f) fog.addTile(node->LEVEL, it.getCoord(), 1.0f, true);
+        };
+        std::vector<const FloatTree::RootNodeType::ChildNodeType*> upper;
+        std::vector<const FloatTree::RootNodeType::ChildNodeType::ChildNodeType*> lower;
+        tree.getNodes(upper);
+        tree.getNodes(lower);
+        insideTiles(upper);
+        insideTiles(lower);
+        for (auto it = tree.root().cbeginValueAll(); it; ++it)
+            if (*it < 0.0f) fog.addTile(FloatTree::RootNodeType::LEVEL, it.getCoord(), 1.0f, true);
+        openvdb::tools::prune(fog);
         openvdb::tools::pruneLevelSet(tree);
         return density;
     }
@@ -1134,13 +1147,15 @@ VolumeSet Morpher::runSdf(double t, const CoordBBox& box, bool prune, double tol
         },
         &warpStats, interrupter, prune ? &wanted : nullptr);
 
-    openvdb::FloatGrid::Ptr values = openvdb::FloatGrid::create(band);
+    // Tiles and the background take the output band's values at once (+/- its width); the
+    // leaves' values beyond the compute band are rewritten by redistance().
+    openvdb::FloatGrid::Ptr values = openvdb::FloatGrid::create(blend.width());
     values->setTransform(mSource.density->transform().copy());
     values->setGridClass(openvdb::GRID_LEVEL_SET);
     VolumeSet out;
     out.color = openvdb::Vec3SGrid::create(background);
     const size_t kept = leaves.size();
-    leaves.moveInto(values->tree(), out.color->tree(), -band);
+    leaves.moveInto(values->tree(), out.color->tree(), -blend.width());
     dropIslands(*values, mBlend.minIslandVoxels, band, blend.deepVoxels());
     out.density = blend.redistance(*values, kSdfRampVoxels * float(voxel));
     out.sdf = values;
