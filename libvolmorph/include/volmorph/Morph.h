@@ -19,8 +19,9 @@
 // band is rebuilt to first order (|b| / |grad b|, never beyond an edge's zero crossing), and the
 // fog is derived from it. frameOverBox() evaluates every voxel instead: the tests' reference.
 // With no feature pairs the warp is the identity at every t: both extended distances at a voxel
-// are then the same in every frame, and are kept per leaf from the first frame that needs them
-// (the frames are the same bit for bit; only the blend's weight changes with t).
+// are then the same in every frame, and are kept per leaf from the first frame that needs them,
+// as are those at the leaves' centres (the frames are the same bit for bit; only the blend's
+// weight changes with t). The extended fields then need only the objects' box plus 8 voxels.
 #pragma once
 
 #include <volmorph/Interrupter.h>

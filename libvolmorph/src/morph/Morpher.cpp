@@ -482,8 +482,48 @@ public:
         return *expected; // another frame kept the same values first
     }
 
+    /// The distances at the centres of the leaves of `box` (output index space), x-major over
+    /// box >> 3: what SdfFrame::classify() samples first in every frame. Computed by the first
+    /// frame that asks for this box.
+    struct Centres {
+        CoordBBox box;
+        std::vector<float> source, target;
+    };
+    template <typename Sampler>
+    std::shared_ptr<const Centres> centres(const CoordBBox& box, const ExtendedDistance& farSource,
+                                           const ExtendedDistance& farTarget)
+    {
+        {
+            std::lock_guard<std::mutex> lock(mCentresMutex);
+            if (mCentres && mCentres->box == box) return mCentres;
+        }
+        auto c = std::make_shared<Centres>();
+        c->box = box;
+        const CoordBBox leaves = box >> size_t(3);
+        const Coord n = leaves.dim();
+        c->source.resize(size_t(n.x()) * n.y() * n.z());
+        c->target.resize(c->source.size());
+        tbb::parallel_for(tbb::blocked_range<int>(0, n.x()), [&](const tbb::blocked_range<int>& r) {
+            ExtendedDistance::Reader<Sampler> a(farSource), b(farTarget);
+            for (int x = r.begin(); x != r.end(); ++x)
+                for (int y = 0; y < n.y(); ++y)
+                    for (int z = 0; z < n.z(); ++z) {
+                        const Coord leaf = leaves.min().offsetBy(x, y, z);
+                        const openvdb::Vec3R centre(leaf.x() * 8 + 3.5, leaf.y() * 8 + 3.5, leaf.z() * 8 + 3.5);
+                        const size_t i = (size_t(x) * n.y() + y) * n.z() + z;
+                        c->source[i] = a(centre);
+                        c->target[i] = b(centre);
+                    }
+        });
+        std::lock_guard<std::mutex> lock(mCentresMutex);
+        if (!mCentres) mCentres = c;
+        return c;
+    }
+
 private:
     CoordBBox mLeaves; ///< leaf coordinates (index >> 3)
+    std::mutex mCentresMutex;
+    std::shared_ptr<const Centres> mCentres;
     size_t mMax;
     size_t mSlotCount = 0;
     std::unique_ptr<std::atomic<Leaf*>[]> mSlots;
@@ -544,7 +584,8 @@ public:
     }
 
     /// Classifies the leaves of `box`. With `prune` false every leaf is evaluated (the reference).
-    void classify(const CoordBBox& box, bool prune)
+    /// `identity`: with no pairs, the distances at the leaves' centres kept across frames.
+    void classify(const CoordBBox& box, bool prune, detail::IdentityDistances* identity = nullptr)
     {
         BlockClasses& c = mClasses;
         c.leaves = box >> size_t(3);
@@ -552,19 +593,26 @@ public:
         const size_t count = size_t(n.x()) * n.y() * n.z();
         auto index = [&n](int x, int y, int z) { return (size_t(x) * n.y() + y) * n.z() + z; };
         std::vector<float> blend(count);
-        std::vector<Vec3d> ps(count), pt(count);
-        tbb::parallel_for(tbb::blocked_range<int>(0, n.x()), [&](const tbb::blocked_range<int>& r) {
-            typename detail::ExtendedDistance::template Reader<Sampler> a(mFarSource), b(mFarTarget);
-            for (int x = r.begin(); x != r.end(); ++x)
-                for (int y = 0; y < n.y(); ++y)
-                    for (int z = 0; z < n.z(); ++z) {
-                        const size_t i = index(x, y, z);
-                        const Coord leaf = c.leaves.min().offsetBy(x, y, z);
-                        const Vec3d centre(leaf.x() * 8 + 3.5, leaf.y() * 8 + 3.5, leaf.z() * 8 + 3.5);
-                        mWarp.map(centre, ps[i], pt[i]);
-                        blend[i] = (1.0f - mTau) * a(ps[i]) + mTau * b(pt[i]);
-                    }
-        });
+        std::vector<Vec3d> ps, pt;
+        if (identity && mWarp.pairCount() == 0) {
+            const auto centres = identity->centres<Sampler>(box, mFarSource, mFarTarget);
+            for (size_t i = 0; i < count; ++i) blend[i] = (1.0f - mTau) * centres->source[i] + mTau * centres->target[i];
+        } else {
+            ps.resize(count);
+            pt.resize(count);
+            tbb::parallel_for(tbb::blocked_range<int>(0, n.x()), [&](const tbb::blocked_range<int>& r) {
+                typename detail::ExtendedDistance::template Reader<Sampler> a(mFarSource), b(mFarTarget);
+                for (int x = r.begin(); x != r.end(); ++x)
+                    for (int y = 0; y < n.y(); ++y)
+                        for (int z = 0; z < n.z(); ++z) {
+                            const size_t i = index(x, y, z);
+                            const Coord leaf = c.leaves.min().offsetBy(x, y, z);
+                            const Vec3d centre(leaf.x() * 8 + 3.5, leaf.y() * 8 + 3.5, leaf.z() * 8 + 3.5);
+                            mWarp.map(centre, ps[i], pt[i]);
+                            blend[i] = (1.0f - mTau) * a(ps[i]) + mTau * b(pt[i]);
+                        }
+            });
+        }
         // The warp's stretch per leaf: the spectral norm of its Jacobian by differences between
         // neighbouring centres, the largest over the 3^3 neighbourhood, with a margin of 1.25 for
         // what varies between centres. The identity's is 1 exactly.
@@ -892,9 +940,10 @@ Morpher::Morpher(VolumeSet source, VolumeSet target, std::vector<FeaturePairSpec
         if (!box.empty()) {
             // A margin for warped points that leave the box: an eighth of its size, at least 8
             // voxels. With no pairs the points are the output's voxels: the blend's zero set lies
-            // within the objects' box, and 8 voxels hold its compute band (beyond the box a read
-            // takes the nearest face's value, which underestimates a distance outside: leaves there
-            // are judged, if anything, too near).
+            // within the objects' box (the band's active voxels), and 8 voxels more hold its
+            // compute band. Beyond the box a read takes the nearest face's value, which
+            // underestimates a distance outside: leaves there are judged, if anything, too near
+            // (4 voxels: 15% more leaves evaluated, for a setup hardly cheaper).
             const Coord dim = box.dim();
             const int margin = mPairs.empty() ? 8 : std::max(8, std::max({dim.x(), dim.y(), dim.z()}) / 8);
             box.expand(margin);
@@ -1097,7 +1146,7 @@ VolumeSet Morpher::runSdf(double t, const CoordBBox& box, bool prune, double tol
     const Vec3f background = (1.0f - tauC) * mSource.color->background() + tauC * mTarget.color->background();
 
     SdfFrame<Sampler> blend(mSource, mTarget, *mFarSource, *mFarTarget, warp, tauS, tauC, background, tolerance);
-    blend.classify(box, prune);
+    blend.classify(box, prune, prune ? mIdentity.get() : nullptr);
     const float band = blend.computeBand();
     LeafCollector leaves(t, mOptions.memoryLimitBytes, background);
     const BlockClasses& classes = blend.classes();
