@@ -413,6 +413,45 @@ TEST(Morph, SparseDomainLosesNothing)
     }
 }
 
+// With no pairs, sdf-mode frames read the distances kept across frames (Morpher's
+// IdentityDistances) instead of sampling through the warp. They must equal the dense reference,
+// which samples every voxel, exactly, also when a frame is made again from what is kept.
+TEST(Morph, SdfFramesWithoutPairsMatchTheDenseReference)
+{
+    const double voxel = 0.05;
+    const VolumeSet s = voxelized("sphere.obj", voxel);
+    ObjectTransform xf;
+    xf.translate = Vec3d(0.5, 0.2, 0);
+    xf.scale = Vec3d(0.7);
+    const VolumeSet d = voxelized("cube.obj", voxel, xf);
+    BlendSpec blend;
+    blend.mode = BlendMode::Sdf;
+    const Morpher morpher(s, d, {}, WarpSpec{}, blend);
+    uint64_t firstSamples = 0;
+    for (double t : {0.5, 0.2, 0.8, 0.5}) {
+        MorphStats sparseStats;
+        const VolumeSet sparse = morpher.frame(t, &sparseStats);
+        openvdb::CoordBBox big = morpher.candidateBounds(t);
+        big.expand(big.dim().x() / 4);
+        const VolumeSet dense = morpher.frameOverBox(t, big, 0.0);
+        const std::string where = "t = " + std::to_string(t);
+        ASSERT_GT(sparse.density->activeVoxelCount(), 0u) << where;
+        EXPECT_EQ(maxDifference(*sparse.sdf, *dense.sdf), 0.0) << where;
+        EXPECT_EQ(maxDifference(*sparse.density, *dense.density), 0.0) << where;
+        EXPECT_EQ(sparse.color->activeVoxelCount(), dense.color->activeVoxelCount()) << where;
+        auto denseColor = dense.color->getConstAccessor();
+        double worstColor = 0.0;
+        for (auto it = sparse.color->cbeginValueOn(); it; ++it)
+            worstColor = std::max(worstColor, double((*it - denseColor.getValue(it.getCoord())).length()));
+        EXPECT_EQ(worstColor, 0.0) << where;
+        if (firstSamples == 0) firstSamples = sparseStats.blendSamples;
+    }
+    // The last frame repeats the first: every distance it needs is kept, none is sampled again.
+    MorphStats again;
+    morpher.frame(0.5, &again);
+    EXPECT_LT(again.blendSamples, firstSamples / 4);
+}
+
 namespace {
 
 /// The largest displacement between the zero sets of two level sets, in voxels, measured on the
