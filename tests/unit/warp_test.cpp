@@ -368,6 +368,19 @@ TEST(Morph, EndsAreSourceAndTarget)
     EXPECT_LT(maxDifference(*morpher.frame(1.0).density, *d.density), 1e-4);
 }
 
+namespace {
+
+/// The unit cube scaled by 0.7 and moved by `translate` (world units), voxelized.
+VolumeSet smallCubeAt(const Vec3d& translate, double voxel)
+{
+    ObjectTransform xf;
+    xf.translate = translate;
+    xf.scale = Vec3d(0.7);
+    return voxelized("cube.obj", voxel, xf);
+}
+
+} // namespace
+
 // The sparse domain against evaluation at every voxel of a box well past the candidate box, in both
 // blend modes. In sdf mode the blend is evaluated only in the leaves (and quarters of leaves) that
 // can hold its band, judged from their centres with the warp's stretch; the rest is inside or
@@ -375,11 +388,7 @@ TEST(Morph, EndsAreSourceAndTarget)
 TEST(Morph, SparseDomainLosesNothing)
 {
     const double voxel = 0.05;
-    const VolumeSet s = voxelized("sphere.obj", voxel);
-    ObjectTransform xf;
-    xf.translate = Vec3d(0.8, 0.2, 0);
-    xf.scale = Vec3d(0.7);
-    const VolumeSet d = voxelized("cube.obj", voxel, xf);
+    const VolumeSet s = voxelized("sphere.obj", voxel), d = smallCubeAt(Vec3d(0.8, 0.2, 0), voxel);
     std::mt19937 random(11);
     for (BlendMode mode : {BlendMode::Density, BlendMode::Sdf}) {
         BlendSpec blend;
@@ -419,11 +428,7 @@ TEST(Morph, SparseDomainLosesNothing)
 TEST(Morph, SdfFramesWithoutPairsMatchTheDenseReference)
 {
     const double voxel = 0.05;
-    const VolumeSet s = voxelized("sphere.obj", voxel);
-    ObjectTransform xf;
-    xf.translate = Vec3d(0.5, 0.2, 0);
-    xf.scale = Vec3d(0.7);
-    const VolumeSet d = voxelized("cube.obj", voxel, xf);
+    const VolumeSet s = voxelized("sphere.obj", voxel), d = smallCubeAt(Vec3d(0.5, 0.2, 0), voxel);
     BlendSpec blend;
     blend.mode = BlendMode::Sdf;
     const Morpher morpher(s, d, {}, WarpSpec{}, blend);

@@ -194,11 +194,7 @@ struct ColorBlend {
     /// ps, pt: the warped points; a, b: the densities there.
     Vec3f operator()(const openvdb::Vec3R& ps, const openvdb::Vec3R& pt, float a, float b)
     {
-        const float wa = (1.0f - tau) * std::max(a, 0.0f), wb = tau * std::max(b, 0.0f);
-        if (!(wa + wb > 0.0f)) return background;
-        const Vec3f ca = wa > 0.0f ? Vec3f(sample<Sampler>(cs, ps)) : Vec3f(0.0f);
-        const Vec3f cb = wb > 0.0f ? Vec3f(sample<Sampler>(ct, pt)) : Vec3f(0.0f);
-        return (wa * ca + wb * cb) / (wa + wb);
+        return mix(a, b, [&] { return Vec3f(sample<Sampler>(cs, ps)); }, [&] { return Vec3f(sample<Sampler>(ct, pt)); });
     }
     /// The same at voxel ijk of both sides (the identity warp). Trilinear weights there are 1 and
     /// 0, so BoxSampler's value is the voxel's own: read it directly.
@@ -208,12 +204,20 @@ struct ColorBlend {
             const openvdb::Vec3R p(Vec3f(float(ijk.x()), float(ijk.y()), float(ijk.z())));
             return (*this)(p, p, a, b);
         } else {
-            const float wa = (1.0f - tau) * std::max(a, 0.0f), wb = tau * std::max(b, 0.0f);
-            if (!(wa + wb > 0.0f)) return background;
-            const Vec3f ca = wa > 0.0f ? cs.getValue(ijk) : Vec3f(0.0f);
-            const Vec3f cb = wb > 0.0f ? ct.getValue(ijk) : Vec3f(0.0f);
-            return (wa * ca + wb * cb) / (wa + wb);
+            return mix(a, b, [&] { return cs.getValue(ijk); }, [&] { return ct.getValue(ijk); });
         }
+    }
+
+private:
+    /// The density-weighted mix; each side's colour is read only when its weight is positive.
+    template <typename ReadS, typename ReadT>
+    Vec3f mix(float a, float b, const ReadS& readSource, const ReadT& readTarget) const
+    {
+        const float wa = (1.0f - tau) * std::max(a, 0.0f), wb = tau * std::max(b, 0.0f);
+        if (!(wa + wb > 0.0f)) return background;
+        const Vec3f ca = wa > 0.0f ? readSource() : Vec3f(0.0f);
+        const Vec3f cb = wb > 0.0f ? readTarget() : Vec3f(0.0f);
+        return (wa * ca + wb * cb) / (wa + wb);
     }
 };
 
@@ -584,7 +588,7 @@ public:
     }
 
     /// Classifies the leaves of `box`. With `prune` false every leaf is evaluated (the reference).
-    /// `identity`: with no pairs, the distances at the leaves' centres kept across frames.
+    /// `identity`: with no pairs, the distances kept across frames (for the leaves' centres).
     void classify(const CoordBBox& box, bool prune, detail::IdentityDistances* identity = nullptr)
     {
         BlockClasses& c = mClasses;
@@ -594,7 +598,7 @@ public:
         auto index = [&n](int x, int y, int z) { return (size_t(x) * n.y() + y) * n.z() + z; };
         std::vector<float> blend(count);
         std::vector<Vec3d> ps, pt;
-        if (identity && mWarp.pairCount() == 0) {
+        if (identity) {
             const auto centres = identity->centres<Sampler>(box, mFarSource, mFarTarget);
             for (size_t i = 0; i < count; ++i) blend[i] = (1.0f - mTau) * centres->source[i] + mTau * centres->target[i];
         } else {
@@ -1146,25 +1150,25 @@ VolumeSet Morpher::runSdf(double t, const CoordBBox& box, bool prune, double tol
     const Vec3f background = (1.0f - tauC) * mSource.color->background() + tauC * mTarget.color->background();
 
     SdfFrame<Sampler> blend(mSource, mTarget, *mFarSource, *mFarTarget, warp, tauS, tauC, background, tolerance);
-    blend.classify(box, prune, prune ? mIdentity.get() : nullptr);
+    // With no pairs (and pruning), distances are read from those kept across frames.
+    detail::IdentityDistances* const keptDistances = prune && warp.pairCount() == 0 ? mIdentity.get() : nullptr;
+    blend.classify(box, prune, keptDistances);
     const float band = blend.computeBand();
     LeafCollector leaves(t, mOptions.memoryLimitBytes, background);
     const BlockClasses& classes = blend.classes();
-    // With no pairs, the leaves to evaluate are read from the distances kept across frames.
-    const bool identity = prune && mIdentity && warp.pairCount() == 0;
-    std::vector<Coord> evaluate;
+    std::vector<Coord> evaluate; // with kept distances, the leaves to evaluate
     for (int x = classes.leaves.min().x(); x <= classes.leaves.max().x(); ++x)
         for (int y = classes.leaves.min().y(); y <= classes.leaves.max().y(); ++y)
             for (int z = classes.leaves.min().z(); z <= classes.leaves.max().z(); ++z) {
                 const int8_t kind = classes.at(Coord(x, y, z));
                 if (kind < 0) leaves.insideTile(Coord(x * 8, y * 8, z * 8));
-                else if (kind == 0 && identity) evaluate.emplace_back(x * 8, y * 8, z * 8);
+                else if (kind == 0 && keptDistances) evaluate.emplace_back(x * 8, y * 8, z * 8);
             }
     const detail::AdaptiveWarp::CellFilter wanted = [&classes](const CoordBBox& cells) {
         return classes.anyToEvaluate(cells);
     };
     detail::AdaptiveWarpStats warpStats;
-   if (identity) {
+    if (keptDistances) {
         std::atomic<bool> stopped{false};
         tbb::parallel_for(tbb::blocked_range<size_t>(0, evaluate.size(), 8), [&](const tbb::blocked_range<size_t>& r) {
             if (stopped || (interrupter && interrupter->wasInterrupted(int(100 * r.begin() / evaluate.size())))) {
@@ -1175,7 +1179,7 @@ VolumeSet Morpher::runSdf(double t, const CoordBBox& box, bool prune, double tol
             auto scratch = std::make_unique<detail::IdentityDistances::Leaf>();
             uint64_t computed = 0;
             for (size_t i = r.begin(); i != r.end(); ++i) {
-                const auto& distances = mIdentity->get<Sampler>(evaluate[i], a, b, *scratch, computed);
+                const auto& distances = keptDistances->get<Sampler>(evaluate[i], a, b, *scratch, computed);
                 auto [value, color] = leaves.make(evaluate[i], band);
                 const int whole = blend(evaluate[i], distances, *value, *color);
                 if (whole == 0) leaves.keep(std::move(value), std::move(color));
@@ -1185,16 +1189,17 @@ VolumeSet Morpher::runSdf(double t, const CoordBBox& box, bool prune, double tol
         });
         if (stopped) throw Interrupted();
         warpStats.leaves = evaluate.size();
-    } else
-    adaptive.forEachLeaf(
-        box, nullptr, nullptr,
-        [&](const detail::WarpLeaf& w) {
-            auto [value, color] = leaves.make(w.origin, band);
-            const int whole = blend(w, *value, *color);
-            if (whole == 0) leaves.keep(std::move(value), std::move(color));
-            else if (whole < 0) leaves.insideTile(w.origin);
-        },
-        &warpStats, interrupter, prune ? &wanted : nullptr);
+    } else {
+        adaptive.forEachLeaf(
+            box, nullptr, nullptr,
+            [&](const detail::WarpLeaf& w) {
+                auto [value, color] = leaves.make(w.origin, band);
+                const int whole = blend(w, *value, *color);
+                if (whole == 0) leaves.keep(std::move(value), std::move(color));
+                else if (whole < 0) leaves.insideTile(w.origin);
+            },
+            &warpStats, interrupter, prune ? &wanted : nullptr);
+    }
 
     // Tiles and the background take the output band's values at once (+/- its width); the
     // leaves' values beyond the compute band are rewritten by redistance().
