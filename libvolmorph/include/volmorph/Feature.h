@@ -40,6 +40,10 @@ struct Feature {
     /// The same, for q = frameCoordinates(p).
     double distanceInFrame(const Vec3d& q) const;
 
+    /// The gradient of the distance, in world (or index) axes, at p with frame coordinates q and
+    /// distance d > 0: the unit vector from the element's nearest point to p.
+    Vec3d gradientInFrame(const Vec3d& q, double d) const;
+
     /// The element's characteristic length, for Beier-Neely weights: 1 for a point, the segment's
     /// length, the rectangle's and the box's diagonal.
     double length() const;

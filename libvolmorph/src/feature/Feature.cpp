@@ -35,6 +35,25 @@ double Feature::distanceInFrame(const Vec3d& q) const
     return q.length();
 }
 
+Vec3d Feature::gradientInFrame(const Vec3d& q, double d) const
+{
+    // q minus its nearest point on the element, in the frame; then rotated to world axes.
+    auto beyond = [](double v, double half) { return v - std::clamp(v, -half, half); };
+    Vec3d v = q;
+    switch (type) {
+    case FeatureType::Point: break;
+    case FeatureType::Segment: v = Vec3d(beyond(q.x(), 0.5 * scale.x()), q.y(), q.z()); break;
+    case FeatureType::Rectangle:
+        v = Vec3d(beyond(q.x(), 0.5 * scale.x()), beyond(q.y(), 0.5 * scale.y()), q.z());
+        break;
+    case FeatureType::Box:
+        v = Vec3d(beyond(q.x(), 0.5 * scale.x()), beyond(q.y(), 0.5 * scale.y()), beyond(q.z(), 0.5 * scale.z()));
+        break;
+    }
+    v /= d;
+    return x * v.x() + y * v.y() + z * v.z();
+}
+
 double Feature::length() const
 {
     switch (type) {

@@ -1093,7 +1093,7 @@ VolumeSet Morpher::run(double t, const CoordBBox& box, bool prune, double tolera
     if (mBlend.mode == BlendMode::Sdf) return runSdf(t, box, prune, tolerance, stats, interrupter);
     const double voxel = mSource.voxelSize();
     const InverseWarp warp(mPairs, mWarp, t, 1.0 / voxel);
-    const detail::AdaptiveWarp adaptive(warp, tolerance, mWarp.epsilon / voxel);
+    const detail::AdaptiveWarp adaptive(warp, tolerance);
     const detail::Occupancy* occS = prune ? mSourceBlocks.get() : nullptr;
     const detail::Occupancy* occT = prune ? mTargetBlocks.get() : nullptr;
     const float tauD = float(mBlend.density.evaluate(t)), tauC = float(mBlend.color.evaluate(t));
@@ -1145,7 +1145,7 @@ VolumeSet Morpher::runSdf(double t, const CoordBBox& box, bool prune, double tol
     // the band, and the fog is derived from the result.
     const double voxel = mSource.voxelSize();
     const InverseWarp warp(mPairs, mWarp, t, 1.0 / voxel);
-    const detail::AdaptiveWarp adaptive(warp, tolerance, mWarp.epsilon / voxel);
+    const detail::AdaptiveWarp adaptive(warp, tolerance);
     const float tauC = float(mBlend.color.evaluate(t)), tauS = float(mBlend.sdf.evaluate(t));
     const Vec3f background = (1.0f - tauC) * mSource.color->background() + tauC * mTarget.color->background();
 

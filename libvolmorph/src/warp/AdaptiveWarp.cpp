@@ -7,6 +7,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <mutex>
 
 namespace volmorph::detail {
@@ -15,28 +16,16 @@ namespace {
 using openvdb::Coord;
 using openvdb::CoordBBox;
 
-/// A cell is locked when its measured error is at most this fraction of the tolerance: the error
-/// is measured at the lattice points only, and in between it can be somewhat larger (the tests
-/// measure every voxel against the exact warp).
-constexpr double kSafety = 0.5;
+/// Trilinear interpolation bounds the error by h^2/8 (|u_xx| + |u_yy| + |u_zz|) (see the header).
+/// The bound is a worst case over the leaf; 1 keeps it a bound.
+constexpr double kBoundScale = 1.0;
 
-/// A cell may be interpolated only when size <= kKappa * (d_min + epsilon) for every element.
-constexpr double kKappa = 0.5;
+/// Below this offset + distance (index units) the weights are too steep to trust the arithmetic
+/// of the sums: the leaf is evaluated exactly (only with a zero or tiny epsilon).
+constexpr double kTinyRadius = 1e-6;
 
 /// Floor division by 8 (block coordinates), correct for negative coordinates.
 inline int block(int v) { return v >= 0 ? v / 8 : -((-v + 7) / 8); }
-
-inline Vec3d trilinear(const Vec3d c[8], double fx, double fy, double fz)
-{
-    const Vec3d x00 = c[0] + fx * (c[1] - c[0]), x10 = c[2] + fx * (c[3] - c[2]);
-    const Vec3d x01 = c[4] + fx * (c[5] - c[4]), x11 = c[6] + fx * (c[7] - c[6]);
-    const Vec3d y0 = x00 + fy * (x10 - x00), y1 = x01 + fy * (x11 - x01);
-    return y0 + fz * (y1 - y0);
-}
-
-inline int latticeIndex(int a, int b, int c) { return a + 3 * b + 9 * c; }
-
-/// Corner k (bit 0: x, bit 1: y, bit 2: z) as a lattice index.
 
 } // namespace
 
@@ -84,99 +73,155 @@ CoordBBox Occupancy::bounds() const
 
 // ------------------------------------------------------------------------------------------------
 
+namespace {
+/// Everything the error bound needs of one pair over it.
+struct PairBounds {
+    double dMin, wMax, wMin, w1, w2; ///< d and w over the leaf, |grad w|, |Hess w| bounds
+    bool constant;                   ///< a box containing the whole leaf: d = 0, w constant
+};
+
+} // namespace
+
+/// The exact sums at the corners of the candidate leaves: a lattice 8 voxels apart over the
+/// leaves' bounding box (index space / 8), evaluated only where a candidate leaf needs it.
+struct AdaptiveWarp::Lattice {
+    struct Point {
+        double w = 0.0;     ///< sum w_i
+        Vec3d s, t;         ///< sum w_i A_i, source and target side
+        bool ok = false;    ///< false: on an element with a zero offset, or not evaluated
+    };
+    Coord lo;               ///< lattice coordinates of point 0 (leaf coordinates)
+    Coord dim;              ///< points along each axis
+    std::vector<Point> points;
+    size_t index(const Coord& leafCoord) const
+    {
+        const Coord c = leafCoord - lo;
+        return (size_t(c.x()) * dim.y() + c.y()) * dim.z() + c.z();
+    }
+};
+
 struct AdaptiveWarp::Context {
-    CoordBBox box;
     const Occupancy* source;
     const Occupancy* target;
     const LeafFunction* fn;
-    const CellFilter* wanted;
     WarpLeaf leaf;
     double maxError = 0.0;
-    uint64_t evaluations = 0, leaves = 0;
-
-    struct Lattice {
-        Vec3d s[27], t[27];
-    };
+    uint64_t evaluations = 0, near = 0, leaves = 0;
+    // Per pair, per leaf (scratch).
+    std::vector<PairBounds> bounds;
+    std::vector<double> resid, slope, term, hessW;
+    std::vector<int> order;
+    std::vector<char> isNear;
 };
 
-AdaptiveWarp::AdaptiveWarp(const InverseWarp& warp, double toleranceVoxels, double epsilonVoxels)
-    : mWarp(warp), mTolerance(toleranceVoxels), mEpsilon(epsilonVoxels)
+namespace {
+
+/// Frobenius norm of the difference of two affine maps' linear parts (bounds the operator norm).
+double linearDistance(const InverseWarp::Affine& a, const InverseWarp::Affine& b)
 {
+    return std::sqrt((a.col[0] - b.col[0]).lengthSqr() + (a.col[1] - b.col[1]).lengthSqr() +
+                     (a.col[2] - b.col[2]).lengthSqr());
 }
 
-bool AdaptiveWarp::nearElement(const Coord& origin, int size) const
+/// True when the box element contains the axis-aligned cube of side `size` centred at `centre`:
+/// in the box's frame, the cube's extent along axis a is size/2 (|a_x| + |a_y| + |a_z|).
+bool boxContains(const Feature& e, const Vec3d& centre, double size)
 {
-    if (mWarp.pairCount() < 2) return false; // one pair: the warp is its affine map, exactly trilinear
-    const double half = 0.5 * size;
-    const Vec3d centre(origin.x() + half, origin.y() + half, origin.z() + half);
-    const double reach = half * std::sqrt(3.0); // the distance is 1-Lipschitz: it changes by at most this
-    for (size_t i = 0; i < mWarp.pairCount(); ++i) {
-        const Feature& e = mWarp.interpolated(i);
-        const double dMin = std::max(0.0, e.distance(centre) - reach);
-        if (double(size) <= kKappa * (dMin + mEpsilon)) continue;
-        if (e.type == FeatureType::Box) {
-            // Wholly inside the box (convex: all corners inside), d = 0 and the weight is constant.
-            bool inside = true;
-            for (int k = 0; k < 8 && inside; ++k)
-                inside = e.distance(Vec3d(origin.x() + (k & 1) * size, origin.y() + ((k >> 1) & 1) * size,
-                                          origin.z() + ((k >> 2) & 1) * size)) == 0.0;
-            if (inside) continue;
-        }
-        return true;
+    const Vec3d q = e.frameCoordinates(centre);
+    const Vec3d* axes[3] = {&e.x, &e.y, &e.z};
+    for (int k = 0; k < 3; ++k) {
+        const Vec3d& a = *axes[k];
+        const double reach = 0.5 * size * (std::abs(a.x()) + std::abs(a.y()) + std::abs(a.z()));
+        if (std::abs(q[k]) + reach > 0.5 * e.scale[k]) return false;
     }
-    return false;
+    return true;
+}
+
+/// Distance in the element's frame, inlined per type for the per-voxel loop.
+template <FeatureType T>
+inline double frameDistance(double qx, double qy, double qz, double hx, double hy, double hz)
+{
+    auto out = [](double v, double half) { return std::max(std::abs(v) - half, 0.0); };
+    if constexpr (T == FeatureType::Point) return std::sqrt(qx * qx + qy * qy + qz * qz);
+    if constexpr (T == FeatureType::Segment) {
+        const double a = out(qx, hx);
+        return std::sqrt(a * a + qy * qy + qz * qz);
+    }
+    if constexpr (T == FeatureType::Rectangle) {
+        const double a = out(qx, hx), b = out(qy, hy);
+        return std::sqrt(a * a + b * b + qz * qz);
+    }
+    const double a = out(qx, hx), b = out(qy, hy), c = out(qz, hz);
+    return std::sqrt(a * a + b * b + c * c);
+}
+
+/// One row of 8 voxels along z: the near pair's weights and weighted residuals added.
+struct Row {
+    double w[8], s[3][8], t[3][8];
+};
+
+template <FeatureType T>
+void addNearPair(Row& row, const Feature& e, const Vec3d& start, double offset, double exponent, double scale,
+                 bool inverseSquare, const Vec3d& rs, const Vec3d& drs, const Vec3d& rt, const Vec3d& drt)
+{
+    const Vec3d q0 = e.frameCoordinates(start);
+    const Vec3d dq(e.x.z(), e.y.z(), e.z.z()); // d/dz of the frame coordinates
+    const double hx = 0.5 * e.scale.x(), hy = 0.5 * e.scale.y(), hz = 0.5 * e.scale.z();
+    double w[8];
+    for (int k = 0; k < 8; ++k) {
+        const double d = frameDistance<T>(q0.x() + k * dq.x(), q0.y() + k * dq.y(), q0.z() + k * dq.z(), hx, hy, hz);
+        const double r = offset + d;
+        w[k] = inverseSquare ? 1.0 / (r * r) : scale * std::pow(r, -exponent);
+    }
+    for (int c = 0; c < 3; ++c)
+        for (int k = 0; k < 8; ++k) {
+            row.s[c][k] += w[k] * (rs[c] + k * drs[c]);
+            row.t[c][k] += w[k] * (rt[c] + k * drt[c]);
+        }
+    for (int k = 0; k < 8; ++k) row.w[k] += w[k];
+}
+
+} // namespace
+
+AdaptiveWarp::AdaptiveWarp(const InverseWarp& warp, double toleranceVoxels)
+    : mWarp(warp), mTolerance(toleranceVoxels)
+{
+    for (size_t i = 0; i < warp.pairCount(); ++i) {
+        mSource.push_back(warp.sourceAffine(i));
+        mTarget.push_back(warp.targetAffine(i));
+    }
+}
+
+void AdaptiveWarp::identityLeaf(Context& ctx) const
+{
+    const Coord& o = ctx.leaf.origin;
+    for (int i = 0; i < 8; ++i)
+        for (int j = 0; j < 8; ++j)
+            for (int k = 0; k < 8; ++k) {
+                const Vec3f p(float(o.x() + i), float(o.y() + j), float(o.z() + k));
+                ctx.leaf.source[(i * 8 + j) * 8 + k] = p;
+                ctx.leaf.target[(i * 8 + j) * 8 + k] = p;
+            }
+}
+
+void AdaptiveWarp::exactLeaf(Context& ctx) const
+{
+    const Coord& o = ctx.leaf.origin;
+    Vec3d s, t;
+    for (int i = 0; i < 8; ++i)
+        for (int j = 0; j < 8; ++j)
+            for (int k = 0; k < 8; ++k) {
+                mWarp.map(Vec3d(o.x() + i, o.y() + j, o.z() + k), s, t);
+                ctx.leaf.source[(i * 8 + j) * 8 + k] = Vec3f(s);
+                ctx.leaf.target[(i * 8 + j) * 8 + k] = Vec3f(t);
+            }
+    ctx.evaluations += 512;
 }
 
 namespace {
 
-/// The 27 points of a cell's next finer lattice: corners copied, the rest exact (or interpolated
-/// when the cell is locked). Returns the measured error, in voxels (0 for a locked cell).
-template <typename Map>
-double evaluateLattice(const Map& map, const Coord& origin, int size, const Vec3d cs[8], const Vec3d ct[8],
-                       bool locked, Vec3d ls[27], Vec3d lt[27], uint64_t& evaluations)
+CoordBBox widened(const Vec3d& lo, const Vec3d& hi, double margin)
 {
-    double error = 0.0;
-    const int half = size / 2;
-    for (int c = 0; c < 3; ++c)
-        for (int b = 0; b < 3; ++b)
-            for (int a = 0; a < 3; ++a) {
-                const int i = latticeIndex(a, b, c);
-                if (!(a & 1) && !(b & 1) && !(c & 1)) {
-                    const int k = (a >> 1) | ((b >> 1) << 1) | ((c >> 1) << 2);
-                    ls[i] = cs[k];
-                    lt[i] = ct[k];
-                    continue;
-                }
-                const Vec3d is = trilinear(cs, 0.5 * a, 0.5 * b, 0.5 * c);
-                const Vec3d it = trilinear(ct, 0.5 * a, 0.5 * b, 0.5 * c);
-                if (locked) {
-                    ls[i] = is;
-                    lt[i] = it;
-                    continue;
-                }
-                map(Vec3d(origin.x() + a * half, origin.y() + b * half, origin.z() + c * half), ls[i], lt[i]);
-                ++evaluations;
-                error = std::max({error, (ls[i] - is).length(), (lt[i] - it).length()});
-            }
-    return error;
-}
-
-void childCorners(const Vec3d ls[27], const Vec3d lt[27], int cx, int cy, int cz, Vec3d cs[8], Vec3d ct[8])
-{
-    for (int k = 0; k < 8; ++k) {
-        const int i = latticeIndex(cx + (k & 1), cy + ((k >> 1) & 1), cz + ((k >> 2) & 1));
-        cs[k] = ls[i];
-        ct[k] = lt[i];
-    }
-}
-
-CoordBBox imageBox(const Vec3d points[27], double margin)
-{
-    Vec3d lo = points[0], hi = points[0];
-    for (int i = 1; i < 27; ++i) {
-        lo = minComponent(lo, points[i]);
-        hi = maxComponent(hi, points[i]);
-    }
     auto clampInt = [](double v) { return int(std::clamp(v, -1.0e9, 1.0e9)); };
     return CoordBBox(Coord(clampInt(std::floor(lo.x() - margin)), clampInt(std::floor(lo.y() - margin)),
                            clampInt(std::floor(lo.z() - margin))),
@@ -184,115 +229,286 @@ CoordBBox imageBox(const Vec3d points[27], double margin)
                            clampInt(std::ceil(hi.z() + margin))));
 }
 
+/// Bounding box of an affine map's image of the cube [o, o + size]^3.
+void affineImage(const InverseWarp::Affine& a, const Vec3d& o, double size, Vec3d& lo, Vec3d& hi)
+{
+    lo = hi = a.apply(o);
+    for (int c = 0; c < 3; ++c) {
+        const Vec3d step = a.col[c] * size;
+        for (int k = 0; k < 3; ++k) (step[k] < 0 ? lo : hi)[k] += step[k];
+    }
+}
+
+/// Trilinear sampling reads up to one voxel past the point.
+constexpr double kSamplerReach = 1.5;
+
+bool touches(const Occupancy* occ, const Vec3d& lo, const Vec3d& hi, double margin)
+{
+    return occ && occ->anyIn(widened(lo, hi, margin));
+}
+
 } // namespace
 
-void AdaptiveWarp::cell(Context& ctx, const Coord& origin, int size, const Corners& corners, bool locked) const
+void AdaptiveWarp::leaf(Context& ctx, const Lattice& lattice, const Coord& origin) const
 {
-    const CoordBBox cube = CoordBBox::createCube(origin, size);
-    if (!ctx.box.hasOverlap(cube) || (ctx.wanted && !(*ctx.wanted)(cube))) return;
-    auto map = [this](const Vec3d& p, Vec3d& s, Vec3d& t) { mWarp.map(p, s, t); };
-    Context::Lattice l;
-    const double error = evaluateLattice(map, origin, size, corners.s, corners.t, locked, l.s, l.t, ctx.evaluations);
-
-    if ((ctx.source || ctx.target) && error <= double(size)) {
-        // Trilinear sampling reads up to one voxel past the point; interpolated points stay within
-        // their corners' hull, exact ones may stray from it by about the measured error.
-        const double margin = 1.5 + 2.0 * error;
-        const bool keep = (ctx.source && ctx.source->anyIn(imageBox(l.s, margin))) ||
-                          (ctx.target && ctx.target->anyIn(imageBox(l.t, margin)));
-        if (!keep) return;
-    }
-    const bool lock = locked || (mTolerance > 0.0 && error <= kSafety * mTolerance && !nearElement(origin, size));
-    if (lock && !locked) ctx.maxError = std::max(ctx.maxError, error);
-
-    if (size > 8) {
-        const int half = size / 2;
-        Corners child;
-        for (int cz = 0; cz < 2; ++cz)
-            for (int cy = 0; cy < 2; ++cy)
-                for (int cx = 0; cx < 2; ++cx) {
-                    childCorners(l.s, l.t, cx, cy, cz, child.s, child.t);
-                    cell(ctx, origin.offsetBy(cx * half, cy * half, cz * half), half, child, lock);
-                }
-        return;
-    }
     ctx.leaf.origin = origin;
-    ++ctx.leaves;
-    if (mWarp.pairCount() == 0) {
-        fillIdentity(ctx, origin);
-    } else if (mTolerance == 0.0) {
-        exactBlock(ctx, origin, 8);
-    } else if (lock) {
-        fillTrilinear(ctx, origin, 8, corners);
-    } else {
-        // The leaf's lattice is already known: its 8 children of 4^3 take their corners from it.
-        Corners child;
-        for (int cz = 0; cz < 2; ++cz)
-            for (int cy = 0; cy < 2; ++cy)
-                for (int cx = 0; cx < 2; ++cx) {
-                    childCorners(l.s, l.t, cx, cy, cz, child.s, child.t);
-                    quarter(ctx, origin.offsetBy(cx * 4, cy * 4, cz * 4), child);
-                }
-    }
-    (*ctx.fn)(ctx.leaf);
-}
-
-void AdaptiveWarp::exactBlock(Context& ctx, const Coord& origin, int size) const
-{
-    const Coord local = origin - ctx.leaf.origin;
-    Vec3d s, t;
-    for (int i = 0; i < size; ++i)
-        for (int j = 0; j < size; ++j)
-            for (int k = 0; k < size; ++k) {
-                mWarp.map(Vec3d(origin.x() + i, origin.y() + j, origin.z() + k), s, t);
-                const int n = ((local.x() + i) * 8 + local.y() + j) * 8 + local.z() + k;
-                ctx.leaf.source[n] = Vec3f(s);
-                ctx.leaf.target[n] = Vec3f(t);
+    const bool cull = ctx.source || ctx.target;
+    const size_t n = mWarp.pairCount();
+    const Vec3d o = origin.asVec3d();
+    auto visit = [&](double errorBound) {
+        if (cull) {
+            // The filled points' own bounding box, widened by what they may be off.
+            Vec3f slo = ctx.leaf.source[0], shi = slo, tlo = ctx.leaf.target[0], thi = tlo;
+            for (int i = 1; i < 512; ++i) {
+                slo = minComponent(slo, ctx.leaf.source[i]);
+                shi = maxComponent(shi, ctx.leaf.source[i]);
+                tlo = minComponent(tlo, ctx.leaf.target[i]);
+                thi = maxComponent(thi, ctx.leaf.target[i]);
             }
-    ctx.evaluations += uint64_t(size) * size * size;
-}
+            const double margin = kSamplerReach + errorBound;
+            if (!touches(ctx.source, Vec3d(slo), Vec3d(shi), margin) && !touches(ctx.target, Vec3d(tlo), Vec3d(thi), margin))
+                return;
+        }
+        ++ctx.leaves;
+        (*ctx.fn)(ctx.leaf);
+    };
 
-void AdaptiveWarp::fillIdentity(Context& ctx, const Coord& origin) const
-{
-    for (int i = 0; i < 8; ++i)
-        for (int j = 0; j < 8; ++j)
-            for (int k = 0; k < 8; ++k) {
-                const Vec3f p(float(origin.x() + i), float(origin.y() + j), float(origin.z() + k));
-                ctx.leaf.source[(i * 8 + j) * 8 + k] = p;
-                ctx.leaf.target[(i * 8 + j) * 8 + k] = p;
-            }
-}
-
-void AdaptiveWarp::fillTrilinear(Context& ctx, const Coord& origin, int size, const Corners& corners) const
-{
-    const Coord local = origin - ctx.leaf.origin;
-    const double step = 1.0 / double(size);
-    for (int i = 0; i < size; ++i)
-        for (int j = 0; j < size; ++j)
-            for (int k = 0; k < size; ++k) {
-                const int n = ((local.x() + i) * 8 + local.y() + j) * 8 + local.z() + k;
-                ctx.leaf.source[n] = Vec3f(trilinear(corners.s, i * step, j * step, k * step));
-                ctx.leaf.target[n] = Vec3f(trilinear(corners.t, i * step, j * step, k * step));
-            }
-}
-
-void AdaptiveWarp::quarter(Context& ctx, const Coord& origin, const Corners& corners) const
-{
-    // A 4^3 cell: interpolated when its lattice check passes, else exact voxel by voxel (64
-    // evaluations, fewer than the 8 x 19 that splitting it into 2^3 cells would cost).
-    if (nearElement(origin, 4)) {
-        exactBlock(ctx, origin, 4);
+    if (n == 0) {
+        if (cull && !touches(ctx.source, o, o + Vec3d(7.0), kSamplerReach) &&
+            !touches(ctx.target, o, o + Vec3d(7.0), kSamplerReach))
+            return;
+        identityLeaf(ctx);
+        ++ctx.leaves;
+        (*ctx.fn)(ctx.leaf);
         return;
     }
-    auto map = [this](const Vec3d& p, Vec3d& s, Vec3d& t) { mWarp.map(p, s, t); };
-    Context::Lattice l;
-    const double error = evaluateLattice(map, origin, 4, corners.s, corners.t, false, l.s, l.t, ctx.evaluations);
-    if (error <= kSafety * mTolerance) {
-        ctx.maxError = std::max(ctx.maxError, error);
-        fillTrilinear(ctx, origin, 4, corners);
-    } else {
-        exactBlock(ctx, origin, 4);
+
+    // Corners, bit 0: +x, bit 1: +y, bit 2: +z.
+    const Coord lc(origin.x() >> 3, origin.y() >> 3, origin.z() >> 3);
+    const Lattice::Point* corner[8];
+    bool cornersOk = true;
+    for (int k = 0; k < 8; ++k) {
+        corner[k] = &lattice.points[lattice.index(lc.offsetBy(k & 1, (k >> 1) & 1, (k >> 2) & 1))];
+        cornersOk = cornersOk && corner[k]->ok;
     }
+
+    // Each pair over the leaf cube [o, o + 8]^3 (its voxels and its far corners).
+    const double h = 8.0, halfDiagonal = 0.5 * h * std::sqrt(3.0);
+    const Vec3d centre = o + Vec3d(0.5 * h);
+    const double offset = mWarp.weightOffset(), b = mWarp.weightExponent();
+    std::vector<PairBounds>& pb = ctx.bounds;
+    pb.resize(n);
+    double wMinSum = 0.0, wCentreMax = -1.0;
+    size_t dominant = 0;
+    bool tiny = false;
+    for (size_t i = 0; i < n; ++i) {
+        const Feature& e = mWarp.interpolated(i);
+        const Vec3d q = e.frameCoordinates(centre);
+        const double dc = e.distanceInFrame(q);
+        PairBounds& p = pb[i];
+        p.constant = e.type == FeatureType::Box && dc == 0.0 && boxContains(e, centre, h);
+        p.dMin = p.constant ? 0.0 : std::max(0.0, dc - halfDiagonal);
+        const double rMin = offset + p.dMin, rMax = offset + (p.constant ? 0.0 : dc + halfDiagonal);
+        if (rMin < kTinyRadius) tiny = true;
+        const double scale = mWarp.weightScale(i);
+        p.wMax = scale * std::pow(std::max(rMin, kTinyRadius), -b);
+        p.wMin = scale * std::pow(rMax, -b);
+        wMinSum += p.wMin;
+        if (p.constant) {
+            p.w1 = p.w2 = 0.0;
+        } else if (p.dMin > 0.0) {
+            // Per axis a: |w_a| <= b w / r |d_a| and |w_aa| <= w (b (b + 1) / r^2 (d_a)^2 +
+            // b / r |d_aa|). grad d is the unit vector from the element's nearest point; over the
+            // leaf it turns by at most |Hess d| halfDiagonal <= halfDiagonal / dMin, so
+            // sup |d_a| <= |g_a| + turn, g its value at the centre; and sum_a |d_aa| <= 3 / dMin.
+            // w1 bounds sqrt(sum_a sup (w_a)^2), w2 bounds sum_a sup |w_aa|.
+            const Vec3d g = e.gradientInFrame(q, dc);
+            const double turn = std::min(1.0, halfDiagonal / p.dMin);
+            double axial = 0.0;
+            for (int a = 0; a < 3; ++a) {
+                const double ga = std::min(1.0, std::abs(g[a]) + turn);
+                axial += ga * ga;
+            }
+            p.w1 = b * p.wMax / rMin * std::sqrt(axial);
+            p.w2 = p.wMax * (b * (b + 1.0) / (rMin * rMin) * axial + 3.0 * b / (rMin * p.dMin));
+        } else {
+            p.w1 = b * p.wMax / rMin;
+            p.w2 = std::numeric_limits<double>::infinity(); // the leaf touches the element: a kink
+        }
+        const double wc = mWarp.weightAt(i, dc);
+        if (wc > wCentreMax) {
+            wCentreMax = wc;
+            dominant = i;
+        }
+    }
+    const InverseWarp::Affine& bS = mSource[dominant];
+    const InverseWarp::Affine& bT = mTarget[dominant];
+
+    // |R_i| over the leaf on either side, |M_i - M_B|, and |rho| = |p - B| <= sum w_i |R_i| / W.
+    std::vector<double>& resid = ctx.resid;
+    std::vector<double>& slope = ctx.slope;
+    resid.resize(n);
+    slope.resize(n);
+    double rhoSum = 0.0, residMax = 0.0;
+    for (size_t i = 0; i < n; ++i) {
+        const double ms = linearDistance(mSource[i], bS), mt = linearDistance(mTarget[i], bT);
+        slope[i] = std::max(ms, mt);
+        resid[i] = std::max((mSource[i].apply(centre) - bS.apply(centre)).length() + ms * halfDiagonal,
+                            (mTarget[i].apply(centre) - bT.apply(centre)).length() + mt * halfDiagonal);
+        rhoSum += pb[i].wMax * resid[i];
+        residMax = std::max(residMax, resid[i]);
+    }
+    const double rhoMax = std::min(residMax, rhoSum / wMinSum);
+
+    // Each far pair's share of the bound; one pair is its own affine map (R = 0, rho = 0).
+    const double k = kBoundScale * h * h / 8.0;
+    ctx.term.assign(n, 0.0);
+    ctx.hessW.assign(n, 0.0);
+    ctx.order.resize(n);
+    ctx.isNear.assign(n, 0);
+    for (size_t i = 0; i < n; ++i) {
+        ctx.order[i] = int(i);
+        if (n == 1 || pb[i].constant) continue;
+        ctx.hessW[i] = k * pb[i].w2;
+        ctx.term[i] = std::isfinite(pb[i].w2) ? k * ((resid[i] + rhoMax) * pb[i].w2 + 2.0 * slope[i] * pb[i].w1)
+                                              : std::numeric_limits<double>::infinity();
+    }
+    // The bound with the pairs of `near` evaluated exactly, the others interpolated.
+    auto boundWith = [&](size_t nearCount) {
+        double terms = 0.0, hess = 0.0;
+        for (size_t j = nearCount; j < n; ++j) {
+            terms += ctx.term[ctx.order[j]];
+            hess += ctx.hessW[ctx.order[j]];
+        }
+        const double denominator = wMinSum - hess;
+        return std::isfinite(terms) && denominator > 0.0 ? terms / denominator : std::numeric_limits<double>::infinity();
+    };
+    const double boundAllFar = boundWith(0);
+
+    // The domain, before any voxel. With every pair far the interpolant is B + I[G] / I[W], and
+    // I[G] / I[W] is a convex combination of the corners' rho_k = G_k / W_k: the image lies
+    // within B(leaf) + hull(rho_k), widened by the bound. Otherwise p = B + rho, |rho| <= rhoMax.
+    if (cull) {
+        Vec3d rsLo(-rhoMax), rsHi(rhoMax), rtLo(-rhoMax), rtHi(rhoMax);
+        double margin = kSamplerReach;
+        if (cornersOk && boundAllFar < rhoMax) {
+            rsLo = rtLo = Vec3d(std::numeric_limits<double>::max());
+            rsHi = rtHi = -rsLo;
+            for (int c = 0; c < 8; ++c) {
+                const Vec3d x = o + Vec3d((c & 1) * h, ((c >> 1) & 1) * h, ((c >> 2) & 1) * h);
+                const Vec3d rs = corner[c]->s / corner[c]->w - bS.apply(x), rt = corner[c]->t / corner[c]->w - bT.apply(x);
+                rsLo = minComponent(rsLo, rs);
+                rsHi = maxComponent(rsHi, rs);
+                rtLo = minComponent(rtLo, rt);
+                rtHi = maxComponent(rtHi, rt);
+            }
+            margin += boundAllFar;
+        }
+        Vec3d lo, hi;
+        affineImage(bS, o, h, lo, hi);
+        const bool s = touches(ctx.source, lo + rsLo, hi + rsHi, margin);
+        affineImage(bT, o, h, lo, hi);
+        if (!s && !touches(ctx.target, lo + rtLo, hi + rtHi, margin)) return;
+    }
+
+    if (mTolerance <= 0.0 || !cornersOk || tiny) {
+        exactLeaf(ctx);
+        visit(0.0);
+        return;
+    }
+
+    // Near pairs: largest share first, until the bound of the rest is within the tolerance.
+    std::sort(ctx.order.begin(), ctx.order.end(), [&](int a, int c) {
+        return ctx.term[a] > ctx.term[c] || (ctx.term[a] == ctx.term[c] && a < c);
+    });
+    size_t nearCount = 0;
+    double bound = boundAllFar;
+    while (bound > mTolerance && nearCount < n) {
+        ctx.isNear[ctx.order[nearCount]] = 1;
+        bound = boundWith(++nearCount);
+    }
+    if (nearCount == n) bound = 0.0; // every pair near: exact at every voxel but for rounding
+
+    // Far sums at the corners: W_F = W - sum_E w_i, G = N - sum_E w_i A_i - W_F B.
+    double cw[8];
+    Vec3d cs[8], ct[8];
+    for (int c = 0; c < 8; ++c) {
+        const Vec3d x = o + Vec3d((c & 1) * h, ((c >> 1) & 1) * h, ((c >> 2) & 1) * h);
+        double w = corner[c]->w;
+        Vec3d s = corner[c]->s, t = corner[c]->t;
+        for (size_t i = 0; i < n; ++i) {
+            if (!ctx.isNear[i]) continue;
+            const double wi = mWarp.weightAt(i, mWarp.interpolated(i).distance(x));
+            w -= wi;
+            s -= wi * mSource[i].apply(x);
+            t -= wi * mTarget[i].apply(x);
+        }
+        cw[c] = w;
+        cs[c] = s - w * bS.apply(x);
+        ct[c] = t - w * bT.apply(x);
+    }
+
+    const bool inverseSquare = mWarp.weighting() == Weighting::InverseSquare;
+    Row row;
+    for (int i = 0; i < 8; ++i) {
+        const double fx = i / h;
+        for (int j = 0; j < 8; ++j) {
+            const double fy = j / h;
+            // Far sums along the row: bilinear at z = 0 and z = h, linear in between.
+            auto bilinear = [&](auto v, int z) {
+                const int base = z << 2;
+                const auto a = v[base] + fx * (v[base + 1] - v[base]);
+                const auto c = v[base + 2] + fx * (v[base + 3] - v[base + 2]);
+                return a + fy * (c - a);
+            };
+            const double w0 = bilinear(cw, 0), w1 = bilinear(cw, 1);
+            const Vec3d s0 = bilinear(cs, 0), s1 = bilinear(cs, 1), t0 = bilinear(ct, 0), t1 = bilinear(ct, 1);
+            for (int z = 0; z < 8; ++z) {
+                const double f = z / h;
+                row.w[z] = w0 + f * (w1 - w0);
+                for (int c = 0; c < 3; ++c) {
+                    row.s[c][z] = s0[c] + f * (s1[c] - s0[c]);
+                    row.t[c][z] = t0[c] + f * (t1[c] - t0[c]);
+                }
+            }
+            const Vec3d start = o + Vec3d(i, j, 0);
+            for (size_t p = 0; p < n; ++p) {
+                if (!ctx.isNear[p]) continue;
+                const Vec3d rs = mSource[p].apply(start) - bS.apply(start), drs = mSource[p].col[2] - bS.col[2];
+                const Vec3d rt = mTarget[p].apply(start) - bT.apply(start), drt = mTarget[p].col[2] - bT.col[2];
+                const Feature& e = mWarp.interpolated(p);
+                const double scale = mWarp.weightScale(p);
+                switch (e.type) {
+                case FeatureType::Point:
+                    addNearPair<FeatureType::Point>(row, e, start, offset, b, scale, inverseSquare, rs, drs, rt, drt);
+                    break;
+                case FeatureType::Segment:
+                    addNearPair<FeatureType::Segment>(row, e, start, offset, b, scale, inverseSquare, rs, drs, rt, drt);
+                    break;
+                case FeatureType::Rectangle:
+                    addNearPair<FeatureType::Rectangle>(row, e, start, offset, b, scale, inverseSquare, rs, drs, rt, drt);
+                    break;
+                case FeatureType::Box:
+                    addNearPair<FeatureType::Box>(row, e, start, offset, b, scale, inverseSquare, rs, drs, rt, drt);
+                    break;
+                }
+            }
+            const Vec3d bs0 = bS.apply(start), bt0 = bT.apply(start);
+            const int n0 = (i * 8 + j) * 8;
+            for (int z = 0; z < 8; ++z) {
+                const double inv = 1.0 / row.w[z];
+                ctx.leaf.source[n0 + z] = Vec3f(float(bs0.x() + z * bS.col[2].x() + row.s[0][z] * inv),
+                                                float(bs0.y() + z * bS.col[2].y() + row.s[1][z] * inv),
+                                                float(bs0.z() + z * bS.col[2].z() + row.s[2][z] * inv));
+                ctx.leaf.target[n0 + z] = Vec3f(float(bt0.x() + z * bT.col[2].x() + row.t[0][z] * inv),
+                                                float(bt0.y() + z * bT.col[2].y() + row.t[1][z] * inv),
+                                                float(bt0.z() + z * bT.col[2].z() + row.t[2][z] * inv));
+            }
+        }
+    }
+    ctx.near += uint64_t(nearCount) * 512;
+    ctx.maxError = std::max(ctx.maxError, bound);
+    visit(bound);
 }
 
 void AdaptiveWarp::forEachLeaf(const CoordBBox& box, const Occupancy* source, const Occupancy* target,
@@ -300,43 +516,114 @@ void AdaptiveWarp::forEachLeaf(const CoordBBox& box, const Occupancy* source, co
                                const CellFilter* wanted) const
 {
     if (box.empty()) return;
-    auto down = [](int v) { return v >= 0 ? v / kTopCell * kTopCell : -((-v + kTopCell - 1) / kTopCell) * kTopCell; };
-    const Coord lo(down(box.min().x()), down(box.min().y()), down(box.min().z()));
+    const size_t n = mWarp.pairCount();
+    auto down = [](int v, int size) { return v >= 0 ? v / size * size : -((-v + size - 1) / size) * size; };
+
+    // 1. Candidate leaves, gathered per top cell: cells the filter refuses, or whose image under
+    //    every pair's affine map (the warp is a convex combination of them) misses both sides'
+    //    occupied blocks, are skipped whole.
+    const Coord lo(down(box.min().x(), kTopCell), down(box.min().y(), kTopCell), down(box.min().z(), kTopCell));
     std::vector<Coord> tops;
     for (int x = lo.x(); x <= box.max().x(); x += kTopCell)
         for (int y = lo.y(); y <= box.max().y(); y += kTopCell)
             for (int z = lo.z(); z <= box.max().z(); z += kTopCell) tops.emplace_back(x, y, z);
-
-    std::mutex statsMutex;
-    std::atomic<bool> stopped{false};
+    std::vector<std::vector<Coord>> perTop(tops.size());
     tbb::parallel_for(tbb::blocked_range<size_t>(0, tops.size(), 1), [&](const tbb::blocked_range<size_t>& r) {
-        auto ctx = std::make_unique<Context>();
-        ctx->box = box;
-        ctx->source = source;
-        ctx->target = target;
-        ctx->fn = &fn;
-        ctx->wanted = wanted;
-        for (size_t i = r.begin(); i != r.end(); ++i) {
-            if (stopped || (interrupter && interrupter->wasInterrupted(int(100 * i / tops.size())))) {
+        for (size_t ti = r.begin(); ti != r.end(); ++ti) {
+            const CoordBBox cube = CoordBBox::createCube(tops[ti], kTopCell);
+            if (wanted && !(*wanted)(cube)) continue;
+            if ((source || target) && n > 0) {
+                Vec3d slo(std::numeric_limits<double>::max()), shi(-slo), tlo(slo), thi(-slo);
+                for (size_t i = 0; i < n; ++i) {
+                    Vec3d a, c;
+                    affineImage(mSource[i], cube.min().asVec3d(), kTopCell, a, c);
+                    slo = minComponent(slo, a);
+                    shi = maxComponent(shi, c);
+                    affineImage(mTarget[i], cube.min().asVec3d(), kTopCell, a, c);
+                    tlo = minComponent(tlo, a);
+                    thi = maxComponent(thi, c);
+                }
+                if (!touches(source, slo, shi, kSamplerReach) && !touches(target, tlo, thi, kSamplerReach)) continue;
+            }
+            CoordBBox part = cube;
+            part.intersect(box);
+            if (part.empty()) continue;
+            for (int x = down(part.min().x(), 8); x <= part.max().x(); x += 8)
+                for (int y = down(part.min().y(), 8); y <= part.max().y(); y += 8)
+                    for (int z = down(part.min().z(), 8); z <= part.max().z(); z += 8) {
+                        const Coord c(x, y, z);
+                        if (wanted && !(*wanted)(CoordBBox::createCube(c, 8))) continue;
+                        perTop[ti].push_back(c);
+                    }
+        }
+    });
+    std::vector<Coord> candidates;
+    for (const auto& v : perTop) candidates.insert(candidates.end(), v.begin(), v.end());
+    if (candidates.empty()) return;
+    if (interrupter && interrupter->wasInterrupted(0)) throw Interrupted();
+
+    // 2. The exact sums at every corner of a candidate leaf, each lattice point once.
+    Lattice lattice;
+    uint64_t latticeEvaluations = 0;
+    if (n > 0) {
+        Coord llo(std::numeric_limits<int>::max()), lhi(std::numeric_limits<int>::min());
+        for (const Coord& c : candidates) {
+            const Coord l(c.x() >> 3, c.y() >> 3, c.z() >> 3);
+            llo = Coord::minComponent(llo, l);
+            lhi = Coord::maxComponent(lhi, l.offsetBy(1));
+        }
+        lattice.lo = llo;
+        lattice.dim = lhi - llo + Coord(1);
+        lattice.points.resize(size_t(lattice.dim.x()) * lattice.dim.y() * lattice.dim.z());
+        std::vector<char> needed(lattice.points.size(), 0);
+        for (const Coord& c : candidates)
+            for (int k = 0; k < 8; ++k)
+                needed[lattice.index(Coord(c.x() >> 3, c.y() >> 3, c.z() >> 3).offsetBy(k & 1, (k >> 1) & 1, (k >> 2) & 1))] = 1;
+        std::vector<size_t> todo;
+        for (size_t i = 0; i < needed.size(); ++i)
+            if (needed[i]) todo.push_back(i);
+        latticeEvaluations = todo.size();
+        std::atomic<bool> stopped{false};
+        tbb::parallel_for(tbb::blocked_range<size_t>(0, todo.size(), 64), [&](const tbb::blocked_range<size_t>& r) {
+            if (stopped || (interrupter && interrupter->wasInterrupted(int(10 * r.begin() / todo.size())))) {
                 stopped = true;
                 return;
             }
-            Corners corners;
-            for (int k = 0; k < 8; ++k) {
-                const Coord c = tops[i].offsetBy((k & 1) * kTopCell, ((k >> 1) & 1) * kTopCell, ((k >> 2) & 1) * kTopCell);
-                mWarp.map(c.asVec3d(), corners.s[k], corners.t[k]);
+            for (size_t i = r.begin(); i != r.end(); ++i) {
+                const size_t idx = todo[i];
+                const int yz = lattice.dim.y() * lattice.dim.z();
+                const Coord l(lattice.lo.x() + int(idx / yz), lattice.lo.y() + int(idx % yz) / lattice.dim.z(),
+                              lattice.lo.z() + int(idx % lattice.dim.z()));
+                Lattice::Point& p = lattice.points[idx];
+                p.ok = mWarp.sums(Vec3d(l.x() * 8.0, l.y() * 8.0, l.z() * 8.0), p.w, p.s, p.t);
             }
-            ctx->evaluations += 8;
-            cell(*ctx, tops[i], kTopCell, corners, false);
+        });
+        if (stopped) throw Interrupted();
+    }
+
+    // 3. Every candidate leaf: culled by the bound, filled, culled by its points, handed on.
+    std::mutex statsMutex;
+    std::atomic<bool> stopped{false};
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, candidates.size(), 16), [&](const tbb::blocked_range<size_t>& r) {
+        if (stopped || (interrupter && interrupter->wasInterrupted(10 + int(90 * r.begin() / candidates.size())))) {
+            stopped = true;
+            return;
         }
+        auto ctx = std::make_unique<Context>();
+        ctx->source = source;
+        ctx->target = target;
+        ctx->fn = &fn;
+        for (size_t i = r.begin(); i != r.end(); ++i) leaf(*ctx, lattice, candidates[i]);
         if (stats) {
             std::lock_guard<std::mutex> lock(statsMutex);
             stats->maxErrorVoxels = std::max(stats->maxErrorVoxels, ctx->maxError);
             stats->exactEvaluations += ctx->evaluations;
+            stats->nearEvaluations += ctx->near;
             stats->leaves += ctx->leaves;
         }
     });
     if (stopped) throw Interrupted();
+    if (stats) stats->exactEvaluations += latticeEvaluations;
 }
 
 } // namespace volmorph::detail

@@ -1,27 +1,38 @@
 // The approximated inverse warp and the sparse output domain, found together.
 //
-// Space is cut into cells aligned to a power-of-two lattice in output index space (64 voxels at the
-// top). The exact warp is evaluated at a cell's 8 corners and at the 19 other points of the next
-// finer lattice (edge midpoints, face centres, centre); the largest distance between the exact
-// value and the corners' trilinear interpolation there is the cell's measured error, in voxels.
-// A cell whose error is within the tolerance is locked: every voxel inside it is interpolated from
-// its corners (Lerios et al. 1995, with a power-of-two octree instead of their adaptive grid).
-// Otherwise it is split into 8 and each child reuses 8 of the 27 points as its corners, down to
-// 4^3 cells; a 4^3 cell that fails is evaluated exactly, voxel by voxel.
+// The exact warp is p(x) = sum w_i(x) A_i(x) / sum w_i(x): affine maps A_i blended by weights
+// w_i = scale_i (offset + d_i)^-b of the distances d_i to the interpolated elements. Its cost is
+// O(pairs) per voxel. The approximation works leaf by leaf (8^3 voxels, output index space):
 //
-// The lattice check cannot see what is smaller than its spacing: the weights (d + epsilon)^-2 bend
-// the warp on the scale of d + epsilon around each element, and the distance d has a kink on the
-// element's boundary. So a cell is only interpolated when it is small next to its distance to
-// every element: size <= kappa * (d_min + epsilon), d_min a lower bound of the distance from the
-// cell to the element (cells wholly inside a box element, where d = 0 and the weight is constant,
-// are exempt).
+// 1. The exact sums W = sum w_i and N = sum w_i A_i are evaluated once at every corner of every
+//    candidate leaf, on a lattice 8 voxels apart shared by neighbouring leaves.
+// 2. In a leaf, the warp is written relative to the affine map B of its dominant pair (the
+//    largest weight at the leaf's centre): p = B + sum w_i R_i / W with R_i = A_i - B. The pairs
+//    are split into near ones (E), evaluated exactly at every voxel, and far ones (F), whose
+//    sums G = sum_F w_i R_i and W_F = sum_F w_i are smooth over the leaf and interpolated
+//    trilinearly from the corners (exact there): p~ = B + (N_E + I[G]) / (W_E + I[W_F]).
+//    A pair whose weight is constant over the leaf (a box containing it) is far and exact.
+// 3. Which pairs are near follows from an a-priori bound of the interpolation error, not from
+//    samples (samples between lattice points miss the kinks of d on the elements' boundaries and
+//    the bending on the scale of d + offset). For u in C^{1,1}, trilinear interpolation over a
+//    cube of side h errs by at most h^2/8 (|u_xx| + |u_yy| + |u_zz|) <= 3 h^2/8 |Hess u|. With
+//    |grad d| <= 1 and |Hess d| <= 1/d (the distance to a convex set), over the leaf
+//      |grad w_i| <= b w_i / r_i,  |Hess w_i| <= w_i (b (b + 1) / r_i^2 + b / (r_i d_i)),
+//    r_i = offset + d_i, each at the leaf's smallest distance to element i; and
+//      |p~ - p| <= (3 h^2/8) sum_F [(|R_i| + |rho|) |Hess w_i| + 2 |M_i - M_B| |grad w_i|]
+//                  / (W_min - (3 h^2/8) sum_F |Hess w_i|),
+//    rho = p - B (a convex combination of the R_i), |R_i| and W_min bounded over the leaf, both
+//    sides. Pairs join E, largest term first, until the bound is within the tolerance. An
+//    element that touches the leaf (d_i = 0 somewhere, not containing it) has a kink there and
+//    is always near. One pair is its affine map: R = 0, no error, nothing near.
+// 4. The same bound decides the domain without evaluating any voxel: p = B + rho lies within
+//    B(leaf) widened by |rho|max; a leaf whose image misses every occupied block on both sides
+//    (widened by the sampler's reach) is skipped. After the leaf is filled, the bounding box of
+//    its warped points (widened by the error bound) is checked again.
 //
-// The same points bound the domain: a cell is dropped when the bounding box of its images on the
-// source side, widened by twice its error and by the sampler's reach, touches no block of the
-// source's active voxels, and likewise on the target side. Interpolated positions lie in the
-// convex hull of their corners, so for locked cells that box is exact. Cells whose error is
-// larger than themselves (a folding warp) are never dropped; their leaves are computed and
-// dropped only when they turn out empty.
+// Lerios et al. (1995) interpolated the warp over an adaptive grid checked at the next finer
+// lattice; here no sample decides the error, and the exact warp is evaluated at about one point
+// per leaf plus the near pairs at the voxels that need them.
 #pragma once
 
 #include <volmorph/Interrupter.h>
@@ -33,6 +44,7 @@
 #include <array>
 #include <atomic>
 #include <functional>
+#include <vector>
 
 namespace volmorph::detail {
 
@@ -58,17 +70,17 @@ struct WarpLeaf {
 };
 
 struct AdaptiveWarpStats {
-    double maxErrorVoxels = 0.0;   ///< the largest error measured in a locked cell
-    uint64_t exactEvaluations = 0;
-    uint64_t leaves = 0;           ///< leaves visited (the candidate domain)
+    double maxErrorVoxels = 0.0;     ///< the largest error bound of an interpolated leaf (voxels)
+    uint64_t exactEvaluations = 0;   ///< exact warp evaluations (lattice points, exact leaves' voxels)
+    uint64_t nearEvaluations = 0;    ///< near pairs evaluated at single voxels (one pair each)
+    uint64_t leaves = 0;             ///< leaves visited (the candidate domain)
 };
 
 class AdaptiveWarp {
 public:
-    /// `warp` must map output index space to source and target index space. Tolerance 0 means
-    /// exact: every voxel is evaluated.
-    /// `epsilonVoxels` is the warp's epsilon in index space.
-    AdaptiveWarp(const InverseWarp& warp, double toleranceVoxels, double epsilonVoxels);
+    /// `warp` must map output index space to source and target index space (built with unit
+    /// 1 / voxel size). Tolerance 0 means exact: every voxel is evaluated.
+    AdaptiveWarp(const InverseWarp& warp, double toleranceVoxels);
 
     using LeafFunction = std::function<void(const WarpLeaf&)>;
     /// "Is any leaf of this cell (output index space) wanted?"; cells answered no are skipped
@@ -83,27 +95,19 @@ public:
                      const LeafFunction& fn, AdaptiveWarpStats* stats = nullptr,
                      Interrupter* interrupter = nullptr, const CellFilter* wanted = nullptr) const;
 
-    /// Every top cell is this many voxels on a side.
+    /// Leaves are first gathered in cells this many voxels on a side (culled, filtered) .
     static constexpr int kTopCell = 64;
 
 private:
-    struct Corners {
-        Vec3d s[8], t[8];  ///< corner bit 0: +x, bit 1: +y, bit 2: +z
-    };
     struct Context;
-    void cell(Context& ctx, const openvdb::Coord& origin, int size, const Corners& corners, bool locked) const;
-    void quarter(Context& ctx, const openvdb::Coord& origin, const Corners& corners) const;
-    void exactBlock(Context& ctx, const openvdb::Coord& origin, int size) const;
-    void fillTrilinear(Context& ctx, const openvdb::Coord& origin, int size, const Corners& corners) const;
-    /// No pairs: the warp is the identity on both sides.
-    void fillIdentity(Context& ctx, const openvdb::Coord& origin) const;
-    /// True when the cell is too large next to some element to be interpolated, whatever the
-    /// lattice check says.
-    bool nearElement(const openvdb::Coord& origin, int size) const;
+    struct Lattice;
+    void leaf(Context& ctx, const Lattice& lattice, const openvdb::Coord& origin) const;
+    void exactLeaf(Context& ctx) const;
+    void identityLeaf(Context& ctx) const;
 
     const InverseWarp& mWarp;
     double mTolerance;
-    double mEpsilon;   ///< the warp's epsilon, index space
+    std::vector<InverseWarp::Affine> mSource, mTarget; ///< each pair's affine map on each side
 };
 
 } // namespace volmorph::detail

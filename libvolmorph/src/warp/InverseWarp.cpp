@@ -44,6 +44,27 @@ double InverseWarp::weight(const Pair& pair, double distance) const
     return std::pow(pair.lengthPow / (mA + distance), mB);
 }
 
+double InverseWarp::weightScale(size_t i) const
+{
+    return mWeighting == Weighting::InverseSquare ? 1.0 : std::pow(mPairs[i].lengthPow, mB);
+}
+
+bool InverseWarp::sums(const Vec3d& p, double& W, Vec3d& S, Vec3d& T) const
+{
+    W = 0.0;
+    S = T = Vec3d(0.0);
+    for (const Pair& pair : mPairs) {
+        const Vec3d q = pair.element.frameCoordinates(p);
+        const double d = pair.element.distanceInFrame(q);
+        if (d + weightOffset() < kOnElement) return false;
+        const double w = weight(pair, d);
+        S += w * (pair.sourceOrigin + pair.toSource[0] * q.x() + pair.toSource[1] * q.y() + pair.toSource[2] * q.z());
+        T += w * (pair.targetOrigin + pair.toTarget[0] * q.x() + pair.toTarget[1] * q.y() + pair.toTarget[2] * q.z());
+        W += w;
+    }
+    return std::isfinite(W) && W > 0.0;
+}
+
 void InverseWarp::map(const Vec3d& p, Vec3d& source, Vec3d& target) const
 {
     if (mPairs.empty()) {
