@@ -47,6 +47,28 @@ Occupancy::Occupancy(const openvdb::FloatTree& tree)
     }
     openvdb::tools::dilateActiveValues(mBlocks, 1, openvdb::tools::NN_FACE_EDGE_VERTEX,
                                        openvdb::tools::PRESERVE_TILES);
+
+    CoordBBox b;
+    if (!mBlocks.evalActiveVoxelBoundingBox(b)) return;
+    const Coord dim = b.dim();
+    constexpr uint64_t kMaxTable = uint64_t(1) << 23; // 32 MiB of counts
+    if (uint64_t(dim.x() + 1) * uint64_t(dim.y() + 1) * uint64_t(dim.z() + 1) > kMaxTable) return;
+    mLo = b.min();
+    mDim = dim;
+    const size_t sy = size_t(dim.z() + 1), sx = sy * size_t(dim.y() + 1);
+    mPrefix.assign(sx * size_t(dim.x() + 1), 0);
+    for (auto it = mBlocks.cbeginValueOn(); it; ++it)
+        for (auto c = it.getBoundingBox().begin(); c; ++c) {
+            const Coord l = *c - mLo;
+            mPrefix[size_t(l.x() + 1) * sx + size_t(l.y() + 1) * sy + size_t(l.z() + 1)] = 1;
+        }
+    for (int x = 1; x <= dim.x(); ++x)
+        for (int y = 1; y <= dim.y(); ++y)
+            for (int z = 1; z <= dim.z(); ++z) {
+                uint32_t* p = &mPrefix[size_t(x) * sx + size_t(y) * sy + size_t(z)];
+                *p += p[-ptrdiff_t(sx)] + p[-ptrdiff_t(sy)] + p[-1] - p[-ptrdiff_t(sx + sy)] - p[-ptrdiff_t(sx + 1)] -
+                      p[-ptrdiff_t(sy + 1)] + p[-ptrdiff_t(sx + sy + 1)];
+            }
 }
 
 bool Occupancy::anyIn(const CoordBBox& box) const
@@ -54,6 +76,16 @@ bool Occupancy::anyIn(const CoordBBox& box) const
     const Coord lo(block(box.min().x()), block(box.min().y()), block(box.min().z()));
     const Coord hi(block(box.max().x()), block(box.max().y()), block(box.max().z()));
     const CoordBBox blocks(lo, hi);
+    if (!mPrefix.empty()) {
+        // Inclusion-exclusion over the summed-volume table, the box clamped to its bounds.
+        const Coord a = Coord::maxComponent(lo, mLo) - mLo, c = Coord::minComponent(hi, mLo + mDim - Coord(1)) - mLo;
+        if (a.x() > c.x() || a.y() > c.y() || a.z() > c.z()) return false;
+        const size_t sy = size_t(mDim.z() + 1), sx = sy * size_t(mDim.y() + 1);
+        auto at = [&](int x, int y, int z) { return int64_t(mPrefix[size_t(x) * sx + size_t(y) * sy + size_t(z)]); };
+        const int x0 = a.x(), y0 = a.y(), z0 = a.z(), x1 = c.x() + 1, y1 = c.y() + 1, z1 = c.z() + 1;
+        return at(x1, y1, z1) - at(x0, y1, z1) - at(x1, y0, z1) - at(x1, y1, z0) + at(x0, y0, z1) + at(x0, y1, z0) +
+                   at(x1, y0, z0) - at(x0, y0, z0) > 0;
+    }
     if (blocks.volume() > (1u << 16)) return true; // too large to be worth asking
     openvdb::tree::ValueAccessor<const openvdb::MaskTree> acc(mBlocks);
     for (int x = lo.x(); x <= hi.x(); ++x)
@@ -112,6 +144,11 @@ struct AdaptiveWarp::Context {
     std::vector<double> resid, slope, term, hessW;
     std::vector<int> order;
     std::vector<char> isNear;
+    // What analyze() found of the last cell.
+    const Lattice::Point* corner[8];
+    bool cornersOk = false, tiny = false, tightBox = false;
+    size_t dominant = 0;
+    double wMinSum = 0.0, rhoMax = 0.0, boundAllFar = 0.0;
 };
 
 namespace {
@@ -137,6 +174,12 @@ bool boxContains(const Feature& e, const Vec3d& centre, double size)
     return true;
 }
 
+/// w = scale r^-b, r = offset + d (InverseWarp's weight law), without pow for the inverse square.
+inline double weightLaw(double scale, double r, double b, bool inverseSquare)
+{
+    return inverseSquare ? 1.0 / (r * r) : scale * std::pow(r, -b);
+}
+
 /// Distance in the element's frame, inlined per type for the per-voxel loop.
 template <FeatureType T>
 inline double frameDistance(double qx, double qy, double qz, double hx, double hy, double hz)
@@ -155,9 +198,13 @@ inline double frameDistance(double qx, double qy, double qz, double hx, double h
     return std::sqrt(a * a + b * b + c * c);
 }
 
-/// One row of 8 voxels along z: the near pair's weights and weighted residuals added.
+/// The voxels' offsets along a row, as doubles (the loops over them vectorize).
+constexpr double kZ[8] = {0, 1, 2, 3, 4, 5, 6, 7};
+
+/// One row of 8 voxels along z, channel-major so that the loops over z vectorize: 0 the weight
+/// sum, 1-3 the weighted residuals on the source side, 4-6 on the target side.
 struct Row {
-    double w[8], s[3][8], t[3][8];
+    double v[7][8];
 };
 
 template <FeatureType T>
@@ -169,16 +216,52 @@ void addNearPair(Row& row, const Feature& e, const Vec3d& start, double offset, 
     const double hx = 0.5 * e.scale.x(), hy = 0.5 * e.scale.y(), hz = 0.5 * e.scale.z();
     double w[8];
     for (int k = 0; k < 8; ++k) {
-        const double d = frameDistance<T>(q0.x() + k * dq.x(), q0.y() + k * dq.y(), q0.z() + k * dq.z(), hx, hy, hz);
+        const double d = frameDistance<T>(q0.x() + kZ[k] * dq.x(), q0.y() + kZ[k] * dq.y(), q0.z() + kZ[k] * dq.z(), hx, hy, hz);
         const double r = offset + d;
-        w[k] = inverseSquare ? 1.0 / (r * r) : scale * std::pow(r, -exponent);
+        w[k] = weightLaw(scale, r, exponent, inverseSquare);
     }
+    for (int k = 0; k < 8; ++k) row.v[0][k] += w[k];
     for (int c = 0; c < 3; ++c)
         for (int k = 0; k < 8; ++k) {
-            row.s[c][k] += w[k] * (rs[c] + k * drs[c]);
-            row.t[c][k] += w[k] * (rt[c] + k * drt[c]);
+            row.v[1 + c][k] += w[k] * (rs[c] + kZ[k] * drs[c]);
+            row.v[4 + c][k] += w[k] * (rt[c] + kZ[k] * drt[c]);
         }
-    for (int k = 0; k < 8; ++k) row.w[k] += w[k];
+}
+
+/// A leaf with no near pair: along each row the far sums are linear in z, so
+/// p = B(x) + (g0 + z gz) / (w0 + z wz) per voxel, with channels as in Row.
+void fillFar(WarpLeaf& leaf, const double far[7][8], const InverseWarp::Affine& bS, const InverseWarp::Affine& bT)
+{
+    const Vec3d o = leaf.origin.asVec3d();
+    for (int i = 0; i < 8; ++i) {
+        const double fx = i / 8.0;
+        for (int j = 0; j < 8; ++j) {
+            const double fy = j / 8.0;
+            double v0[7], dv[7];
+            for (int c = 0; c < 7; ++c) {
+                const double* v = far[c];
+                const double a0 = v[0] + fx * (v[1] - v[0]), c0 = v[2] + fx * (v[3] - v[2]);
+                const double a1 = v[4] + fx * (v[5] - v[4]), c1 = v[6] + fx * (v[7] - v[6]);
+                v0[c] = a0 + fy * (c0 - a0);
+                dv[c] = (a1 + fy * (c1 - a1) - v0[c]) / 8.0;
+            }
+            const Vec3d start = o + Vec3d(i, j, 0);
+            const Vec3d bs = bS.apply(start), bt = bT.apply(start);
+            const Vec3d& bsz = bS.col[2];
+            const Vec3d& btz = bT.col[2];
+            Vec3f* s = &leaf.source[(i * 8 + j) * 8];
+            Vec3f* t = &leaf.target[(i * 8 + j) * 8];
+            for (int z = 0; z < 8; ++z) {
+                const double inv = 1.0 / (v0[0] + kZ[z] * dv[0]);
+                s[z] = Vec3f(float(bs.x() + kZ[z] * bsz.x() + (v0[1] + kZ[z] * dv[1]) * inv),
+                             float(bs.y() + kZ[z] * bsz.y() + (v0[2] + kZ[z] * dv[2]) * inv),
+                             float(bs.z() + kZ[z] * bsz.z() + (v0[3] + kZ[z] * dv[3]) * inv));
+                t[z] = Vec3f(float(bt.x() + kZ[z] * btz.x() + (v0[4] + kZ[z] * dv[4]) * inv),
+                             float(bt.y() + kZ[z] * btz.y() + (v0[5] + kZ[z] * dv[5]) * inv),
+                             float(bt.z() + kZ[z] * btz.z() + (v0[6] + kZ[z] * dv[6]) * inv));
+            }
+        }
+    }
 }
 
 } // namespace
@@ -186,10 +269,15 @@ void addNearPair(Row& row, const Feature& e, const Vec3d& start, double offset, 
 AdaptiveWarp::AdaptiveWarp(const InverseWarp& warp, double toleranceVoxels)
     : mWarp(warp), mTolerance(toleranceVoxels)
 {
-    for (size_t i = 0; i < warp.pairCount(); ++i) {
+    const size_t n = warp.pairCount();
+    for (size_t i = 0; i < n; ++i) {
         mSource.push_back(warp.sourceAffine(i));
         mTarget.push_back(warp.targetAffine(i));
     }
+    mSlope.resize(n * n);
+    for (size_t i = 0; i < n; ++i)
+        for (size_t j = 0; j < n; ++j)
+            mSlope[i * n + j] = std::max(linearDistance(mSource[i], mSource[j]), linearDistance(mTarget[i], mTarget[j]));
 }
 
 void AdaptiveWarp::identityLeaf(Context& ctx) const
@@ -249,70 +337,52 @@ bool touches(const Occupancy* occ, const Vec3d& lo, const Vec3d& hi, double marg
 
 } // namespace
 
-void AdaptiveWarp::leaf(Context& ctx, const Lattice& lattice, const Coord& origin) const
+bool AdaptiveWarp::analyze(Context& ctx, const Lattice& lattice, const Coord& origin, int size) const
 {
-    ctx.leaf.origin = origin;
-    const bool cull = ctx.source || ctx.target;
     const size_t n = mWarp.pairCount();
-    const Vec3d o = origin.asVec3d();
-    auto visit = [&](double errorBound) {
-        if (cull) {
-            // The filled points' own bounding box, widened by what they may be off.
-            Vec3f slo = ctx.leaf.source[0], shi = slo, tlo = ctx.leaf.target[0], thi = tlo;
-            for (int i = 1; i < 512; ++i) {
-                slo = minComponent(slo, ctx.leaf.source[i]);
-                shi = maxComponent(shi, ctx.leaf.source[i]);
-                tlo = minComponent(tlo, ctx.leaf.target[i]);
-                thi = maxComponent(thi, ctx.leaf.target[i]);
-            }
-            const double margin = kSamplerReach + errorBound;
-            if (!touches(ctx.source, Vec3d(slo), Vec3d(shi), margin) && !touches(ctx.target, Vec3d(tlo), Vec3d(thi), margin))
-                return;
-        }
-        ++ctx.leaves;
-        (*ctx.fn)(ctx.leaf);
-    };
-
-    if (n == 0) {
-        if (cull && !touches(ctx.source, o, o + Vec3d(7.0), kSamplerReach) &&
-            !touches(ctx.target, o, o + Vec3d(7.0), kSamplerReach))
-            return;
-        identityLeaf(ctx);
-        ++ctx.leaves;
-        (*ctx.fn)(ctx.leaf);
-        return;
-    }
-
-    // Corners, bit 0: +x, bit 1: +y, bit 2: +z.
+    const bool cull = ctx.source || ctx.target;
+    // Corners, bit 0: +x, bit 1: +y, bit 2: +z; lattice points are 8 voxels apart.
+    const int step = size / 8;
     const Coord lc(origin.x() >> 3, origin.y() >> 3, origin.z() >> 3);
-    const Lattice::Point* corner[8];
-    bool cornersOk = true;
+    const Lattice::Point** corner = ctx.corner;
+    bool& cornersOk = ctx.cornersOk;
+    cornersOk = true;
     for (int k = 0; k < 8; ++k) {
-        corner[k] = &lattice.points[lattice.index(lc.offsetBy(k & 1, (k >> 1) & 1, (k >> 2) & 1))];
+        corner[k] = &lattice.points[lattice.index(lc.offsetBy((k & 1) * step, ((k >> 1) & 1) * step, ((k >> 2) & 1) * step))];
         cornersOk = cornersOk && corner[k]->ok;
     }
 
-    // Each pair over the leaf cube [o, o + 8]^3 (its voxels and its far corners).
-    const double h = 8.0, halfDiagonal = 0.5 * h * std::sqrt(3.0);
+    // Each pair over the cube [o, o + size]^3 (a leaf: its voxels and its far corners).
+    const Vec3d o = origin.asVec3d();
+    const double h = size, halfDiagonal = 0.5 * h * std::sqrt(3.0);
     const Vec3d centre = o + Vec3d(0.5 * h);
     const double offset = mWarp.weightOffset(), b = mWarp.weightExponent();
+    const bool inverseSquare = mWarp.weighting() == Weighting::InverseSquare;
     std::vector<PairBounds>& pb = ctx.bounds;
     pb.resize(n);
-    double wMinSum = 0.0, wCentreMax = -1.0;
-    size_t dominant = 0;
-    bool tiny = false;
+    double& wMinSum = ctx.wMinSum;
+    double wCentreMax = -1.0;
+    size_t& dominant = ctx.dominant;
+    bool& tiny = ctx.tiny;
+    wMinSum = 0.0;
+    dominant = 0;
+    tiny = false;
     for (size_t i = 0; i < n; ++i) {
         const Feature& e = mWarp.interpolated(i);
         const Vec3d q = e.frameCoordinates(centre);
         const double dc = e.distanceInFrame(q);
         PairBounds& p = pb[i];
         p.constant = e.type == FeatureType::Box && dc == 0.0 && boxContains(e, centre, h);
-        p.dMin = p.constant ? 0.0 : std::max(0.0, dc - halfDiagonal);
+        // d is convex (the distance to a convex set), so it lies above its tangent plane at the
+        // centre: over the cube, d >= dc - h/2 |g|_1, g = grad d at the centre.
+        const Vec3d g = dc > 0.0 ? e.gradientInFrame(q, dc) : Vec3d(0.0);
+        const double gL1 = std::abs(g.x()) + std::abs(g.y()) + std::abs(g.z());
+        p.dMin = dc > 0.0 ? std::max(0.0, dc - 0.5 * h * gL1) : 0.0;
         const double rMin = offset + p.dMin, rMax = offset + (p.constant ? 0.0 : dc + halfDiagonal);
         if (rMin < kTinyRadius) tiny = true;
         const double scale = mWarp.weightScale(i);
-        p.wMax = scale * std::pow(std::max(rMin, kTinyRadius), -b);
-        p.wMin = scale * std::pow(rMax, -b);
+        p.wMax = weightLaw(scale, std::max(rMin, kTinyRadius), b, inverseSquare);
+        p.wMin = weightLaw(scale, rMax, b, inverseSquare);
         wMinSum += p.wMin;
         if (p.constant) {
             p.w1 = p.w2 = 0.0;
@@ -320,9 +390,8 @@ void AdaptiveWarp::leaf(Context& ctx, const Lattice& lattice, const Coord& origi
             // Per axis a: |w_a| <= b w / r |d_a| and |w_aa| <= w (b (b + 1) / r^2 (d_a)^2 +
             // b / r |d_aa|). grad d is the unit vector from the element's nearest point; over the
             // leaf it turns by at most |Hess d| halfDiagonal <= halfDiagonal / dMin, so
-            // sup |d_a| <= |g_a| + turn, g its value at the centre; and sum_a |d_aa| <= 3 / dMin.
+            // sup |d_a| <= |g_a| + turn; and sum_a |d_aa| <= 3 / dMin.
             // w1 bounds sqrt(sum_a sup (w_a)^2), w2 bounds sum_a sup |w_aa|.
-            const Vec3d g = e.gradientInFrame(q, dc);
             const double turn = std::min(1.0, halfDiagonal / p.dMin);
             double axial = 0.0;
             for (int a = 0; a < 3; ++a) {
@@ -351,14 +420,13 @@ void AdaptiveWarp::leaf(Context& ctx, const Lattice& lattice, const Coord& origi
     slope.resize(n);
     double rhoSum = 0.0, residMax = 0.0;
     for (size_t i = 0; i < n; ++i) {
-        const double ms = linearDistance(mSource[i], bS), mt = linearDistance(mTarget[i], bT);
-        slope[i] = std::max(ms, mt);
-        resid[i] = std::max((mSource[i].apply(centre) - bS.apply(centre)).length() + ms * halfDiagonal,
-                            (mTarget[i].apply(centre) - bT.apply(centre)).length() + mt * halfDiagonal);
+        slope[i] = mSlope[dominant * n + i];
+        resid[i] = std::max((mSource[i].apply(centre) - bS.apply(centre)).length(),
+                            (mTarget[i].apply(centre) - bT.apply(centre)).length()) + slope[i] * halfDiagonal;
         rhoSum += pb[i].wMax * resid[i];
         residMax = std::max(residMax, resid[i]);
     }
-    const double rhoMax = std::min(residMax, rhoSum / wMinSum);
+    const double rhoMax = ctx.rhoMax = std::min(residMax, rhoSum / wMinSum);
 
     // Each far pair's share of the bound; one pair is its own affine map (R = 0, rho = 0).
     const double k = kBoundScale * h * h / 8.0;
@@ -373,25 +441,17 @@ void AdaptiveWarp::leaf(Context& ctx, const Lattice& lattice, const Coord& origi
         ctx.term[i] = std::isfinite(pb[i].w2) ? k * ((resid[i] + rhoMax) * pb[i].w2 + 2.0 * slope[i] * pb[i].w1)
                                               : std::numeric_limits<double>::infinity();
     }
-    // The bound with the pairs of `near` evaluated exactly, the others interpolated.
-    auto boundWith = [&](size_t nearCount) {
-        double terms = 0.0, hess = 0.0;
-        for (size_t j = nearCount; j < n; ++j) {
-            terms += ctx.term[ctx.order[j]];
-            hess += ctx.hessW[ctx.order[j]];
-        }
-        const double denominator = wMinSum - hess;
-        return std::isfinite(terms) && denominator > 0.0 ? terms / denominator : std::numeric_limits<double>::infinity();
-    };
-    const double boundAllFar = boundWith(0);
+    const double boundAllFar = ctx.boundAllFar = boundWith(ctx, 0);
 
     // The domain, before any voxel. With every pair far the interpolant is B + I[G] / I[W], and
     // I[G] / I[W] is a convex combination of the corners' rho_k = G_k / W_k: the image lies
     // within B(leaf) + hull(rho_k), widened by the bound. Otherwise p = B + rho, |rho| <= rhoMax.
+    const bool cornerHull = cornersOk && boundAllFar < rhoMax;
+    ctx.tightBox = cornerHull || rhoMax <= kSamplerReach;
     if (cull) {
         Vec3d rsLo(-rhoMax), rsHi(rhoMax), rtLo(-rhoMax), rtHi(rhoMax);
         double margin = kSamplerReach;
-        if (cornersOk && boundAllFar < rhoMax) {
+        if (cornerHull) {
             rsLo = rtLo = Vec3d(std::numeric_limits<double>::max());
             rsHi = rtHi = -rsLo;
             for (int c = 0; c < 8; ++c) {
@@ -408,12 +468,73 @@ void AdaptiveWarp::leaf(Context& ctx, const Lattice& lattice, const Coord& origi
         affineImage(bS, o, h, lo, hi);
         const bool s = touches(ctx.source, lo + rsLo, hi + rsHi, margin);
         affineImage(bT, o, h, lo, hi);
-        if (!s && !touches(ctx.target, lo + rtLo, hi + rtHi, margin)) return;
+        if (!s && !touches(ctx.target, lo + rtLo, hi + rtHi, margin)) return false;
+    }
+    return true;
+
+}
+
+double AdaptiveWarp::boundWith(const Context& ctx, size_t nearCount) const
+{
+    // The bound with the first nearCount pairs of ctx.order evaluated exactly, the others
+    // interpolated.
+    double terms = 0.0, hess = 0.0;
+    for (size_t j = nearCount; j < ctx.order.size(); ++j) {
+        terms += ctx.term[ctx.order[j]];
+        hess += ctx.hessW[ctx.order[j]];
+    }
+    const double denominator = ctx.wMinSum - hess;
+    return std::isfinite(terms) && denominator > 0.0 ? terms / denominator : std::numeric_limits<double>::infinity();
+}
+
+void AdaptiveWarp::leaf(Context& ctx, const Lattice& lattice, const Coord& origin) const
+{
+    ctx.leaf.origin = origin;
+    const bool cull = ctx.source || ctx.target;
+    const size_t n = mWarp.pairCount();
+    const Vec3d o = origin.asVec3d();
+    // `recheck`: cull again by the filled points, when the bound's box before the fill was loose.
+    auto visit = [&](double errorBound, bool recheck) {
+        if (cull && recheck) {
+            // The filled points' own bounding box, widened by what they may be off.
+            Vec3f slo = ctx.leaf.source[0], shi = slo, tlo = ctx.leaf.target[0], thi = tlo;
+            for (int i = 1; i < 512; ++i) {
+                slo = minComponent(slo, ctx.leaf.source[i]);
+                shi = maxComponent(shi, ctx.leaf.source[i]);
+                tlo = minComponent(tlo, ctx.leaf.target[i]);
+                thi = maxComponent(thi, ctx.leaf.target[i]);
+            }
+            const double margin = kSamplerReach + errorBound;
+            if (!touches(ctx.source, Vec3d(slo), Vec3d(shi), margin) && !touches(ctx.target, Vec3d(tlo), Vec3d(thi), margin))
+                return;
+        }
+        ++ctx.leaves;
+        (*ctx.fn)(ctx.leaf);
+    };
+
+    if (n == 0) {
+        if (cull && !touches(ctx.source, o, o + Vec3d(7.0), kSamplerReach) &&
+            !touches(ctx.target, o, o + Vec3d(7.0), kSamplerReach))
+            return;
+        identityLeaf(ctx);
+        ++ctx.leaves;
+        (*ctx.fn)(ctx.leaf);
+        return;
     }
 
-    if (mTolerance <= 0.0 || !cornersOk || tiny) {
+    if (!analyze(ctx, lattice, origin, 8)) return;
+    const double h = 8.0;
+    const Lattice::Point* const* corner = ctx.corner;
+    const double offset = mWarp.weightOffset(), b = mWarp.weightExponent();
+    const bool inverseSquare = mWarp.weighting() == Weighting::InverseSquare;
+    const InverseWarp::Affine& bS = mSource[ctx.dominant];
+    const InverseWarp::Affine& bT = mTarget[ctx.dominant];
+    const bool tightBox = ctx.tightBox;
+    const double boundAllFar = ctx.boundAllFar;
+
+    if (mTolerance <= 0.0 || !ctx.cornersOk || ctx.tiny) {
         exactLeaf(ctx);
-        visit(0.0);
+        visit(0.0, !tightBox);
         return;
     }
 
@@ -425,13 +546,13 @@ void AdaptiveWarp::leaf(Context& ctx, const Lattice& lattice, const Coord& origi
     double bound = boundAllFar;
     while (bound > mTolerance && nearCount < n) {
         ctx.isNear[ctx.order[nearCount]] = 1;
-        bound = boundWith(++nearCount);
+        bound = boundWith(ctx, ++nearCount);
     }
     if (nearCount == n) bound = 0.0; // every pair near: exact at every voxel but for rounding
 
-    // Far sums at the corners: W_F = W - sum_E w_i, G = N - sum_E w_i A_i - W_F B.
-    double cw[8];
-    Vec3d cs[8], ct[8];
+    // Far sums at the corners: W_F = W - sum_E w_i, G = N - sum_E w_i A_i - W_F B; channels as
+    // in Row.
+    double far[7][8];
     for (int c = 0; c < 8; ++c) {
         const Vec3d x = o + Vec3d((c & 1) * h, ((c >> 1) & 1) * h, ((c >> 2) & 1) * h);
         double w = corner[c]->w;
@@ -443,72 +564,74 @@ void AdaptiveWarp::leaf(Context& ctx, const Lattice& lattice, const Coord& origi
             s -= wi * mSource[i].apply(x);
             t -= wi * mTarget[i].apply(x);
         }
-        cw[c] = w;
-        cs[c] = s - w * bS.apply(x);
-        ct[c] = t - w * bT.apply(x);
+        s -= w * bS.apply(x);
+        t -= w * bT.apply(x);
+        far[0][c] = w;
+        for (int k = 0; k < 3; ++k) {
+            far[1 + k][c] = s[k];
+            far[4 + k][c] = t[k];
+        }
     }
 
-    const bool inverseSquare = mWarp.weighting() == Weighting::InverseSquare;
-    Row row;
-    for (int i = 0; i < 8; ++i) {
-        const double fx = i / h;
-        for (int j = 0; j < 8; ++j) {
-            const double fy = j / h;
-            // Far sums along the row: bilinear at z = 0 and z = h, linear in between.
-            auto bilinear = [&](auto v, int z) {
-                const int base = z << 2;
-                const auto a = v[base] + fx * (v[base + 1] - v[base]);
-                const auto c = v[base + 2] + fx * (v[base + 3] - v[base + 2]);
-                return a + fy * (c - a);
-            };
-            const double w0 = bilinear(cw, 0), w1 = bilinear(cw, 1);
-            const Vec3d s0 = bilinear(cs, 0), s1 = bilinear(cs, 1), t0 = bilinear(ct, 0), t1 = bilinear(ct, 1);
-            for (int z = 0; z < 8; ++z) {
-                const double f = z / h;
-                row.w[z] = w0 + f * (w1 - w0);
-                for (int c = 0; c < 3; ++c) {
-                    row.s[c][z] = s0[c] + f * (s1[c] - s0[c]);
-                    row.t[c][z] = t0[c] + f * (t1[c] - t0[c]);
+    const double bsz[3] = {bS.col[2].x(), bS.col[2].y(), bS.col[2].z()};
+    const double btz[3] = {bT.col[2].x(), bT.col[2].y(), bT.col[2].z()};
+    if (nearCount == 0) {
+        fillFar(ctx.leaf, far, bS, bT);
+    } else {
+        Row row;
+        for (int i = 0; i < 8; ++i) {
+            const double fx = i / h;
+            for (int j = 0; j < 8; ++j) {
+                const double fy = j / h;
+                // Far sums along the row: bilinear at z = 0 and z = h, linear in between.
+                for (int c = 0; c < 7; ++c) {
+                    const double* v = far[c];
+                    const double a0 = v[0] + fx * (v[1] - v[0]), c0 = v[2] + fx * (v[3] - v[2]);
+                    const double a1 = v[4] + fx * (v[5] - v[4]), c1 = v[6] + fx * (v[7] - v[6]);
+                    const double z0 = a0 + fy * (c0 - a0), z1 = a1 + fy * (c1 - a1), dz = (z1 - z0) / h;
+                    for (int z = 0; z < 8; ++z) row.v[c][z] = z0 + kZ[z] * dz;
                 }
-            }
-            const Vec3d start = o + Vec3d(i, j, 0);
-            for (size_t p = 0; p < n; ++p) {
-                if (!ctx.isNear[p]) continue;
-                const Vec3d rs = mSource[p].apply(start) - bS.apply(start), drs = mSource[p].col[2] - bS.col[2];
-                const Vec3d rt = mTarget[p].apply(start) - bT.apply(start), drt = mTarget[p].col[2] - bT.col[2];
-                const Feature& e = mWarp.interpolated(p);
-                const double scale = mWarp.weightScale(p);
-                switch (e.type) {
-                case FeatureType::Point:
-                    addNearPair<FeatureType::Point>(row, e, start, offset, b, scale, inverseSquare, rs, drs, rt, drt);
-                    break;
-                case FeatureType::Segment:
-                    addNearPair<FeatureType::Segment>(row, e, start, offset, b, scale, inverseSquare, rs, drs, rt, drt);
-                    break;
-                case FeatureType::Rectangle:
-                    addNearPair<FeatureType::Rectangle>(row, e, start, offset, b, scale, inverseSquare, rs, drs, rt, drt);
-                    break;
-                case FeatureType::Box:
-                    addNearPair<FeatureType::Box>(row, e, start, offset, b, scale, inverseSquare, rs, drs, rt, drt);
-                    break;
+                const Vec3d start = o + Vec3d(i, j, 0);
+                for (size_t p = 0; p < n; ++p) {
+                    if (!ctx.isNear[p]) continue;
+                    const Vec3d rs = mSource[p].apply(start) - bS.apply(start), drs = mSource[p].col[2] - bS.col[2];
+                    const Vec3d rt = mTarget[p].apply(start) - bT.apply(start), drt = mTarget[p].col[2] - bT.col[2];
+                    const Feature& e = mWarp.interpolated(p);
+                    const double scale = mWarp.weightScale(p);
+                    switch (e.type) {
+                    case FeatureType::Point:
+                        addNearPair<FeatureType::Point>(row, e, start, offset, b, scale, inverseSquare, rs, drs, rt, drt);
+                        break;
+                    case FeatureType::Segment:
+                        addNearPair<FeatureType::Segment>(row, e, start, offset, b, scale, inverseSquare, rs, drs, rt, drt);
+                        break;
+                    case FeatureType::Rectangle:
+                        addNearPair<FeatureType::Rectangle>(row, e, start, offset, b, scale, inverseSquare, rs, drs, rt, drt);
+                        break;
+                    case FeatureType::Box:
+                        addNearPair<FeatureType::Box>(row, e, start, offset, b, scale, inverseSquare, rs, drs, rt, drt);
+                        break;
+                    }
                 }
-            }
-            const Vec3d bs0 = bS.apply(start), bt0 = bT.apply(start);
-            const int n0 = (i * 8 + j) * 8;
-            for (int z = 0; z < 8; ++z) {
-                const double inv = 1.0 / row.w[z];
-                ctx.leaf.source[n0 + z] = Vec3f(float(bs0.x() + z * bS.col[2].x() + row.s[0][z] * inv),
-                                                float(bs0.y() + z * bS.col[2].y() + row.s[1][z] * inv),
-                                                float(bs0.z() + z * bS.col[2].z() + row.s[2][z] * inv));
-                ctx.leaf.target[n0 + z] = Vec3f(float(bt0.x() + z * bT.col[2].x() + row.t[0][z] * inv),
-                                                float(bt0.y() + z * bT.col[2].y() + row.t[1][z] * inv),
-                                                float(bt0.z() + z * bT.col[2].z() + row.t[2][z] * inv));
+                // p = B(x) + residual sum / weight sum.
+                const Vec3d bs0 = bS.apply(start), bt0 = bT.apply(start);
+                const int n0 = (i * 8 + j) * 8;
+                for (int z = 0; z < 8; ++z) {
+                    const double inv = 1.0 / row.v[0][z];
+                    ctx.leaf.source[n0 + z] = Vec3f(float(bs0[0] + kZ[z] * bsz[0] + row.v[1][z] * inv),
+                                                    float(bs0[1] + kZ[z] * bsz[1] + row.v[2][z] * inv),
+                                                    float(bs0[2] + kZ[z] * bsz[2] + row.v[3][z] * inv));
+                    ctx.leaf.target[n0 + z] = Vec3f(float(bt0[0] + kZ[z] * btz[0] + row.v[4][z] * inv),
+                                                    float(bt0[1] + kZ[z] * btz[1] + row.v[5][z] * inv),
+                                                    float(bt0[2] + kZ[z] * btz[2] + row.v[6][z] * inv));
+                }
             }
         }
+
     }
     ctx.near += uint64_t(nearCount) * 512;
     ctx.maxError = std::max(ctx.maxError, bound);
-    visit(bound);
+    visit(bound, !tightBox || nearCount > 0);
 }
 
 void AdaptiveWarp::forEachLeaf(const CoordBBox& box, const Occupancy* source, const Occupancy* target,
@@ -548,13 +671,17 @@ void AdaptiveWarp::forEachLeaf(const CoordBBox& box, const Occupancy* source, co
             CoordBBox part = cube;
             part.intersect(box);
             if (part.empty()) continue;
-            for (int x = down(part.min().x(), 8); x <= part.max().x(); x += 8)
-                for (int y = down(part.min().y(), 8); y <= part.max().y(); y += 8)
-                    for (int z = down(part.min().z(), 8); z <= part.max().z(); z += 8) {
-                        const Coord c(x, y, z);
-                        if (wanted && !(*wanted)(CoordBBox::createCube(c, 8))) continue;
-                        perTop[ti].push_back(c);
-                    }
+            // Leaves grouped by cells of 2^3 leaves (step 2 culls those cells).
+            for (int cx = down(part.min().x(), 16); cx <= part.max().x(); cx += 16)
+                for (int cy = down(part.min().y(), 16); cy <= part.max().y(); cy += 16)
+                    for (int cz = down(part.min().z(), 16); cz <= part.max().z(); cz += 16)
+                        for (int x = std::max(cx, down(part.min().x(), 8)); x <= std::min(cx + 8, part.max().x()); x += 8)
+                            for (int y = std::max(cy, down(part.min().y(), 8)); y <= std::min(cy + 8, part.max().y()); y += 8)
+                                for (int z = std::max(cz, down(part.min().z(), 8)); z <= std::min(cz + 8, part.max().z()); z += 8) {
+                                    const Coord c(x, y, z);
+                                    if (wanted && !(*wanted)(CoordBBox::createCube(c, 8))) continue;
+                                    perTop[ti].push_back(c);
+                                }
         }
     });
     std::vector<Coord> candidates;
@@ -562,48 +689,82 @@ void AdaptiveWarp::forEachLeaf(const CoordBBox& box, const Occupancy* source, co
     if (candidates.empty()) return;
     if (interrupter && interrupter->wasInterrupted(0)) throw Interrupted();
 
-    // 2. The exact sums at every corner of a candidate leaf, each lattice point once.
+    // 2. The exact sums at the corners of the candidate leaves, each lattice point once. With
+    //    occupancies, cells of 2^3 leaves are culled first from their own corners (every other
+    //    lattice point), so that the leaves of a cell whose image misses both sides cost nothing.
     Lattice lattice;
     uint64_t latticeEvaluations = 0;
+    std::atomic<bool> stopped{false};
     if (n > 0) {
+        auto cellOf = [](const Coord& c) { return Coord(c.x() & ~15, c.y() & ~15, c.z() & ~15); };
         Coord llo(std::numeric_limits<int>::max()), lhi(std::numeric_limits<int>::min());
         for (const Coord& c : candidates) {
-            const Coord l(c.x() >> 3, c.y() >> 3, c.z() >> 3);
-            llo = Coord::minComponent(llo, l);
-            lhi = Coord::maxComponent(lhi, l.offsetBy(1));
+            const Coord l = cellOf(c);
+            llo = Coord::minComponent(llo, Coord(l.x() >> 3, l.y() >> 3, l.z() >> 3));
+            lhi = Coord::maxComponent(lhi, Coord(l.x() >> 3, l.y() >> 3, l.z() >> 3).offsetBy(2));
         }
         lattice.lo = llo;
         lattice.dim = lhi - llo + Coord(1);
         lattice.points.resize(size_t(lattice.dim.x()) * lattice.dim.y() * lattice.dim.z());
-        std::vector<char> needed(lattice.points.size(), 0);
-        for (const Coord& c : candidates)
-            for (int k = 0; k < 8; ++k)
-                needed[lattice.index(Coord(c.x() >> 3, c.y() >> 3, c.z() >> 3).offsetBy(k & 1, (k >> 1) & 1, (k >> 2) & 1))] = 1;
-        std::vector<size_t> todo;
-        for (size_t i = 0; i < needed.size(); ++i)
-            if (needed[i]) todo.push_back(i);
-        latticeEvaluations = todo.size();
-        std::atomic<bool> stopped{false};
-        tbb::parallel_for(tbb::blocked_range<size_t>(0, todo.size(), 64), [&](const tbb::blocked_range<size_t>& r) {
-            if (stopped || (interrupter && interrupter->wasInterrupted(int(10 * r.begin() / todo.size())))) {
-                stopped = true;
-                return;
-            }
-            for (size_t i = r.begin(); i != r.end(); ++i) {
-                const size_t idx = todo[i];
+        std::vector<char> state(lattice.points.size(), 0); // 1 wanted, 2 evaluated
+        auto evaluate = [&](int progressFrom) {
+            std::vector<size_t> todo;
+            for (size_t i = 0; i < state.size(); ++i)
+                if (state[i] == 1) {
+                    todo.push_back(i);
+                    state[i] = 2;
+                }
+            latticeEvaluations += todo.size();
+            tbb::parallel_for(tbb::blocked_range<size_t>(0, todo.size(), 64), [&](const tbb::blocked_range<size_t>& r) {
+                if (stopped || (interrupter && interrupter->wasInterrupted(progressFrom + int(5 * r.begin() / todo.size())))) {
+                    stopped = true;
+                    return;
+                }
                 const int yz = lattice.dim.y() * lattice.dim.z();
-                const Coord l(lattice.lo.x() + int(idx / yz), lattice.lo.y() + int(idx % yz) / lattice.dim.z(),
-                              lattice.lo.z() + int(idx % lattice.dim.z()));
-                Lattice::Point& p = lattice.points[idx];
-                p.ok = mWarp.sums(Vec3d(l.x() * 8.0, l.y() * 8.0, l.z() * 8.0), p.w, p.s, p.t);
+                for (size_t i = r.begin(); i != r.end(); ++i) {
+                    const size_t idx = todo[i];
+                    const Coord l(lattice.lo.x() + int(idx / yz), lattice.lo.y() + int(idx % yz) / lattice.dim.z(),
+                                  lattice.lo.z() + int(idx % lattice.dim.z()));
+                    Lattice::Point& p = lattice.points[idx];
+                    p.ok = mWarp.sums(Vec3d(l.x() * 8.0, l.y() * 8.0, l.z() * 8.0), p.w, p.s, p.t);
+                }
+            });
+            if (stopped) throw Interrupted();
+        };
+        auto want = [&](const Coord& origin, int step) {
+            const Coord l(origin.x() >> 3, origin.y() >> 3, origin.z() >> 3);
+            for (int k = 0; k < 8; ++k) {
+                char& st = state[lattice.index(l.offsetBy((k & 1) * step, ((k >> 1) & 1) * step, ((k >> 2) & 1) * step))];
+                if (st == 0) st = 1;
             }
-        });
-        if (stopped) throw Interrupted();
+        };
+        if (source || target) {
+            // The cells and, per cell, where its leaves begin in `candidates`.
+            std::vector<size_t> begin;
+            for (size_t i = 0; i < candidates.size(); ++i)
+                if (i == 0 || cellOf(candidates[i]) != cellOf(candidates[i - 1])) begin.push_back(i);
+            begin.push_back(candidates.size());
+            for (size_t c = 0; c + 1 < begin.size(); ++c) want(cellOf(candidates[begin[c]]), 2);
+            evaluate(0);
+            std::vector<char> keep(begin.size() - 1, 0);
+            tbb::parallel_for(tbb::blocked_range<size_t>(0, keep.size(), 16), [&](const tbb::blocked_range<size_t>& r) {
+                auto ctx = std::make_unique<Context>();
+                ctx->source = source;
+                ctx->target = target;
+                for (size_t c = r.begin(); c != r.end(); ++c)
+                    keep[c] = analyze(*ctx, lattice, cellOf(candidates[begin[c]]), 16);
+            });
+            std::vector<Coord> kept;
+            for (size_t c = 0; c < keep.size(); ++c)
+                if (keep[c]) kept.insert(kept.end(), candidates.begin() + begin[c], candidates.begin() + begin[c + 1]);
+            candidates.swap(kept);
+        }
+        for (const Coord& c : candidates) want(c, 1);
+        evaluate(5);
     }
 
     // 3. Every candidate leaf: culled by the bound, filled, culled by its points, handed on.
     std::mutex statsMutex;
-    std::atomic<bool> stopped{false};
     tbb::parallel_for(tbb::blocked_range<size_t>(0, candidates.size(), 16), [&](const tbb::blocked_range<size_t>& r) {
         if (stopped || (interrupter && interrupter->wasInterrupted(10 + int(90 * r.begin() / candidates.size())))) {
             stopped = true;

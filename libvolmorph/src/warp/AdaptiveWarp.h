@@ -60,6 +60,10 @@ public:
 
 private:
     openvdb::MaskTree mBlocks;
+    // The same blocks as a summed-volume table over their bounds, for box queries in O(1)
+    // (empty when that table would be too large; then the tree is scanned).
+    openvdb::Coord mLo, mDim;           ///< block coordinates of the table's first cell, cells per axis
+    std::vector<uint32_t> mPrefix;      ///< (mDim + 1)^3 counts of occupied blocks below each corner
 };
 
 /// Warped positions of one output leaf's 8^3 voxels, in the index space of source and target.
@@ -101,6 +105,10 @@ public:
 private:
     struct Context;
     struct Lattice;
+    /// The bound's terms for the cube of `size` (8 or 16) voxels at origin, from its corners;
+    /// false when its image misses both sides' occupied blocks.
+    bool analyze(Context& ctx, const Lattice& lattice, const openvdb::Coord& origin, int size) const;
+    double boundWith(const Context& ctx, size_t nearCount) const;
     void leaf(Context& ctx, const Lattice& lattice, const openvdb::Coord& origin) const;
     void exactLeaf(Context& ctx) const;
     void identityLeaf(Context& ctx) const;
@@ -108,6 +116,7 @@ private:
     const InverseWarp& mWarp;
     double mTolerance;
     std::vector<InverseWarp::Affine> mSource, mTarget; ///< each pair's affine map on each side
+    std::vector<double> mSlope; ///< [i * n + j]: |M_i - M_j| (Frobenius), the larger side
 };
 
 } // namespace volmorph::detail
