@@ -8,11 +8,13 @@
 
 #include <openvdb/tools/Composite.h>
 #include <openvdb/tools/LevelSetSphere.h>
+#include <openvdb/tools/Morphology.h>
 
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <filesystem>
+#include <iostream>
 #include <mutex>
 #include <random>
 #include <set>
@@ -252,13 +254,21 @@ TEST(InverseWarp, DegenerateInputsStayFinite)
 
 TEST(AdaptiveWarp, WithinToleranceOfTheExactWarpOnRandomConfigurations)
 {
+    // Inverse-square weights at t = 1/4 and 3/4, Beier-Neely's at t = 1/2. The bound behind the
+    // approximation is a worst case, so the error is checked at every voxel, not sampled.
     std::mt19937 random(2024);
     for (int n : {1, 2, 4, 8, 16, 32, 64}) {
-        for (int trial = 0; trial < 2; ++trial) {
+        for (int trial = 0; trial < 3; ++trial) {
             const auto pairs = randomPairs(random, n, 96.0);
             WarpSpec spec;
             spec.epsilon = 2.0; // index units here (unit = 1)
-            const double t = 0.25 + 0.5 * trial;
+            if (trial == 2) {
+                spec.weighting = Weighting::BeierNeely;
+                spec.a = 2.0;
+                spec.b = 2.0;
+                spec.p = 0.5;
+            }
+            const double t = 0.25 + 0.25 * trial;
             const InverseWarp warp(pairs, spec, t);
             const double tolerance = 0.25;
             const detail::AdaptiveWarp adaptive(warp, tolerance);
@@ -283,8 +293,91 @@ TEST(AdaptiveWarp, WithinToleranceOfTheExactWarpOnRandomConfigurations)
             EXPECT_LE(worst, tolerance) << n << " pairs, trial " << trial;
             EXPECT_LE(stats.maxErrorVoxels, tolerance);
             EXPECT_EQ(stats.leaves, 12u * 12u * 12u);
+            // Pairs packed this densely (2 voxels of epsilon, elements 2-26 voxels, moved up to
+            // 24) leave most pairs near most voxels; the next test is the efficient case.
+            const double pairEvaluations = double(stats.exactEvaluations) * n + double(stats.nearEvaluations);
+            EXPECT_LE(pairEvaluations, 1.01 * 96.0 * 96 * 96 * n);
         }
     }
+}
+
+TEST(AdaptiveWarp, FewPairEvaluationsWherePairsAreApart)
+{
+    // Eight pairs of each type at the corners of a 2^3 grid 96 voxels apart, moved by up to 8
+    // voxels and turned by up to 20 degrees, epsilon 4 voxels: most of the 192^3 box is far
+    // from all of them, and most of the exact warp's pair evaluations are saved (0.22 of them are
+    // made; the bound is a worst case, some 10 times the error actually made).
+    std::mt19937 random(11);
+    std::uniform_real_distribution<double> u(-1.0, 1.0);
+    std::vector<FeaturePairSpec> pairs;
+    for (int k = 0; k < 8; ++k) {
+        const Vec3d at(48.0 + 96 * (k & 1), 48.0 + 96 * ((k >> 1) & 1), 48.0 + 96 * ((k >> 2) & 1));
+        const Vec3d axis = Vec3d(u(random), u(random), u(random) + 2.0).unit();
+        const double angle = u(random) * M_PI / 9.0;
+        pairs.push_back(pair(FeatureType(k % 4), element(at, Vec3d(1, 0, 0), Vec3d(0, 1, 0), Vec3d(12, 8, 6)),
+                             element(at + 8.0 * Vec3d(u(random), u(random), u(random)), rotate(Vec3d(1, 0, 0), axis, angle),
+                                     rotate(Vec3d(0, 1, 0), axis, angle), Vec3d(14, 7, 6))));
+    }
+    WarpSpec spec;
+    spec.epsilon = 4.0;
+    const InverseWarp warp(pairs, spec, 0.5);
+    const detail::AdaptiveWarp adaptive(warp, 0.25);
+    std::mutex m;
+    double worst = 0.0;
+    detail::AdaptiveWarpStats stats;
+    adaptive.forEachLeaf(openvdb::CoordBBox(openvdb::Coord(0), openvdb::Coord(191)), nullptr, nullptr,
+                         [&](const detail::WarpLeaf& leaf) {
+                             double local = 0.0;
+                             Vec3d s, d;
+                             for (int i = 0; i < 512; ++i) {
+                                 warp.map(leaf.origin.offsetBy(i >> 6, (i >> 3) & 7, i & 7).asVec3d(), s, d);
+                                 local = std::max({local, (Vec3d(leaf.source[i]) - s).length(),
+                                                   (Vec3d(leaf.target[i]) - d).length()});
+                             }
+                             std::lock_guard<std::mutex> lock(m);
+                             worst = std::max(worst, local);
+                         },
+                         &stats);
+    const double voxels = 192.0 * 192 * 192;
+    const double share = (double(stats.exactEvaluations) * 8 + double(stats.nearEvaluations)) / (8 * voxels);
+    std::cout << "largest error " << worst << " voxel, bound " << stats.maxErrorVoxels << ", pair evaluations "
+              << share << " of the exact warp's\n";
+    EXPECT_LE(worst, 0.25);
+    EXPECT_LE(stats.maxErrorVoxels, 0.25);
+    EXPECT_LT(share, 0.3);
+}
+
+TEST(AdaptiveWarp, OccupancyBoxQueriesMatchTheTree)
+{
+    // Occupancy answers box queries from a summed-volume table; the tree, scanned block by block,
+    // is the reference.
+    openvdb::FloatTree tree(0.0f);
+    std::mt19937 random(7);
+    std::uniform_int_distribution<int> coord(-200, 200);
+    for (int i = 0; i < 300; ++i) tree.setValue(openvdb::Coord(coord(random), coord(random), coord(random)), 1.0f);
+    tree.fill(openvdb::CoordBBox(openvdb::Coord(256), openvdb::Coord(256 + 127)), 1.0f, true); // a tile
+    const detail::Occupancy occupancy(tree);
+    openvdb::MaskTree blocks; // the same rule: blocks with active values, dilated by one block
+    auto block = [](int v) { return v >= 0 ? v / 8 : -((-v + 7) / 8); };
+    for (auto it = tree.cbeginValueOn(); it; ++it)
+        for (auto c = it.getBoundingBox().begin(); c; ++c)
+            blocks.setValueOn(openvdb::Coord(block((*c).x()), block((*c).y()), block((*c).z())));
+    openvdb::tools::dilateActiveValues(blocks, 1, openvdb::tools::NN_FACE_EDGE_VERTEX);
+    std::uniform_int_distribution<int> size(0, 40);
+    int hits = 0;
+    for (int i = 0; i < 3000; ++i) {
+        const openvdb::Coord lo(coord(random) * 2, coord(random) * 2, coord(random) * 2);
+        const openvdb::CoordBBox box(lo, lo.offsetBy(size(random), size(random), size(random)));
+        bool expected = false;
+        for (int x = block(box.min().x()); x <= block(box.max().x()) && !expected; ++x)
+            for (int y = block(box.min().y()); y <= block(box.max().y()) && !expected; ++y)
+                for (int z = block(box.min().z()); z <= block(box.max().z()) && !expected; ++z)
+                    expected = blocks.isValueOn(openvdb::Coord(x, y, z));
+        ASSERT_EQ(occupancy.anyIn(box), expected) << box;
+        hits += expected;
+    }
+    EXPECT_GT(hits, 100); // both answers were exercised
+    EXPECT_LT(hits, 2900);
 }
 
 TEST(Morph, PointPairTranslatesTheSphereLinearly)

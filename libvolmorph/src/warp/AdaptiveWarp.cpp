@@ -116,12 +116,14 @@ struct PairBounds {
 
 /// The exact sums at the corners of the candidate leaves: a lattice 8 voxels apart over the
 /// leaves' bounding box (index space / 8), evaluated only where a candidate leaf needs it.
+struct AdaptiveWarp::LatticePoint {
+    double w = 0.0;     ///< sum w_i
+    Vec3d s, t;         ///< sum w_i A_i, source and target side
+    bool ok = false;    ///< false: on an element with a zero offset, or not evaluated
+};
+
 struct AdaptiveWarp::Lattice {
-    struct Point {
-        double w = 0.0;     ///< sum w_i
-        Vec3d s, t;         ///< sum w_i A_i, source and target side
-        bool ok = false;    ///< false: on an element with a zero offset, or not evaluated
-    };
+    using Point = LatticePoint;
     Coord lo;               ///< lattice coordinates of point 0 (leaf coordinates)
     Coord dim;              ///< points along each axis
     std::vector<Point> points;
@@ -145,7 +147,7 @@ struct AdaptiveWarp::Context {
     std::vector<int> order;
     std::vector<char> isNear;
     // What analyze() found of the last cell.
-    const Lattice::Point* corner[8];
+    const LatticePoint* corner[8];
     bool cornersOk = false, tiny = false, tightBox = false;
     size_t dominant = 0;
     double wMinSum = 0.0, rhoMax = 0.0, boundAllFar = 0.0;
@@ -215,10 +217,12 @@ void addNearPair(Row& row, const Feature& e, const Vec3d& start, double offset, 
     const Vec3d dq(e.x.z(), e.y.z(), e.z.z()); // d/dz of the frame coordinates
     const double hx = 0.5 * e.scale.x(), hy = 0.5 * e.scale.y(), hz = 0.5 * e.scale.z();
     double w[8];
-    for (int k = 0; k < 8; ++k) {
-        const double d = frameDistance<T>(q0.x() + kZ[k] * dq.x(), q0.y() + kZ[k] * dq.y(), q0.z() + kZ[k] * dq.z(), hx, hy, hz);
-        const double r = offset + d;
-        w[k] = weightLaw(scale, r, exponent, inverseSquare);
+    for (int k = 0; k < 8; ++k)
+        w[k] = offset + frameDistance<T>(q0.x() + kZ[k] * dq.x(), q0.y() + kZ[k] * dq.y(), q0.z() + kZ[k] * dq.z(), hx, hy, hz);
+    if (inverseSquare) {
+        for (int k = 0; k < 8; ++k) w[k] = 1.0 / (w[k] * w[k]);
+    } else {
+        for (int k = 0; k < 8; ++k) w[k] = scale * std::pow(w[k], -exponent);
     }
     for (int k = 0; k < 8; ++k) row.v[0][k] += w[k];
     for (int c = 0; c < 3; ++c)
@@ -226,42 +230,6 @@ void addNearPair(Row& row, const Feature& e, const Vec3d& start, double offset, 
             row.v[1 + c][k] += w[k] * (rs[c] + kZ[k] * drs[c]);
             row.v[4 + c][k] += w[k] * (rt[c] + kZ[k] * drt[c]);
         }
-}
-
-/// A leaf with no near pair: along each row the far sums are linear in z, so
-/// p = B(x) + (g0 + z gz) / (w0 + z wz) per voxel, with channels as in Row.
-void fillFar(WarpLeaf& leaf, const double far[7][8], const InverseWarp::Affine& bS, const InverseWarp::Affine& bT)
-{
-    const Vec3d o = leaf.origin.asVec3d();
-    for (int i = 0; i < 8; ++i) {
-        const double fx = i / 8.0;
-        for (int j = 0; j < 8; ++j) {
-            const double fy = j / 8.0;
-            double v0[7], dv[7];
-            for (int c = 0; c < 7; ++c) {
-                const double* v = far[c];
-                const double a0 = v[0] + fx * (v[1] - v[0]), c0 = v[2] + fx * (v[3] - v[2]);
-                const double a1 = v[4] + fx * (v[5] - v[4]), c1 = v[6] + fx * (v[7] - v[6]);
-                v0[c] = a0 + fy * (c0 - a0);
-                dv[c] = (a1 + fy * (c1 - a1) - v0[c]) / 8.0;
-            }
-            const Vec3d start = o + Vec3d(i, j, 0);
-            const Vec3d bs = bS.apply(start), bt = bT.apply(start);
-            const Vec3d& bsz = bS.col[2];
-            const Vec3d& btz = bT.col[2];
-            Vec3f* s = &leaf.source[(i * 8 + j) * 8];
-            Vec3f* t = &leaf.target[(i * 8 + j) * 8];
-            for (int z = 0; z < 8; ++z) {
-                const double inv = 1.0 / (v0[0] + kZ[z] * dv[0]);
-                s[z] = Vec3f(float(bs.x() + kZ[z] * bsz.x() + (v0[1] + kZ[z] * dv[1]) * inv),
-                             float(bs.y() + kZ[z] * bsz.y() + (v0[2] + kZ[z] * dv[2]) * inv),
-                             float(bs.z() + kZ[z] * bsz.z() + (v0[3] + kZ[z] * dv[3]) * inv));
-                t[z] = Vec3f(float(bt.x() + kZ[z] * btz.x() + (v0[4] + kZ[z] * dv[4]) * inv),
-                             float(bt.y() + kZ[z] * btz.y() + (v0[5] + kZ[z] * dv[5]) * inv),
-                             float(bt.z() + kZ[z] * btz.z() + (v0[6] + kZ[z] * dv[6]) * inv));
-            }
-        }
-    }
 }
 
 } // namespace
@@ -337,19 +305,13 @@ bool touches(const Occupancy* occ, const Vec3d& lo, const Vec3d& hi, double marg
 
 } // namespace
 
-bool AdaptiveWarp::analyze(Context& ctx, const Lattice& lattice, const Coord& origin, int size) const
+void AdaptiveWarp::analyze(Context& ctx, const LatticePoint* const corners[8], const Coord& origin, int size) const
 {
     const size_t n = mWarp.pairCount();
-    const bool cull = ctx.source || ctx.target;
-    // Corners, bit 0: +x, bit 1: +y, bit 2: +z; lattice points are 8 voxels apart.
-    const int step = size / 8;
-    const Coord lc(origin.x() >> 3, origin.y() >> 3, origin.z() >> 3);
-    const Lattice::Point** corner = ctx.corner;
-    bool& cornersOk = ctx.cornersOk;
-    cornersOk = true;
+    ctx.cornersOk = true;
     for (int k = 0; k < 8; ++k) {
-        corner[k] = &lattice.points[lattice.index(lc.offsetBy((k & 1) * step, ((k >> 1) & 1) * step, ((k >> 2) & 1) * step))];
-        cornersOk = cornersOk && corner[k]->ok;
+        ctx.corner[k] = corners[k];
+        ctx.cornersOk = ctx.cornersOk && corners[k]->ok;
     }
 
     // Each pair over the cube [o, o + size]^3 (a leaf: its voxels and its far corners).
@@ -441,14 +403,23 @@ bool AdaptiveWarp::analyze(Context& ctx, const Lattice& lattice, const Coord& or
         ctx.term[i] = std::isfinite(pb[i].w2) ? k * ((resid[i] + rhoMax) * pb[i].w2 + 2.0 * slope[i] * pb[i].w1)
                                               : std::numeric_limits<double>::infinity();
     }
-    const double boundAllFar = ctx.boundAllFar = boundWith(ctx, 0);
+    ctx.boundAllFar = boundWith(ctx, 0);
 
-    // The domain, before any voxel. With every pair far the interpolant is B + I[G] / I[W], and
-    // I[G] / I[W] is a convex combination of the corners' rho_k = G_k / W_k: the image lies
-    // within B(leaf) + hull(rho_k), widened by the bound. Otherwise p = B + rho, |rho| <= rhoMax.
-    const bool cornerHull = cornersOk && boundAllFar < rhoMax;
+}
+
+// The domain, before any voxel. With every pair far the interpolant is B + I[G] / I[W], and
+// I[G] / I[W] is a convex combination of the corners' rho_k = G_k / W_k: the image lies within
+// B(cube) + hull(rho_k), widened by the bound. Otherwise p = B + rho with |rho| <= rhoMax.
+bool AdaptiveWarp::mayTouch(Context& ctx, const Coord& origin, int size) const
+{
+    const double h = size, rhoMax = ctx.rhoMax, boundAllFar = ctx.boundAllFar;
+    const Vec3d o = origin.asVec3d();
+    const InverseWarp::Affine& bS = mSource[ctx.dominant];
+    const InverseWarp::Affine& bT = mTarget[ctx.dominant];
+    const LatticePoint* const* corner = ctx.corner;
+    const bool cornerHull = ctx.cornersOk && boundAllFar < rhoMax;
     ctx.tightBox = cornerHull || rhoMax <= kSamplerReach;
-    if (cull) {
+    {
         Vec3d rsLo(-rhoMax), rsHi(rhoMax), rtLo(-rhoMax), rtHi(rhoMax);
         double margin = kSamplerReach;
         if (cornerHull) {
@@ -471,7 +442,6 @@ bool AdaptiveWarp::analyze(Context& ctx, const Lattice& lattice, const Coord& or
         if (!s && !touches(ctx.target, lo + rtLo, hi + rtHi, margin)) return false;
     }
     return true;
-
 }
 
 double AdaptiveWarp::boundWith(const Context& ctx, size_t nearCount) const
@@ -487,13 +457,138 @@ double AdaptiveWarp::boundWith(const Context& ctx, size_t nearCount) const
     return std::isfinite(terms) && denominator > 0.0 ? terms / denominator : std::numeric_limits<double>::infinity();
 }
 
+double AdaptiveWarp::selectNear(Context& ctx, size_t& nearCount) const
+{
+    // Largest share first, until the bound of the rest is within the tolerance.
+    const size_t n = mWarp.pairCount();
+    std::sort(ctx.order.begin(), ctx.order.end(), [&](int a, int c) {
+        return ctx.term[a] > ctx.term[c] || (ctx.term[a] == ctx.term[c] && a < c);
+    });
+    nearCount = 0;
+    double bound = ctx.boundAllFar;
+    while (bound > mTolerance && nearCount < n) {
+        ctx.isNear[ctx.order[nearCount]] = 1;
+        bound = boundWith(ctx, ++nearCount);
+    }
+    return nearCount == n ? 0.0 : bound; // every pair near: exact at every voxel but for rounding
+}
+
+void AdaptiveWarp::fill(Context& ctx, const Coord& origin) const
+{
+    constexpr int Size = 8;
+    const size_t n = mWarp.pairCount();
+    const double h = Size;
+    const Vec3d o = origin.asVec3d();
+    const Coord local = origin - ctx.leaf.origin;
+    const InverseWarp::Affine& bS = mSource[ctx.dominant];
+    const InverseWarp::Affine& bT = mTarget[ctx.dominant];
+
+    // Far sums at the corners: W_F = W - sum_E w_i, G = N - sum_E w_i A_i - W_F B; channels as
+    // in Row.
+    double far[7][8];
+    bool anyNear = false;
+    for (int c = 0; c < 8; ++c) {
+        const Vec3d x = o + Vec3d((c & 1) * h, ((c >> 1) & 1) * h, ((c >> 2) & 1) * h);
+        double w = ctx.corner[c]->w;
+        Vec3d s = ctx.corner[c]->s, t = ctx.corner[c]->t;
+        for (size_t i = 0; i < n; ++i) {
+            if (!ctx.isNear[i]) continue;
+            anyNear = true;
+            const double wi = mWarp.weightAt(i, mWarp.interpolated(i).distance(x));
+            w -= wi;
+            s -= wi * mSource[i].apply(x);
+            t -= wi * mTarget[i].apply(x);
+        }
+        s -= w * bS.apply(x);
+        t -= w * bT.apply(x);
+        far[0][c] = w;
+        for (int k = 0; k < 3; ++k) {
+            far[1 + k][c] = s[k];
+            far[4 + k][c] = t[k];
+        }
+    }
+
+    const double offset = mWarp.weightOffset(), b = mWarp.weightExponent();
+    const bool inverseSquare = mWarp.weighting() == Weighting::InverseSquare;
+    const Vec3d& bsz = bS.col[2];
+    const Vec3d& btz = bT.col[2];
+    for (int i = 0; i < Size; ++i) {
+        const double fx = i / h;
+        for (int j = 0; j < Size; ++j) {
+            const double fy = j / h;
+            // Far sums along the row: bilinear at z = 0 and z = h, linear in between.
+            double v0[7], dv[7];
+            for (int c = 0; c < 7; ++c) {
+                const double* v = far[c];
+                const double a0 = v[0] + fx * (v[1] - v[0]), c0 = v[2] + fx * (v[3] - v[2]);
+                const double a1 = v[4] + fx * (v[5] - v[4]), c1 = v[6] + fx * (v[7] - v[6]);
+                v0[c] = a0 + fy * (c0 - a0);
+                dv[c] = (a1 + fy * (c1 - a1) - v0[c]) / h;
+            }
+            const Vec3d start = o + Vec3d(i, j, 0);
+            const Vec3d bs = bS.apply(start), bt = bT.apply(start);
+            const int n0 = ((local.x() + i) * 8 + local.y() + j) * 8 + local.z();
+            Vec3f* out0 = &ctx.leaf.source[n0];
+            Vec3f* out1 = &ctx.leaf.target[n0];
+            if (!anyNear) {
+                // p = B(x) + (g0 + z gz) / (w0 + z wz).
+                for (int z = 0; z < Size; ++z) {
+                    const double inv = 1.0 / (v0[0] + kZ[z] * dv[0]);
+                    out0[z] = Vec3f(float(bs.x() + kZ[z] * bsz.x() + (v0[1] + kZ[z] * dv[1]) * inv),
+                                    float(bs.y() + kZ[z] * bsz.y() + (v0[2] + kZ[z] * dv[2]) * inv),
+                                    float(bs.z() + kZ[z] * bsz.z() + (v0[3] + kZ[z] * dv[3]) * inv));
+                    out1[z] = Vec3f(float(bt.x() + kZ[z] * btz.x() + (v0[4] + kZ[z] * dv[4]) * inv),
+                                    float(bt.y() + kZ[z] * btz.y() + (v0[5] + kZ[z] * dv[5]) * inv),
+                                    float(bt.z() + kZ[z] * btz.z() + (v0[6] + kZ[z] * dv[6]) * inv));
+                }
+                continue;
+            }
+            Row row;
+            for (int c = 0; c < 7; ++c)
+                for (int z = 0; z < 8; ++z) row.v[c][z] = v0[c] + kZ[z] * dv[c];
+            for (size_t p = 0; p < n; ++p) {
+                if (!ctx.isNear[p]) continue;
+                const Vec3d rs = mSource[p].apply(start) - bs, drs = mSource[p].col[2] - bsz;
+                const Vec3d rt = mTarget[p].apply(start) - bt, drt = mTarget[p].col[2] - btz;
+                const Feature& e = mWarp.interpolated(p);
+                const double scale = mWarp.weightScale(p);
+                switch (e.type) {
+                case FeatureType::Point:
+                    addNearPair<FeatureType::Point>(row, e, start, offset, b, scale, inverseSquare, rs, drs, rt, drt);
+                    break;
+                case FeatureType::Segment:
+                    addNearPair<FeatureType::Segment>(row, e, start, offset, b, scale, inverseSquare, rs, drs, rt, drt);
+                    break;
+                case FeatureType::Rectangle:
+                    addNearPair<FeatureType::Rectangle>(row, e, start, offset, b, scale, inverseSquare, rs, drs, rt, drt);
+                    break;
+                case FeatureType::Box:
+                    addNearPair<FeatureType::Box>(row, e, start, offset, b, scale, inverseSquare, rs, drs, rt, drt);
+                    break;
+                }
+            }
+            // p = B(x) + residual sum / weight sum.
+            for (int z = 0; z < Size; ++z) {
+                const double inv = 1.0 / row.v[0][z];
+                out0[z] = Vec3f(float(bs.x() + kZ[z] * bsz.x() + row.v[1][z] * inv),
+                                float(bs.y() + kZ[z] * bsz.y() + row.v[2][z] * inv),
+                                float(bs.z() + kZ[z] * bsz.z() + row.v[3][z] * inv));
+                out1[z] = Vec3f(float(bt.x() + kZ[z] * btz.x() + row.v[4][z] * inv),
+                                float(bt.y() + kZ[z] * btz.y() + row.v[5][z] * inv),
+                                float(bt.z() + kZ[z] * btz.z() + row.v[6][z] * inv));
+            }
+        }
+    }
+}
+
 void AdaptiveWarp::leaf(Context& ctx, const Lattice& lattice, const Coord& origin) const
 {
     ctx.leaf.origin = origin;
     const bool cull = ctx.source || ctx.target;
     const size_t n = mWarp.pairCount();
     const Vec3d o = origin.asVec3d();
-    // `recheck`: cull again by the filled points, when the bound's box before the fill was loose.
+    // `recheck`: cull again by the filled points, when the box before the fill was loose or near
+    // pairs were evaluated.
     auto visit = [&](double errorBound, bool recheck) {
         if (cull && recheck) {
             // The filled points' own bounding box, widened by what they may be off.
@@ -522,116 +617,26 @@ void AdaptiveWarp::leaf(Context& ctx, const Lattice& lattice, const Coord& origi
         return;
     }
 
-    if (!analyze(ctx, lattice, origin, 8)) return;
-    const double h = 8.0;
-    const Lattice::Point* const* corner = ctx.corner;
-    const double offset = mWarp.weightOffset(), b = mWarp.weightExponent();
-    const bool inverseSquare = mWarp.weighting() == Weighting::InverseSquare;
-    const InverseWarp::Affine& bS = mSource[ctx.dominant];
-    const InverseWarp::Affine& bT = mTarget[ctx.dominant];
+    const Coord lc(origin.x() >> 3, origin.y() >> 3, origin.z() >> 3);
+    const LatticePoint* corners[8];
+    for (int k = 0; k < 8; ++k)
+        corners[k] = &lattice.points[lattice.index(lc.offsetBy(k & 1, (k >> 1) & 1, (k >> 2) & 1))];
+    analyze(ctx, corners, origin, 8);
+    if (cull && !mayTouch(ctx, origin, 8)) return;
     const bool tightBox = ctx.tightBox;
-    const double boundAllFar = ctx.boundAllFar;
-
     if (mTolerance <= 0.0 || !ctx.cornersOk || ctx.tiny) {
         exactLeaf(ctx);
         visit(0.0, !tightBox);
         return;
     }
 
-    // Near pairs: largest share first, until the bound of the rest is within the tolerance.
-    std::sort(ctx.order.begin(), ctx.order.end(), [&](int a, int c) {
-        return ctx.term[a] > ctx.term[c] || (ctx.term[a] == ctx.term[c] && a < c);
-    });
     size_t nearCount = 0;
-    double bound = boundAllFar;
-    while (bound > mTolerance && nearCount < n) {
-        ctx.isNear[ctx.order[nearCount]] = 1;
-        bound = boundWith(ctx, ++nearCount);
-    }
-    if (nearCount == n) bound = 0.0; // every pair near: exact at every voxel but for rounding
-
-    // Far sums at the corners: W_F = W - sum_E w_i, G = N - sum_E w_i A_i - W_F B; channels as
-    // in Row.
-    double far[7][8];
-    for (int c = 0; c < 8; ++c) {
-        const Vec3d x = o + Vec3d((c & 1) * h, ((c >> 1) & 1) * h, ((c >> 2) & 1) * h);
-        double w = corner[c]->w;
-        Vec3d s = corner[c]->s, t = corner[c]->t;
-        for (size_t i = 0; i < n; ++i) {
-            if (!ctx.isNear[i]) continue;
-            const double wi = mWarp.weightAt(i, mWarp.interpolated(i).distance(x));
-            w -= wi;
-            s -= wi * mSource[i].apply(x);
-            t -= wi * mTarget[i].apply(x);
-        }
-        s -= w * bS.apply(x);
-        t -= w * bT.apply(x);
-        far[0][c] = w;
-        for (int k = 0; k < 3; ++k) {
-            far[1 + k][c] = s[k];
-            far[4 + k][c] = t[k];
-        }
-    }
-
-    const double bsz[3] = {bS.col[2].x(), bS.col[2].y(), bS.col[2].z()};
-    const double btz[3] = {bT.col[2].x(), bT.col[2].y(), bT.col[2].z()};
-    if (nearCount == 0) {
-        fillFar(ctx.leaf, far, bS, bT);
-    } else {
-        Row row;
-        for (int i = 0; i < 8; ++i) {
-            const double fx = i / h;
-            for (int j = 0; j < 8; ++j) {
-                const double fy = j / h;
-                // Far sums along the row: bilinear at z = 0 and z = h, linear in between.
-                for (int c = 0; c < 7; ++c) {
-                    const double* v = far[c];
-                    const double a0 = v[0] + fx * (v[1] - v[0]), c0 = v[2] + fx * (v[3] - v[2]);
-                    const double a1 = v[4] + fx * (v[5] - v[4]), c1 = v[6] + fx * (v[7] - v[6]);
-                    const double z0 = a0 + fy * (c0 - a0), z1 = a1 + fy * (c1 - a1), dz = (z1 - z0) / h;
-                    for (int z = 0; z < 8; ++z) row.v[c][z] = z0 + kZ[z] * dz;
-                }
-                const Vec3d start = o + Vec3d(i, j, 0);
-                for (size_t p = 0; p < n; ++p) {
-                    if (!ctx.isNear[p]) continue;
-                    const Vec3d rs = mSource[p].apply(start) - bS.apply(start), drs = mSource[p].col[2] - bS.col[2];
-                    const Vec3d rt = mTarget[p].apply(start) - bT.apply(start), drt = mTarget[p].col[2] - bT.col[2];
-                    const Feature& e = mWarp.interpolated(p);
-                    const double scale = mWarp.weightScale(p);
-                    switch (e.type) {
-                    case FeatureType::Point:
-                        addNearPair<FeatureType::Point>(row, e, start, offset, b, scale, inverseSquare, rs, drs, rt, drt);
-                        break;
-                    case FeatureType::Segment:
-                        addNearPair<FeatureType::Segment>(row, e, start, offset, b, scale, inverseSquare, rs, drs, rt, drt);
-                        break;
-                    case FeatureType::Rectangle:
-                        addNearPair<FeatureType::Rectangle>(row, e, start, offset, b, scale, inverseSquare, rs, drs, rt, drt);
-                        break;
-                    case FeatureType::Box:
-                        addNearPair<FeatureType::Box>(row, e, start, offset, b, scale, inverseSquare, rs, drs, rt, drt);
-                        break;
-                    }
-                }
-                // p = B(x) + residual sum / weight sum.
-                const Vec3d bs0 = bS.apply(start), bt0 = bT.apply(start);
-                const int n0 = (i * 8 + j) * 8;
-                for (int z = 0; z < 8; ++z) {
-                    const double inv = 1.0 / row.v[0][z];
-                    ctx.leaf.source[n0 + z] = Vec3f(float(bs0[0] + kZ[z] * bsz[0] + row.v[1][z] * inv),
-                                                    float(bs0[1] + kZ[z] * bsz[1] + row.v[2][z] * inv),
-                                                    float(bs0[2] + kZ[z] * bsz[2] + row.v[3][z] * inv));
-                    ctx.leaf.target[n0 + z] = Vec3f(float(bt0[0] + kZ[z] * btz[0] + row.v[4][z] * inv),
-                                                    float(bt0[1] + kZ[z] * btz[1] + row.v[5][z] * inv),
-                                                    float(bt0[2] + kZ[z] * btz[2] + row.v[6][z] * inv));
-                }
-            }
-        }
-
-    }
-    ctx.near += uint64_t(nearCount) * 512;
+    const double bound = selectNear(ctx, nearCount);
+    const uint64_t near = uint64_t(nearCount) * 512;
+    fill(ctx, origin);
+    ctx.near += near;
     ctx.maxError = std::max(ctx.maxError, bound);
-    visit(bound, !tightBox || nearCount > 0);
+    visit(bound, !tightBox || near > 0);
 }
 
 void AdaptiveWarp::forEachLeaf(const CoordBBox& box, const Occupancy* source, const Occupancy* target,
@@ -751,8 +756,15 @@ void AdaptiveWarp::forEachLeaf(const CoordBBox& box, const Occupancy* source, co
                 auto ctx = std::make_unique<Context>();
                 ctx->source = source;
                 ctx->target = target;
-                for (size_t c = r.begin(); c != r.end(); ++c)
-                    keep[c] = analyze(*ctx, lattice, cellOf(candidates[begin[c]]), 16);
+                for (size_t c = r.begin(); c != r.end(); ++c) {
+                    const Coord cell = cellOf(candidates[begin[c]]);
+                    const Coord l(cell.x() >> 3, cell.y() >> 3, cell.z() >> 3);
+                    const LatticePoint* corners[8];
+                    for (int k = 0; k < 8; ++k)
+                        corners[k] = &lattice.points[lattice.index(l.offsetBy((k & 1) * 2, ((k >> 1) & 1) * 2, ((k >> 2) & 1) * 2))];
+                    analyze(*ctx, corners, cell, 16);
+                    keep[c] = mayTouch(*ctx, cell, 16);
+                }
             });
             std::vector<Coord> kept;
             for (size_t c = 0; c < keep.size(); ++c)

@@ -104,11 +104,19 @@ public:
 
 private:
     struct Context;
+    struct LatticePoint;
     struct Lattice;
-    /// The bound's terms for the cube of `size` (8 or 16) voxels at origin, from its corners;
-    /// false when its image misses both sides' occupied blocks.
-    bool analyze(Context& ctx, const Lattice& lattice, const openvdb::Coord& origin, int size) const;
+    /// The bound's terms for the cube of `size` (4, 8 or 16) voxels at origin, from the exact
+    /// sums at its corners (bit 0: +x, bit 1: +y, bit 2: +z), into ctx.
+    void analyze(Context& ctx, const LatticePoint* const corners[8], const openvdb::Coord& origin, int size) const;
+    /// False when the analysed cube's image misses both sides' occupied blocks.
+    bool mayTouch(Context& ctx, const openvdb::Coord& origin, int size) const;
+    /// The bound with the first nearCount pairs (largest terms first) evaluated exactly.
     double boundWith(const Context& ctx, size_t nearCount) const;
+    /// Marks the analysed cube's near pairs; returns its bound.
+    double selectNear(Context& ctx, size_t& nearCount) const;
+    /// Fills the analysed leaf at origin: far sums interpolated, near pairs evaluated.
+    void fill(Context& ctx, const openvdb::Coord& origin) const;
     void leaf(Context& ctx, const Lattice& lattice, const openvdb::Coord& origin) const;
     void exactLeaf(Context& ctx) const;
     void identityLeaf(Context& ctx) const;
