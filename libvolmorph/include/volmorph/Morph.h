@@ -53,7 +53,7 @@ struct MorphOptions {
 inline constexpr uint64_t kMorphBytesPerLeaf = 24 * 1024;
 
 struct MorphStats {
-    double maxWarpErrorVoxels = 0.0;   ///< largest error measured where the warp was interpolated
+    double maxWarpErrorVoxels = 0.0;   ///< largest error bound of a leaf where the warp was interpolated
     uint64_t exactEvaluations = 0;     ///< exact warp evaluations (a pair of points each)
     uint64_t candidateLeaves = 0;      ///< output leaves evaluated
     uint64_t outputLeaves = 0;         ///< output leaves kept (non-empty)

@@ -625,8 +625,9 @@ void AdaptiveWarp::leaf(Context& ctx, const Lattice& lattice, const Coord& origi
     if (cull && !mayTouch(ctx, origin, 8)) return;
     const bool tightBox = ctx.tightBox;
     if (mTolerance <= 0.0 || !ctx.cornersOk || ctx.tiny) {
+        // Exact points: their own box is the domain's best test, and cheap next to them.
         exactLeaf(ctx);
-        visit(0.0, !tightBox);
+        visit(0.0, true);
         return;
     }
 
