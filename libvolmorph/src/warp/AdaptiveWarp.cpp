@@ -107,6 +107,13 @@ CoordBBox Occupancy::bounds() const
 
 namespace {
 /// Everything the error bound needs of one pair over it.
+/// Per-voxel sums of a leaf, channel-major: 0 the weight sum, 1-3 the weighted residuals on the
+/// source side, 4-6 on the target side. Single precision, as the warped points are stored: its
+/// rounding (about 1e-6 of a residual of some tens of voxels) is far below any tolerance.
+struct LeafSums {
+    alignas(64) float v[7][512];
+};
+
 struct PairBounds {
     double dMin, wMax, wMin, w1, w2; ///< d and w over the leaf, |grad w|, |Hess w| bounds
     bool constant;                   ///< a box containing the whole leaf: d = 0, w constant
@@ -142,13 +149,14 @@ struct AdaptiveWarp::Context {
     double maxError = 0.0;
     uint64_t evaluations = 0, near = 0, leaves = 0;
     // Per pair, per leaf (scratch).
+    std::unique_ptr<LeafSums> sums = std::make_unique<LeafSums>();
     std::vector<PairBounds> bounds;
     std::vector<double> resid, slope, term, hessW;
     std::vector<int> order;
     std::vector<char> isNear;
     // What analyze() found of the last cell.
     const LatticePoint* corner[8];
-    bool cornersOk = false, tiny = false, tightBox = false;
+    bool cornersOk = false, tiny = false, coreTouches = false;
     size_t dominant = 0;
     double wMinSum = 0.0, rhoMax = 0.0, boundAllFar = 0.0;
 };
@@ -184,9 +192,9 @@ inline double weightLaw(double scale, double r, double b, bool inverseSquare)
 
 /// Distance in the element's frame, inlined per type for the per-voxel loop.
 template <FeatureType T>
-inline double frameDistance(double qx, double qy, double qz, double hx, double hy, double hz)
+inline float frameDistance(float qx, float qy, float qz, float hx, float hy, float hz)
 {
-    auto out = [](double v, double half) { return std::max(std::abs(v) - half, 0.0); };
+    auto out = [](float v, float half) { return std::max(std::abs(v) - half, 0.0f); };
     if constexpr (T == FeatureType::Point) return std::sqrt(qx * qx + qy * qy + qz * qz);
     if constexpr (T == FeatureType::Segment) {
         const double a = out(qx, hx);
@@ -203,33 +211,58 @@ inline double frameDistance(double qx, double qy, double qz, double hx, double h
 /// The voxels' offsets along a row, as doubles (the loops over them vectorize).
 constexpr double kZ[8] = {0, 1, 2, 3, 4, 5, 6, 7};
 
-/// One row of 8 voxels along z, channel-major so that the loops over z vectorize: 0 the weight
-/// sum, 1-3 the weighted residuals on the source side, 4-6 on the target side.
-struct Row {
-    double v[7][8];
-};
-
-template <FeatureType T>
-void addNearPair(Row& row, const Feature& e, const Vec3d& start, double offset, double exponent, double scale,
-                 bool inverseSquare, const Vec3d& rs, const Vec3d& drs, const Vec3d& rt, const Vec3d& drt)
-{
-    const Vec3d q0 = e.frameCoordinates(start);
-    const Vec3d dq(e.x.z(), e.y.z(), e.z.z()); // d/dz of the frame coordinates
-    const double hx = 0.5 * e.scale.x(), hy = 0.5 * e.scale.y(), hz = 0.5 * e.scale.z();
-    double w[8];
-    for (int k = 0; k < 8; ++k)
-        w[k] = offset + frameDistance<T>(q0.x() + kZ[k] * dq.x(), q0.y() + kZ[k] * dq.y(), q0.z() + kZ[k] * dq.z(), hx, hy, hz);
-    if (inverseSquare) {
-        for (int k = 0; k < 8; ++k) w[k] = 1.0 / (w[k] * w[k]);
-    } else {
-        for (int k = 0; k < 8; ++k) w[k] = scale * std::pow(w[k], -exponent);
-    }
-    for (int k = 0; k < 8; ++k) row.v[0][k] += w[k];
-    for (int c = 0; c < 3; ++c)
-        for (int k = 0; k < 8; ++k) {
-            row.v[1 + c][k] += w[k] * (rs[c] + kZ[k] * drs[c]);
-            row.v[4 + c][k] += w[k] * (rt[c] + kZ[k] * drt[c]);
+/// Each voxel's offsets in its leaf, in OpenVDB's order (index (i * 8 + j) * 8 + k), as floats:
+/// loops over the 512 voxels of a leaf then vectorize.
+struct LeafOffsets {
+    float i[512], j[512], k[512];
+    LeafOffsets()
+    {
+        for (int n = 0; n < 512; ++n) {
+            i[n] = n >> 6;
+            j[n] = (n >> 3) & 7;
+            k[n] = n & 7;
         }
+    }
+};
+const LeafOffsets kOffsets;
+
+/// Adds one near pair's weight and weighted residuals at every voxel of the leaf at o. rs and rt
+/// are the residuals R = A - B at o; their steps along the axes are the columns of M_A - M_B.
+template <FeatureType T>
+void addNearPair(LeafSums& sums, const Feature& e, const Vec3d& o, double offset, double exponent, double scale,
+                 bool inverseSquare, const Vec3d& rs, const Vec3d drs[3], const Vec3d& rt, const Vec3d drt[3])
+{
+    const Vec3f q0(e.frameCoordinates(o));
+    // Steps of the frame coordinates along x, y and z: the frame's rows.
+    const Vec3f dx(Vec3d(e.x.x(), e.y.x(), e.z.x())), dy(Vec3d(e.x.y(), e.y.y(), e.z.y())),
+        dz(Vec3d(e.x.z(), e.y.z(), e.z.z()));
+    const float hx = float(0.5 * e.scale.x()), hy = float(0.5 * e.scale.y()), hz = float(0.5 * e.scale.z());
+    const float* I = kOffsets.i;
+    const float* J = kOffsets.j;
+    const float* K = kOffsets.k;
+    alignas(64) float w[512];
+    for (int n = 0; n < 512; ++n) {
+        const float qx = q0.x() + I[n] * dx.x() + J[n] * dy.x() + K[n] * dz.x();
+        const float qy = q0.y() + I[n] * dx.y() + J[n] * dy.y() + K[n] * dz.y();
+        const float qz = q0.z() + I[n] * dx.z() + J[n] * dy.z() + K[n] * dz.z();
+        w[n] = float(offset) + frameDistance<T>(qx, qy, qz, hx, hy, hz);
+    }
+    if (inverseSquare) {
+        for (int n = 0; n < 512; ++n) w[n] = 1.0f / (w[n] * w[n]);
+    } else {
+        for (int n = 0; n < 512; ++n) w[n] = float(scale * std::pow(double(w[n]), -exponent));
+    }
+    for (int n = 0; n < 512; ++n) sums.v[0][n] += w[n];
+    for (int c = 0; c < 3; ++c) {
+        float* s = sums.v[1 + c];
+        float* t = sums.v[4 + c];
+        const float r0 = float(rs[c]), r1 = float(drs[0][c]), r2 = float(drs[1][c]), r3 = float(drs[2][c]);
+        const float u0 = float(rt[c]), u1 = float(drt[0][c]), u2 = float(drt[1][c]), u3 = float(drt[2][c]);
+        for (int n = 0; n < 512; ++n) {
+            s[n] += w[n] * (r0 + I[n] * r1 + J[n] * r2 + K[n] * r3);
+            t[n] += w[n] * (u0 + I[n] * u1 + J[n] * u2 + K[n] * u3);
+        }
+    }
 }
 
 } // namespace
@@ -416,32 +449,35 @@ bool AdaptiveWarp::mayTouch(Context& ctx, const Coord& origin, int size) const
     const Vec3d o = origin.asVec3d();
     const InverseWarp::Affine& bS = mSource[ctx.dominant];
     const InverseWarp::Affine& bT = mTarget[ctx.dominant];
-    const LatticePoint* const* corner = ctx.corner;
-    const bool cornerHull = ctx.cornersOk && boundAllFar < rhoMax;
-    ctx.tightBox = cornerHull || rhoMax <= kSamplerReach;
-    {
-        Vec3d rsLo(-rhoMax), rsHi(rhoMax), rtLo(-rhoMax), rtHi(rhoMax);
-        double margin = kSamplerReach;
-        if (cornerHull) {
-            rsLo = rtLo = Vec3d(std::numeric_limits<double>::max());
-            rsHi = rtHi = -rsLo;
-            for (int c = 0; c < 8; ++c) {
-                const Vec3d x = o + Vec3d((c & 1) * h, ((c >> 1) & 1) * h, ((c >> 2) & 1) * h);
-                const Vec3d rs = corner[c]->s / corner[c]->w - bS.apply(x), rt = corner[c]->t / corner[c]->w - bT.apply(x);
-                rsLo = minComponent(rsLo, rs);
-                rsHi = maxComponent(rsHi, rs);
-                rtLo = minComponent(rtLo, rt);
-                rtHi = maxComponent(rtHi, rt);
-            }
-            margin += boundAllFar;
+    // The corners' residuals rho_k = p_k - B(x_k), each side.
+    Vec3d rsLo(-rhoMax), rsHi(rhoMax), rtLo(-rhoMax), rtHi(rhoMax);
+    if (ctx.cornersOk) {
+        rsLo = rtLo = Vec3d(std::numeric_limits<double>::max());
+        rsHi = rtHi = -rsLo;
+        for (int c = 0; c < 8; ++c) {
+            const LatticePoint& p = *ctx.corner[c];
+            const Vec3d x = o + Vec3d((c & 1) * h, ((c >> 1) & 1) * h, ((c >> 2) & 1) * h);
+            const Vec3d rs = p.s / p.w - bS.apply(x), rt = p.t / p.w - bT.apply(x);
+            rsLo = minComponent(rsLo, rs);
+            rsHi = maxComponent(rsHi, rs);
+            rtLo = minComponent(rtLo, rt);
+            rtHi = maxComponent(rtHi, rt);
         }
-        Vec3d lo, hi;
-        affineImage(bS, o, h, lo, hi);
-        const bool s = touches(ctx.source, lo + rsLo, hi + rsHi, margin);
-        affineImage(bT, o, h, lo, hi);
-        if (!s && !touches(ctx.target, lo + rtLo, hi + rtHi, margin)) return false;
     }
-    return true;
+    Vec3d sLo, sHi, tLo, tHi;
+    affineImage(bS, o, h, sLo, sHi);
+    affineImage(bT, o, h, tLo, tHi);
+    // Where the corners themselves land: a cube whose corners' box touches an occupied block is
+    // kept without a second test on its filled points.
+    ctx.coreTouches = ctx.cornersOk && (touches(ctx.source, sLo + rsLo, sHi + rsHi, kSamplerReach) ||
+                                        touches(ctx.target, tLo + rtLo, tHi + rtHi, kSamplerReach));
+    if (ctx.coreTouches) return true;
+    if (ctx.cornersOk && boundAllFar < rhoMax) {
+        const double margin = kSamplerReach + boundAllFar;
+        return touches(ctx.source, sLo + rsLo, sHi + rsHi, margin) || touches(ctx.target, tLo + rtLo, tHi + rtHi, margin);
+    }
+    const double margin = kSamplerReach + rhoMax;
+    return touches(ctx.source, sLo, sHi, margin) || touches(ctx.target, tLo, tHi, margin);
 }
 
 double AdaptiveWarp::boundWith(const Context& ctx, size_t nearCount) const
@@ -479,7 +515,6 @@ void AdaptiveWarp::fill(Context& ctx, const Coord& origin) const
     const size_t n = mWarp.pairCount();
     const double h = Size;
     const Vec3d o = origin.asVec3d();
-    const Coord local = origin - ctx.leaf.origin;
     const InverseWarp::Affine& bS = mSource[ctx.dominant];
     const InverseWarp::Affine& bT = mTarget[ctx.dominant];
 
@@ -527,7 +562,7 @@ void AdaptiveWarp::fill(Context& ctx, const Coord& origin) const
             }
             const Vec3d start = o + Vec3d(i, j, 0);
             const Vec3d bs = bS.apply(start), bt = bT.apply(start);
-            const int n0 = ((local.x() + i) * 8 + local.y() + j) * 8 + local.z();
+            const int n0 = (i * 8 + j) * 8;
             Vec3f* out0 = &ctx.leaf.source[n0];
             Vec3f* out1 = &ctx.leaf.target[n0];
             if (!anyNear) {
@@ -543,41 +578,54 @@ void AdaptiveWarp::fill(Context& ctx, const Coord& origin) const
                 }
                 continue;
             }
-            Row row;
             for (int c = 0; c < 7; ++c)
-                for (int z = 0; z < 8; ++z) row.v[c][z] = v0[c] + kZ[z] * dv[c];
-            for (size_t p = 0; p < n; ++p) {
-                if (!ctx.isNear[p]) continue;
-                const Vec3d rs = mSource[p].apply(start) - bs, drs = mSource[p].col[2] - bsz;
-                const Vec3d rt = mTarget[p].apply(start) - bt, drt = mTarget[p].col[2] - btz;
-                const Feature& e = mWarp.interpolated(p);
-                const double scale = mWarp.weightScale(p);
-                switch (e.type) {
-                case FeatureType::Point:
-                    addNearPair<FeatureType::Point>(row, e, start, offset, b, scale, inverseSquare, rs, drs, rt, drt);
-                    break;
-                case FeatureType::Segment:
-                    addNearPair<FeatureType::Segment>(row, e, start, offset, b, scale, inverseSquare, rs, drs, rt, drt);
-                    break;
-                case FeatureType::Rectangle:
-                    addNearPair<FeatureType::Rectangle>(row, e, start, offset, b, scale, inverseSquare, rs, drs, rt, drt);
-                    break;
-                case FeatureType::Box:
-                    addNearPair<FeatureType::Box>(row, e, start, offset, b, scale, inverseSquare, rs, drs, rt, drt);
-                    break;
-                }
-            }
-            // p = B(x) + residual sum / weight sum.
-            for (int z = 0; z < Size; ++z) {
-                const double inv = 1.0 / row.v[0][z];
-                out0[z] = Vec3f(float(bs.x() + kZ[z] * bsz.x() + row.v[1][z] * inv),
-                                float(bs.y() + kZ[z] * bsz.y() + row.v[2][z] * inv),
-                                float(bs.z() + kZ[z] * bsz.z() + row.v[3][z] * inv));
-                out1[z] = Vec3f(float(bt.x() + kZ[z] * btz.x() + row.v[4][z] * inv),
-                                float(bt.y() + kZ[z] * btz.y() + row.v[5][z] * inv),
-                                float(bt.z() + kZ[z] * btz.z() + row.v[6][z] * inv));
-            }
+                for (int z = 0; z < Size; ++z) ctx.sums->v[c][n0 + z] = float(v0[c] + kZ[z] * dv[c]);
         }
+    }
+    if (!anyNear) return;
+
+    // Near pairs at every voxel, then p = B(x) + residual sum / weight sum.
+    LeafSums& sums = *ctx.sums;
+    for (size_t p = 0; p < n; ++p) {
+        if (!ctx.isNear[p]) continue;
+        const Vec3d rs = mSource[p].apply(o) - bS.apply(o), rt = mTarget[p].apply(o) - bT.apply(o);
+        const Vec3d drs[3] = {mSource[p].col[0] - bS.col[0], mSource[p].col[1] - bS.col[1], mSource[p].col[2] - bS.col[2]};
+        const Vec3d drt[3] = {mTarget[p].col[0] - bT.col[0], mTarget[p].col[1] - bT.col[1], mTarget[p].col[2] - bT.col[2]};
+        const Feature& e = mWarp.interpolated(p);
+        const double scale = mWarp.weightScale(p);
+        switch (e.type) {
+        case FeatureType::Point:
+            addNearPair<FeatureType::Point>(sums, e, o, offset, b, scale, inverseSquare, rs, drs, rt, drt);
+            break;
+        case FeatureType::Segment:
+            addNearPair<FeatureType::Segment>(sums, e, o, offset, b, scale, inverseSquare, rs, drs, rt, drt);
+            break;
+        case FeatureType::Rectangle:
+            addNearPair<FeatureType::Rectangle>(sums, e, o, offset, b, scale, inverseSquare, rs, drs, rt, drt);
+            break;
+        case FeatureType::Box:
+            addNearPair<FeatureType::Box>(sums, e, o, offset, b, scale, inverseSquare, rs, drs, rt, drt);
+            break;
+        }
+    }
+    // B(x) in double (positions are hundreds of voxels), the residual's share in float.
+    const Vec3d bs0 = bS.apply(o), bt0 = bT.apply(o);
+    const float* I = kOffsets.i;
+    const float* J = kOffsets.j;
+    const float* K = kOffsets.k;
+    alignas(64) float out[6][512];
+    for (int c = 0; c < 3; ++c) {
+        const double s0 = bs0[c], s1 = bS.col[0][c], s2 = bS.col[1][c], s3 = bS.col[2][c];
+        const double t0 = bt0[c], t1 = bT.col[0][c], t2 = bT.col[1][c], t3 = bT.col[2][c];
+        for (int n2 = 0; n2 < 512; ++n2) {
+            const float inv = 1.0f / sums.v[0][n2];
+            out[c][n2] = float(s0 + I[n2] * s1 + J[n2] * s2 + K[n2] * s3 + double(sums.v[1 + c][n2] * inv));
+            out[3 + c][n2] = float(t0 + I[n2] * t1 + J[n2] * t2 + K[n2] * t3 + double(sums.v[4 + c][n2] * inv));
+        }
+    }
+    for (int n2 = 0; n2 < 512; ++n2) {
+        ctx.leaf.source[n2] = Vec3f(out[0][n2], out[1][n2], out[2][n2]);
+        ctx.leaf.target[n2] = Vec3f(out[3][n2], out[4][n2], out[5][n2]);
     }
 }
 
@@ -587,8 +635,7 @@ void AdaptiveWarp::leaf(Context& ctx, const Lattice& lattice, const Coord& origi
     const bool cull = ctx.source || ctx.target;
     const size_t n = mWarp.pairCount();
     const Vec3d o = origin.asVec3d();
-    // `recheck`: cull again by the filled points, when the box before the fill was loose or near
-    // pairs were evaluated.
+    // `recheck`: cull again by the filled points, when only the bound's margin kept the leaf.
     auto visit = [&](double errorBound, bool recheck) {
         if (cull && recheck) {
             // The filled points' own bounding box, widened by what they may be off.
@@ -623,11 +670,9 @@ void AdaptiveWarp::leaf(Context& ctx, const Lattice& lattice, const Coord& origi
         corners[k] = &lattice.points[lattice.index(lc.offsetBy(k & 1, (k >> 1) & 1, (k >> 2) & 1))];
     analyze(ctx, corners, origin, 8);
     if (cull && !mayTouch(ctx, origin, 8)) return;
-    const bool tightBox = ctx.tightBox;
     if (mTolerance <= 0.0 || !ctx.cornersOk || ctx.tiny) {
-        // Exact points: their own box is the domain's best test, and cheap next to them.
         exactLeaf(ctx);
-        visit(0.0, true);
+        visit(0.0, !ctx.coreTouches);
         return;
     }
 
@@ -637,7 +682,7 @@ void AdaptiveWarp::leaf(Context& ctx, const Lattice& lattice, const Coord& origi
     fill(ctx, origin);
     ctx.near += near;
     ctx.maxError = std::max(ctx.maxError, bound);
-    visit(bound, !tightBox || near > 0);
+    visit(bound, !ctx.coreTouches);
 }
 
 void AdaptiveWarp::forEachLeaf(const CoordBBox& box, const Occupancy* source, const Occupancy* target,
