@@ -1,7 +1,5 @@
 #include "AdaptiveWarp.h"
 
-#include <openvdb/tools/Morphology.h>
-
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
@@ -24,89 +22,6 @@ constexpr double kBoundScale = 1.0;
 /// of the sums: the leaf is evaluated exactly (only with a zero or tiny epsilon).
 constexpr double kTinyRadius = 1e-6;
 
-/// Floor division by 8 (block coordinates), correct for negative coordinates.
-inline int block(int v) { return v >= 0 ? v / 8 : -((-v + 7) / 8); }
-
-} // namespace
-
-// ------------------------------------------------------------------------------------------------
-
-Occupancy::Occupancy(const openvdb::FloatTree& tree)
-{
-    openvdb::tree::ValueAccessor<openvdb::MaskTree> acc(mBlocks);
-    for (auto leaf = tree.cbeginLeaf(); leaf; ++leaf)
-        if (!leaf->isEmpty()) acc.setValueOn(Coord(block(leaf->origin().x()), block(leaf->origin().y()), block(leaf->origin().z())));
-    auto tiles = tree.cbeginValueOn();
-    tiles.setMaxDepth(openvdb::FloatTree::ValueOnCIter::LEAF_DEPTH - 1); // tiles only, not voxels
-    for (; tiles; ++tiles) {
-        if (tiles.isVoxelValue()) continue;
-        const CoordBBox b = tiles.getBoundingBox();
-        mBlocks.fill(CoordBBox(Coord(block(b.min().x()), block(b.min().y()), block(b.min().z())),
-                               Coord(block(b.max().x()), block(b.max().y()), block(b.max().z()))),
-                     true, true);
-    }
-    openvdb::tools::dilateActiveValues(mBlocks, 1, openvdb::tools::NN_FACE_EDGE_VERTEX,
-                                       openvdb::tools::PRESERVE_TILES);
-
-    CoordBBox b;
-    if (!mBlocks.evalActiveVoxelBoundingBox(b)) return;
-    const Coord dim = b.dim();
-    constexpr uint64_t kMaxTable = uint64_t(1) << 23; // 32 MiB of counts
-    if (uint64_t(dim.x() + 1) * uint64_t(dim.y() + 1) * uint64_t(dim.z() + 1) > kMaxTable) return;
-    mLo = b.min();
-    mDim = dim;
-    const size_t sy = size_t(dim.z() + 1), sx = sy * size_t(dim.y() + 1);
-    mPrefix.assign(sx * size_t(dim.x() + 1), 0);
-    for (auto it = mBlocks.cbeginValueOn(); it; ++it)
-        for (auto c = it.getBoundingBox().begin(); c; ++c) {
-            const Coord l = *c - mLo;
-            mPrefix[size_t(l.x() + 1) * sx + size_t(l.y() + 1) * sy + size_t(l.z() + 1)] = 1;
-        }
-    for (int x = 1; x <= dim.x(); ++x)
-        for (int y = 1; y <= dim.y(); ++y)
-            for (int z = 1; z <= dim.z(); ++z) {
-                uint32_t* p = &mPrefix[size_t(x) * sx + size_t(y) * sy + size_t(z)];
-                *p += p[-ptrdiff_t(sx)] + p[-ptrdiff_t(sy)] + p[-1] - p[-ptrdiff_t(sx + sy)] - p[-ptrdiff_t(sx + 1)] -
-                      p[-ptrdiff_t(sy + 1)] + p[-ptrdiff_t(sx + sy + 1)];
-            }
-}
-
-bool Occupancy::anyIn(const CoordBBox& box) const
-{
-    const Coord lo(block(box.min().x()), block(box.min().y()), block(box.min().z()));
-    const Coord hi(block(box.max().x()), block(box.max().y()), block(box.max().z()));
-    const CoordBBox blocks(lo, hi);
-    if (!mPrefix.empty()) {
-        // Inclusion-exclusion over the summed-volume table, the box clamped to its bounds.
-        const Coord a = Coord::maxComponent(lo, mLo) - mLo, c = Coord::minComponent(hi, mLo + mDim - Coord(1)) - mLo;
-        if (a.x() > c.x() || a.y() > c.y() || a.z() > c.z()) return false;
-        const size_t sy = size_t(mDim.z() + 1), sx = sy * size_t(mDim.y() + 1);
-        auto at = [&](int x, int y, int z) { return int64_t(mPrefix[size_t(x) * sx + size_t(y) * sy + size_t(z)]); };
-        const int x0 = a.x(), y0 = a.y(), z0 = a.z(), x1 = c.x() + 1, y1 = c.y() + 1, z1 = c.z() + 1;
-        return at(x1, y1, z1) - at(x0, y1, z1) - at(x1, y0, z1) - at(x1, y1, z0) + at(x0, y0, z1) + at(x0, y1, z0) +
-                   at(x1, y0, z0) - at(x0, y0, z0) > 0;
-    }
-    if (blocks.volume() > (1u << 16)) return true; // too large to be worth asking
-    openvdb::tree::ValueAccessor<const openvdb::MaskTree> acc(mBlocks);
-    for (int x = lo.x(); x <= hi.x(); ++x)
-        for (int y = lo.y(); y <= hi.y(); ++y)
-            for (int z = lo.z(); z <= hi.z(); ++z)
-                if (acc.isValueOn(Coord(x, y, z))) return true;
-    return false;
-}
-
-CoordBBox Occupancy::bounds() const
-{
-    CoordBBox b;
-    if (!mBlocks.evalActiveVoxelBoundingBox(b)) return CoordBBox();
-    const Coord lo = b.min(), hi = b.max();
-    return CoordBBox(Coord(lo.x() * 8, lo.y() * 8, lo.z() * 8), Coord(hi.x() * 8 + 7, hi.y() * 8 + 7, hi.z() * 8 + 7));
-}
-
-// ------------------------------------------------------------------------------------------------
-
-namespace {
-/// Everything the error bound needs of one pair over it.
 /// Per-voxel sums of a leaf, channel-major: 0 the weight sum, 1-3 the weighted residuals on the
 /// source side, 4-6 on the target side. Single precision, as the warped points are stored: its
 /// rounding (about 1e-6 of a residual of some tens of voxels) is far below any tolerance.
@@ -114,6 +29,7 @@ struct LeafSums {
     alignas(64) float v[7][512];
 };
 
+/// Everything the error bound needs of one pair over a cube.
 struct PairBounds {
     double dMin, wMax, wMin, w1, w2; ///< d and w over the leaf, |grad w|, |Hess w| bounds
     bool constant;                   ///< a box containing the whole leaf: d = 0, w constant

@@ -25,10 +25,13 @@
 //    sides. Pairs join E, largest term first, until the bound is within the tolerance. An
 //    element that touches the leaf (d_i = 0 somewhere, not containing it) has a kink there and
 //    is always near. One pair is its affine map: R = 0, no error, nothing near.
-// 4. The same bound decides the domain without evaluating any voxel: p = B + rho lies within
-//    B(leaf) widened by |rho|max; a leaf whose image misses every occupied block on both sides
-//    (widened by the sampler's reach) is skipped. After the leaf is filled, the bounding box of
-//    its warped points (widened by the error bound) is checked again.
+// 4. The same bound decides the domain without evaluating any voxel. With every pair far, the
+//    interpolant is B + I[G] / I[W], and I[G] / I[W] is a convex combination of the corners'
+//    residuals, so the image lies within B(leaf) + their hull, widened by the bound; otherwise
+//    p = B + rho lies within B(leaf) widened by |rho|max. A leaf whose image misses every
+//    occupied block of both sides (widened by the sampler's reach) is skipped; blocks of 2^3
+//    leaves are judged first, from every other lattice point. A leaf kept only by the bound's
+//    margin is checked again on its filled points.
 //
 // Lerios et al. (1995) interpolated the warp over an adaptive grid checked at the next finer
 // lattice; here no sample decides the error, and the exact warp is evaluated at about one point
@@ -39,6 +42,8 @@
 #include <volmorph/Mesh.h>
 #include <volmorph/Warp.h>
 
+#include "Occupancy.h"
+
 #include <openvdb/openvdb.h>
 
 #include <array>
@@ -47,24 +52,6 @@
 #include <vector>
 
 namespace volmorph::detail {
-
-/// "Might a trilinear sample here be non-zero?" at the resolution of 8^3 blocks: the blocks holding
-/// active voxels or tiles of a grid, dilated by one block.
-class Occupancy {
-public:
-    explicit Occupancy(const openvdb::FloatTree& tree);
-    /// True when any block overlapping `box` (index space of the grid) is occupied.
-    bool anyIn(const openvdb::CoordBBox& box) const;
-    /// Index-space bounds of the occupied blocks (empty when nothing is).
-    openvdb::CoordBBox bounds() const;
-
-private:
-    openvdb::MaskTree mBlocks;
-    // The same blocks as a summed-volume table over their bounds, for box queries in O(1)
-    // (empty when that table would be too large; then the tree is scanned).
-    openvdb::Coord mLo, mDim;           ///< block coordinates of the table's first cell, cells per axis
-    std::vector<uint32_t> mPrefix;      ///< (mDim + 1)^3 counts of occupied blocks below each corner
-};
 
 /// Warped positions of one output leaf's 8^3 voxels, in the index space of source and target.
 /// Voxel (i, j, k) of the leaf is at [(i * 8 + j) * 8 + k], as in OpenVDB's leaf nodes.
@@ -99,7 +86,8 @@ public:
                      const LeafFunction& fn, AdaptiveWarpStats* stats = nullptr,
                      Interrupter* interrupter = nullptr, const CellFilter* wanted = nullptr) const;
 
-    /// Leaves are first gathered in cells this many voxels on a side (culled, filtered) .
+    /// Leaves are first gathered in cells this many voxels on a side (filtered, and culled by the
+    /// hull of every pair's affine image).
     static constexpr int kTopCell = 64;
 
 private:
