@@ -142,6 +142,29 @@ std::vector<FeaturePairSpec> randomPairs(std::mt19937& random, int n, double ext
     return pairs;
 }
 
+/// The largest distance between the approximated and the exact warp's points, on either side,
+/// over every `stride`-th voxel of every leaf of the box [0, last]^3 (index space).
+double largestError(const InverseWarp& warp, const detail::AdaptiveWarp& adaptive, int last, int stride,
+                    detail::AdaptiveWarpStats& stats)
+{
+    std::mutex m;
+    double worst = 0.0;
+    adaptive.forEachLeaf(openvdb::CoordBBox(openvdb::Coord(0), openvdb::Coord(last)), nullptr, nullptr,
+                         [&](const detail::WarpLeaf& leaf) {
+                             double local = 0.0;
+                             Vec3d s, d;
+                             for (int i = 0; i < 512; i += stride) {
+                                 warp.map(leaf.origin.offsetBy(i >> 6, (i >> 3) & 7, i & 7).asVec3d(), s, d);
+                                 local = std::max({local, (Vec3d(leaf.source[i]) - s).length(),
+                                                   (Vec3d(leaf.target[i]) - d).length()});
+                             }
+                             std::lock_guard<std::mutex> lock(m);
+                             worst = std::max(worst, local);
+                         },
+                         &stats);
+    return worst;
+}
+
 } // namespace
 
 TEST(Feature, DistancePerType)
@@ -272,24 +295,9 @@ TEST(AdaptiveWarp, WithinToleranceOfTheExactWarpOnRandomConfigurations)
             const InverseWarp warp(pairs, spec, t);
             const double tolerance = 0.25;
             const detail::AdaptiveWarp adaptive(warp, tolerance);
-            std::mutex m;
-            double worst = 0.0;
             detail::AdaptiveWarpStats stats;
-            adaptive.forEachLeaf(openvdb::CoordBBox(openvdb::Coord(0), openvdb::Coord(95)), nullptr, nullptr,
-                                 [&](const detail::WarpLeaf& leaf) {
-                                     double local = 0.0;
-                                     Vec3d s, d;
-                                     // Every voxel up to 16 pairs; every 3rd beyond keeps the test quick.
-                                     for (int i = 0; i < 512; i += n <= 16 ? 1 : 3) {
-                                         const openvdb::Coord c = leaf.origin.offsetBy(i >> 6, (i >> 3) & 7, i & 7);
-                                         warp.map(c.asVec3d(), s, d);
-                                         local = std::max({local, (Vec3d(leaf.source[i]) - s).length(),
-                                                           (Vec3d(leaf.target[i]) - d).length()});
-                                     }
-                                     std::lock_guard<std::mutex> lock(m);
-                                     worst = std::max(worst, local);
-                                 },
-                                 &stats);
+            // Every voxel up to 16 pairs; every 3rd beyond keeps the test quick.
+            const double worst = largestError(warp, adaptive, 95, n <= 16 ? 1 : 3, stats);
             EXPECT_LE(worst, tolerance) << n << " pairs, trial " << trial;
             EXPECT_LE(stats.maxErrorVoxels, tolerance);
             EXPECT_EQ(stats.leaves, 12u * 12u * 12u);
@@ -322,22 +330,8 @@ TEST(AdaptiveWarp, FewPairEvaluationsWherePairsAreApart)
     spec.epsilon = 4.0;
     const InverseWarp warp(pairs, spec, 0.5);
     const detail::AdaptiveWarp adaptive(warp, 0.25);
-    std::mutex m;
-    double worst = 0.0;
     detail::AdaptiveWarpStats stats;
-    adaptive.forEachLeaf(openvdb::CoordBBox(openvdb::Coord(0), openvdb::Coord(191)), nullptr, nullptr,
-                         [&](const detail::WarpLeaf& leaf) {
-                             double local = 0.0;
-                             Vec3d s, d;
-                             for (int i = 0; i < 512; ++i) {
-                                 warp.map(leaf.origin.offsetBy(i >> 6, (i >> 3) & 7, i & 7).asVec3d(), s, d);
-                                 local = std::max({local, (Vec3d(leaf.source[i]) - s).length(),
-                                                   (Vec3d(leaf.target[i]) - d).length()});
-                             }
-                             std::lock_guard<std::mutex> lock(m);
-                             worst = std::max(worst, local);
-                         },
-                         &stats);
+    const double worst = largestError(warp, adaptive, 191, 1, stats);
     const double voxels = 192.0 * 192 * 192;
     const double share = (double(stats.exactEvaluations) * 8 + double(stats.nearEvaluations)) / (8 * voxels);
     std::cout << "largest error " << worst << " voxel, bound " << stats.maxErrorVoxels << ", pair evaluations "

@@ -58,6 +58,12 @@ private:
         double lengthPow = 1; ///< length^p, Beier-Neely only
     };
     double weight(const Pair& pair, double distance) const;
+    /// Pair's affine images on both sides of the point with frame coordinates q.
+    static void images(const Pair& pair, const Vec3d& q, Vec3d& source, Vec3d& target)
+    {
+        source = pair.sourceOrigin + pair.toSource[0] * q.x() + pair.toSource[1] * q.y() + pair.toSource[2] * q.z();
+        target = pair.targetOrigin + pair.toTarget[0] * q.x() + pair.toTarget[1] * q.y() + pair.toTarget[2] * q.z();
+    }
 
     std::vector<Pair> mPairs;
     Weighting mWeighting;

@@ -7,6 +7,7 @@
 #include <cmath>
 #include <limits>
 #include <mutex>
+#include <type_traits>
 
 namespace volmorph::detail {
 namespace {
@@ -67,7 +68,7 @@ struct AdaptiveWarp::Context {
     // Per pair, per leaf (scratch).
     std::unique_ptr<LeafSums> sums = std::make_unique<LeafSums>();
     std::vector<PairBounds> bounds;
-    std::vector<double> resid, slope, term, hessW;
+    std::vector<double> resid, slope, term, hessW, suffixTerm, suffixHess;
     std::vector<int> order;
     std::vector<char> isNear;
     // What analyze() found of the last cell.
@@ -98,12 +99,6 @@ bool boxContains(const Feature& e, const Vec3d& centre, double size)
         if (std::abs(q[k]) + reach > 0.5 * e.scale[k]) return false;
     }
     return true;
-}
-
-/// w = scale r^-b, r = offset + d (InverseWarp's weight law), without pow for the inverse square.
-inline double weightLaw(double scale, double r, double b, bool inverseSquare)
-{
-    return inverseSquare ? 1.0 / (r * r) : scale * std::pow(r, -b);
 }
 
 /// Distance in the element's frame, inlined per type for the per-voxel loop.
@@ -268,7 +263,6 @@ void AdaptiveWarp::analyze(Context& ctx, const LatticePoint* const corners[8], c
     const double h = size, halfDiagonal = 0.5 * h * std::sqrt(3.0);
     const Vec3d centre = o + Vec3d(0.5 * h);
     const double offset = mWarp.weightOffset(), b = mWarp.weightExponent();
-    const bool inverseSquare = mWarp.weighting() == Weighting::InverseSquare;
     std::vector<PairBounds>& pb = ctx.bounds;
     pb.resize(n);
     double& wMinSum = ctx.wMinSum;
@@ -291,9 +285,8 @@ void AdaptiveWarp::analyze(Context& ctx, const LatticePoint* const corners[8], c
         p.dMin = dc > 0.0 ? std::max(0.0, dc - 0.5 * h * gL1) : 0.0;
         const double rMin = offset + p.dMin, rMax = offset + (p.constant ? 0.0 : dc + halfDiagonal);
         if (rMin < kTinyRadius) tiny = true;
-        const double scale = mWarp.weightScale(i);
-        p.wMax = weightLaw(scale, std::max(rMin, kTinyRadius), b, inverseSquare);
-        p.wMin = weightLaw(scale, rMax, b, inverseSquare);
+        p.wMax = mWarp.weightAt(i, std::max(p.dMin, kTinyRadius - offset));
+        p.wMin = mWarp.weightAt(i, rMax - offset);
         wMinSum += p.wMin;
         if (p.constant) {
             p.w1 = p.w2 = 0.0;
@@ -352,8 +345,12 @@ void AdaptiveWarp::analyze(Context& ctx, const LatticePoint* const corners[8], c
         ctx.term[i] = std::isfinite(pb[i].w2) ? k * ((resid[i] + rhoMax) * pb[i].w2 + 2.0 * slope[i] * pb[i].w1)
                                               : std::numeric_limits<double>::infinity();
     }
-    ctx.boundAllFar = boundWith(ctx, 0);
-
+    double terms = 0.0, hess = 0.0;
+    for (size_t i = 0; i < n; ++i) {
+        terms += ctx.term[i];
+        hess += ctx.hessW[i];
+    }
+    ctx.boundAllFar = bound(ctx, terms, hess);
 }
 
 // The domain, before any voxel. With every pair far the interpolant is B + I[G] / I[W], and
@@ -396,33 +393,35 @@ bool AdaptiveWarp::mayTouch(Context& ctx, const Coord& origin, int size) const
     return touches(ctx.source, sLo, sHi, margin) || touches(ctx.target, tLo, tHi, margin);
 }
 
-double AdaptiveWarp::boundWith(const Context& ctx, size_t nearCount) const
+double AdaptiveWarp::bound(const Context& ctx, double terms, double hess) const
 {
-    // The bound with the first nearCount pairs of ctx.order evaluated exactly, the others
-    // interpolated.
-    double terms = 0.0, hess = 0.0;
-    for (size_t j = nearCount; j < ctx.order.size(); ++j) {
-        terms += ctx.term[ctx.order[j]];
-        hess += ctx.hessW[ctx.order[j]];
-    }
+    // The far pairs' terms over the smallest total weight, less what interpolating it may take.
     const double denominator = ctx.wMinSum - hess;
     return std::isfinite(terms) && denominator > 0.0 ? terms / denominator : std::numeric_limits<double>::infinity();
 }
 
 double AdaptiveWarp::selectNear(Context& ctx, size_t& nearCount) const
 {
-    // Largest share first, until the bound of the rest is within the tolerance.
+    // Largest share first: the far set is a suffix of that order, so its sums are suffix sums;
+    // the near set is the shortest prefix whose suffix is within the tolerance.
     const size_t n = mWarp.pairCount();
     std::sort(ctx.order.begin(), ctx.order.end(), [&](int a, int c) {
         return ctx.term[a] > ctx.term[c] || (ctx.term[a] == ctx.term[c] && a < c);
     });
-    nearCount = 0;
-    double bound = ctx.boundAllFar;
-    while (bound > mTolerance && nearCount < n) {
-        ctx.isNear[ctx.order[nearCount]] = 1;
-        bound = boundWith(ctx, ++nearCount);
+    ctx.suffixTerm.assign(n + 1, 0.0);
+    ctx.suffixHess.assign(n + 1, 0.0);
+    for (size_t j = n; j-- > 0;) {
+        ctx.suffixTerm[j] = ctx.suffixTerm[j + 1] + ctx.term[ctx.order[j]];
+        ctx.suffixHess[j] = ctx.suffixHess[j + 1] + ctx.hessW[ctx.order[j]];
     }
-    return nearCount == n ? 0.0 : bound; // every pair near: exact at every voxel but for rounding
+    nearCount = 0;
+    double b = ctx.boundAllFar;
+    while (b > mTolerance && nearCount < n) {
+        ctx.isNear[ctx.order[nearCount]] = 1;
+        ++nearCount;
+        b = bound(ctx, ctx.suffixTerm[nearCount], ctx.suffixHess[nearCount]);
+    }
+    return nearCount == n ? 0.0 : b; // every pair near: exact at every voxel but for rounding
 }
 
 void AdaptiveWarp::fill(Context& ctx, const Coord& origin) const
@@ -435,7 +434,7 @@ void AdaptiveWarp::fill(Context& ctx, const Coord& origin) const
     const InverseWarp::Affine& bT = mTarget[ctx.dominant];
 
     // Far sums at the corners: W_F = W - sum_E w_i, G = N - sum_E w_i A_i - W_F B; channels as
-    // in Row.
+    // in LeafSums.
     double far[7][8];
     bool anyNear = false;
     for (int c = 0; c < 8; ++c) {
@@ -508,20 +507,14 @@ void AdaptiveWarp::fill(Context& ctx, const Coord& origin) const
         const Vec3d drs[3] = {mSource[p].col[0] - bS.col[0], mSource[p].col[1] - bS.col[1], mSource[p].col[2] - bS.col[2]};
         const Vec3d drt[3] = {mTarget[p].col[0] - bT.col[0], mTarget[p].col[1] - bT.col[1], mTarget[p].col[2] - bT.col[2]};
         const Feature& e = mWarp.interpolated(p);
-        const double scale = mWarp.weightScale(p);
+        auto add = [&](auto type) {
+            addNearPair<decltype(type)::value>(sums, e, o, offset, b, mWarp.weightScale(p), inverseSquare, rs, drs, rt, drt);
+        };
         switch (e.type) {
-        case FeatureType::Point:
-            addNearPair<FeatureType::Point>(sums, e, o, offset, b, scale, inverseSquare, rs, drs, rt, drt);
-            break;
-        case FeatureType::Segment:
-            addNearPair<FeatureType::Segment>(sums, e, o, offset, b, scale, inverseSquare, rs, drs, rt, drt);
-            break;
-        case FeatureType::Rectangle:
-            addNearPair<FeatureType::Rectangle>(sums, e, o, offset, b, scale, inverseSquare, rs, drs, rt, drt);
-            break;
-        case FeatureType::Box:
-            addNearPair<FeatureType::Box>(sums, e, o, offset, b, scale, inverseSquare, rs, drs, rt, drt);
-            break;
+        case FeatureType::Point: add(std::integral_constant<FeatureType, FeatureType::Point>()); break;
+        case FeatureType::Segment: add(std::integral_constant<FeatureType, FeatureType::Segment>()); break;
+        case FeatureType::Rectangle: add(std::integral_constant<FeatureType, FeatureType::Rectangle>()); break;
+        case FeatureType::Box: add(std::integral_constant<FeatureType, FeatureType::Box>()); break;
         }
     }
     // B(x) in double (positions are hundreds of voxels), the residual's share in float.

@@ -99,8 +99,8 @@ private:
     void analyze(Context& ctx, const LatticePoint* const corners[8], const openvdb::Coord& origin, int size) const;
     /// False when the analysed cube's image misses both sides' occupied blocks.
     bool mayTouch(Context& ctx, const openvdb::Coord& origin, int size) const;
-    /// The bound with the first nearCount pairs (largest terms first) evaluated exactly.
-    double boundWith(const Context& ctx, size_t nearCount) const;
+    /// The error bound of the analysed cube from its far pairs' summed terms and Hessian bounds.
+    double bound(const Context& ctx, double terms, double hess) const;
     /// Marks the analysed cube's near pairs; returns its bound.
     double selectNear(Context& ctx, size_t& nearCount) const;
     /// Fills the analysed leaf at origin: far sums interpolated, near pairs evaluated.

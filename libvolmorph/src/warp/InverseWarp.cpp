@@ -58,8 +58,10 @@ bool InverseWarp::sums(const Vec3d& p, double& W, Vec3d& S, Vec3d& T) const
         const double d = pair.element.distanceInFrame(q);
         if (d + weightOffset() < kOnElement) return false;
         const double w = weight(pair, d);
-        S += w * (pair.sourceOrigin + pair.toSource[0] * q.x() + pair.toSource[1] * q.y() + pair.toSource[2] * q.z());
-        T += w * (pair.targetOrigin + pair.toTarget[0] * q.x() + pair.toTarget[1] * q.y() + pair.toTarget[2] * q.z());
+        Vec3d ps, pt;
+        images(pair, q, ps, pt);
+        S += w * ps;
+        T += w * pt;
         W += w;
     }
     return std::isfinite(W) && W > 0.0;
@@ -77,8 +79,8 @@ void InverseWarp::map(const Vec3d& p, Vec3d& source, Vec3d& target) const
     int hits = 0;
     for (const Pair& pair : mPairs) {
         const Vec3d q = pair.element.frameCoordinates(p);
-        const Vec3d ps = pair.sourceOrigin + pair.toSource[0] * q.x() + pair.toSource[1] * q.y() + pair.toSource[2] * q.z();
-        const Vec3d pt = pair.targetOrigin + pair.toTarget[0] * q.x() + pair.toTarget[1] * q.y() + pair.toTarget[2] * q.z();
+        Vec3d ps, pt;
+        images(pair, q, ps, pt);
         const double d = pair.element.distanceInFrame(q);
         if (mWeighting == Weighting::InverseSquare && d + mEpsilon < kOnElement) {
             hitS += ps;
