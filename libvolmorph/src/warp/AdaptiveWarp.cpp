@@ -105,22 +105,24 @@ bool boxContains(const Feature& e, const Vec3d& centre, double size)
 template <FeatureType T>
 inline float frameDistance(float qx, float qy, float qz, float hx, float hy, float hz)
 {
-    auto out = [](float v, float half) { return std::max(std::abs(v) - half, 0.0f); };
+    // max(|v| - half, 0), written without a branch (exact: a + |a| is 2a or 0) so the loops
+    // over a leaf's voxels vectorize.
+    auto out = [](float v, float half) {
+        const float a = std::abs(v) - half;
+        return 0.5f * (a + std::abs(a));
+    };
     if constexpr (T == FeatureType::Point) return std::sqrt(qx * qx + qy * qy + qz * qz);
     if constexpr (T == FeatureType::Segment) {
-        const double a = out(qx, hx);
+        const float a = out(qx, hx);
         return std::sqrt(a * a + qy * qy + qz * qz);
     }
     if constexpr (T == FeatureType::Rectangle) {
-        const double a = out(qx, hx), b = out(qy, hy);
+        const float a = out(qx, hx), b = out(qy, hy);
         return std::sqrt(a * a + b * b + qz * qz);
     }
-    const double a = out(qx, hx), b = out(qy, hy), c = out(qz, hz);
+    const float a = out(qx, hx), b = out(qy, hy), c = out(qz, hz);
     return std::sqrt(a * a + b * b + c * c);
 }
-
-/// The voxels' offsets along a row, as doubles (the loops over them vectorize).
-constexpr double kZ[8] = {0, 1, 2, 3, 4, 5, 6, 7};
 
 /// Each voxel's offsets in its leaf, in OpenVDB's order (index (i * 8 + j) * 8 + k), as floats:
 /// loops over the 512 voxels of a leaf then vectorize.
@@ -460,84 +462,72 @@ void AdaptiveWarp::fill(Context& ctx, const Coord& origin) const
 
     const double offset = mWarp.weightOffset(), b = mWarp.weightExponent();
     const bool inverseSquare = mWarp.weighting() == Weighting::InverseSquare;
-    const Vec3d& bsz = bS.col[2];
-    const Vec3d& btz = bT.col[2];
-    for (int i = 0; i < Size; ++i) {
-        const double fx = i / h;
-        for (int j = 0; j < Size; ++j) {
-            const double fy = j / h;
-            // Far sums along the row: bilinear at z = 0 and z = h, linear in between.
-            double v0[7], dv[7];
-            for (int c = 0; c < 7; ++c) {
-                const double* v = far[c];
-                const double a0 = v[0] + fx * (v[1] - v[0]), c0 = v[2] + fx * (v[3] - v[2]);
-                const double a1 = v[4] + fx * (v[5] - v[4]), c1 = v[6] + fx * (v[7] - v[6]);
-                v0[c] = a0 + fy * (c0 - a0);
-                dv[c] = (a1 + fy * (c1 - a1) - v0[c]) / h;
-            }
-            const Vec3d start = o + Vec3d(i, j, 0);
-            const Vec3d bs = bS.apply(start), bt = bT.apply(start);
-            const int n0 = (i * 8 + j) * 8;
-            Vec3f* out0 = &ctx.leaf.source[n0];
-            Vec3f* out1 = &ctx.leaf.target[n0];
-            if (!anyNear) {
-                // p = B(x) + (g0 + z gz) / (w0 + z wz).
-                for (int z = 0; z < Size; ++z) {
-                    const double inv = 1.0 / (v0[0] + kZ[z] * dv[0]);
-                    out0[z] = Vec3f(float(bs.x() + kZ[z] * bsz.x() + (v0[1] + kZ[z] * dv[1]) * inv),
-                                    float(bs.y() + kZ[z] * bsz.y() + (v0[2] + kZ[z] * dv[2]) * inv),
-                                    float(bs.z() + kZ[z] * bsz.z() + (v0[3] + kZ[z] * dv[3]) * inv));
-                    out1[z] = Vec3f(float(bt.x() + kZ[z] * btz.x() + (v0[4] + kZ[z] * dv[4]) * inv),
-                                    float(bt.y() + kZ[z] * btz.y() + (v0[5] + kZ[z] * dv[5]) * inv),
-                                    float(bt.z() + kZ[z] * btz.z() + (v0[6] + kZ[z] * dv[6]) * inv));
-                }
-                continue;
-            }
-            for (int c = 0; c < 7; ++c)
-                for (int z = 0; z < Size; ++z) ctx.sums->v[c][n0 + z] = float(v0[c] + kZ[z] * dv[c]);
-        }
-    }
-    if (!anyNear) return;
 
-    // Near pairs at every voxel, then p = B(x) + residual sum / weight sum.
+    // Far sums at every voxel: bilinear at each row's ends (z = 0 and z = h), linear along the
+    // row; single precision, channel-major, so the row loops vectorize.
     LeafSums& sums = *ctx.sums;
-    for (size_t p = 0; p < n; ++p) {
-        if (!ctx.isNear[p]) continue;
-        const Vec3d rs = mSource[p].apply(o) - bS.apply(o), rt = mTarget[p].apply(o) - bT.apply(o);
-        const Vec3d drs[3] = {mSource[p].col[0] - bS.col[0], mSource[p].col[1] - bS.col[1], mSource[p].col[2] - bS.col[2]};
-        const Vec3d drt[3] = {mTarget[p].col[0] - bT.col[0], mTarget[p].col[1] - bT.col[1], mTarget[p].col[2] - bT.col[2]};
-        const Feature& e = mWarp.interpolated(p);
-        auto add = [&](auto type) {
-            addNearPair<decltype(type)::value>(sums, e, o, offset, b, mWarp.weightScale(p), inverseSquare, rs, drs, rt, drt);
-        };
-        switch (e.type) {
-        case FeatureType::Point: add(std::integral_constant<FeatureType, FeatureType::Point>()); break;
-        case FeatureType::Segment: add(std::integral_constant<FeatureType, FeatureType::Segment>()); break;
-        case FeatureType::Rectangle: add(std::integral_constant<FeatureType, FeatureType::Rectangle>()); break;
-        case FeatureType::Box: add(std::integral_constant<FeatureType, FeatureType::Box>()); break;
+    for (int c = 0; c < 7; ++c) {
+        const double* v = far[c];
+        float* out = sums.v[c];
+        for (int i = 0; i < Size; ++i) {
+            const double fx = i / h;
+            const double a0 = v[0] + fx * (v[1] - v[0]), c0 = v[2] + fx * (v[3] - v[2]);
+            const double a1 = v[4] + fx * (v[5] - v[4]), c1 = v[6] + fx * (v[7] - v[6]);
+            for (int j = 0; j < Size; ++j) {
+                const double fy = j / h;
+                const double z0 = a0 + fy * (c0 - a0), z1 = a1 + fy * (c1 - a1);
+                const float base = float(z0), step = float((z1 - z0) / h);
+                float* row = out + (i * Size + j) * Size;
+                for (int z = 0; z < Size; ++z) row[z] = base + kOffsets.k[z] * step;
+            }
         }
     }
-    // B(x) in double (positions are hundreds of voxels), the residual's share in float.
+
+    // Near pairs at every voxel.
+    if (anyNear) {
+        for (size_t p = 0; p < n; ++p) {
+            if (!ctx.isNear[p]) continue;
+            const Vec3d rs = mSource[p].apply(o) - bS.apply(o), rt = mTarget[p].apply(o) - bT.apply(o);
+            const Vec3d drs[3] = {mSource[p].col[0] - bS.col[0], mSource[p].col[1] - bS.col[1], mSource[p].col[2] - bS.col[2]};
+            const Vec3d drt[3] = {mTarget[p].col[0] - bT.col[0], mTarget[p].col[1] - bT.col[1], mTarget[p].col[2] - bT.col[2]};
+            const Feature& e = mWarp.interpolated(p);
+            auto add = [&](auto type) {
+                addNearPair<decltype(type)::value>(sums, e, o, offset, b, mWarp.weightScale(p), inverseSquare, rs, drs, rt, drt);
+            };
+            switch (e.type) {
+            case FeatureType::Point: add(std::integral_constant<FeatureType, FeatureType::Point>()); break;
+            case FeatureType::Segment: add(std::integral_constant<FeatureType, FeatureType::Segment>()); break;
+            case FeatureType::Rectangle: add(std::integral_constant<FeatureType, FeatureType::Rectangle>()); break;
+            case FeatureType::Box: add(std::integral_constant<FeatureType, FeatureType::Box>()); break;
+            }
+        }
+    }
+
+    // p = B(x) + residual sum / weight sum, in single precision as the points are stored (their
+    // rounding, some 1e-5 voxel at hundreds of voxels from the origin, is far below a tolerance).
     const Vec3d bs0 = bS.apply(o), bt0 = bT.apply(o);
     const float* I = kOffsets.i;
     const float* J = kOffsets.j;
     const float* K = kOffsets.k;
+    alignas(64) float inv[512];
+    for (int m = 0; m < 512; ++m) inv[m] = 1.0f / sums.v[0][m];
     alignas(64) float out[6][512];
     for (int c = 0; c < 3; ++c) {
-        const double s0 = bs0[c], s1 = bS.col[0][c], s2 = bS.col[1][c], s3 = bS.col[2][c];
-        const double t0 = bt0[c], t1 = bT.col[0][c], t2 = bT.col[1][c], t3 = bT.col[2][c];
-        for (int n2 = 0; n2 < 512; ++n2) {
-            const float inv = 1.0f / sums.v[0][n2];
-            out[c][n2] = float(s0 + I[n2] * s1 + J[n2] * s2 + K[n2] * s3 + double(sums.v[1 + c][n2] * inv));
-            out[3 + c][n2] = float(t0 + I[n2] * t1 + J[n2] * t2 + K[n2] * t3 + double(sums.v[4 + c][n2] * inv));
+        const float s1 = float(bS.col[0][c]), s2 = float(bS.col[1][c]), s3 = float(bS.col[2][c]);
+        const float t1 = float(bT.col[0][c]), t2 = float(bT.col[1][c]), t3 = float(bT.col[2][c]);
+        const float s0 = float(bs0[c]), t0 = float(bt0[c]);
+        const float* gs = sums.v[1 + c];
+        const float* gt = sums.v[4 + c];
+        for (int m = 0; m < 512; ++m) {
+            out[c][m] = s0 + ((I[m] * s1 + J[m] * s2 + K[m] * s3) + gs[m] * inv[m]);
+            out[3 + c][m] = t0 + ((I[m] * t1 + J[m] * t2 + K[m] * t3) + gt[m] * inv[m]);
         }
     }
-    for (int n2 = 0; n2 < 512; ++n2) {
-        ctx.leaf.source[n2] = Vec3f(out[0][n2], out[1][n2], out[2][n2]);
-        ctx.leaf.target[n2] = Vec3f(out[3][n2], out[4][n2], out[5][n2]);
+    for (int m = 0; m < 512; ++m) {
+        ctx.leaf.source[m] = Vec3f(out[0][m], out[1][m], out[2][m]);
+        ctx.leaf.target[m] = Vec3f(out[3][m], out[4][m], out[5][m]);
     }
 }
-
 void AdaptiveWarp::leaf(Context& ctx, const Lattice& lattice, const Coord& origin) const
 {
     ctx.leaf.origin = origin;
