@@ -100,7 +100,7 @@ void warpOnly(benchmark::State& state, double tolerance)
         adaptive.forEachLeaf(box, &occS, &occT,
                              [&](const detail::WarpLeaf& leaf) {
                                  float sum = 0.0f;
-                                 for (int i = 0; i < 512; ++i) sum += leaf.source[i].x() + leaf.target[i].y();
+                                 for (int i = 0; i < 512; ++i) sum += leaf.source(i).x() + leaf.target(i).y();
                                  sink += uint64_t(sum != 0.0f);
                              },
                              &stats);
@@ -117,7 +117,7 @@ void warpOnly(benchmark::State& state, double tolerance)
             Vec3d ps, pt;
             for (int i = 0; i < 512; i += 3) {
                 warp.map(leaf.origin.offsetBy(i >> 6, (i >> 3) & 7, i & 7).asVec3d(), ps, pt);
-                local = std::max({local, (Vec3d(leaf.source[i]) - ps).length(), (Vec3d(leaf.target[i]) - pt).length()});
+                local = std::max({local, (Vec3d(leaf.source(i)) - ps).length(), (Vec3d(leaf.target(i)) - pt).length()});
             }
             std::lock_guard<std::mutex> lock(m);
             worst = std::max(worst, local);

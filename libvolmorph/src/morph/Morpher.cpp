@@ -237,7 +237,7 @@ struct Resampler {
         ColorBlend<Sampler> blend(source, target, tauColor, background);
         bool any = false;
         for (openvdb::Index n = 0; n < 512; ++n) {
-            const openvdb::Vec3R ps(w.source[n]), pt(w.target[n]);
+            const openvdb::Vec3R ps(w.source(n)), pt(w.target(n));
             const float a = sample<Sampler>(ds, ps);
             const float b = sample<Sampler>(dt, pt);
             const float d = (1.0f - tauDensity) * a + tauDensity * b;
@@ -739,7 +739,7 @@ public:
             const int qx = (q & 1) * 4, qy = ((q >> 1) & 1) * 4, qz = ((q >> 2) & 1) * 4;
             if (mPrune) {
                 const openvdb::Index c = ((qx + 2) * 8 + qy + 2) * 8 + qz + 2;
-                const float d = (1.0f - mTau) * a(openvdb::Vec3R(w.source[c])) + mTau * b(openvdb::Vec3R(w.target[c]));
+                const float d = (1.0f - mTau) * a(openvdb::Vec3R(w.source(c))) + mTau * b(openvdb::Vec3R(w.target(c)));
                 ++samples;
                 if (!(std::abs(d) < quarterLimit)) {
                     fill(qx, qy, qz, 4, d);
@@ -752,8 +752,8 @@ public:
                     Vec3f ms(0.0f), mt(0.0f);
                     for (int v = 0; v < 8; ++v) {
                         const openvdb::Index n = openvdb::Index(((bx + (v & 1)) * 8 + by + ((v >> 1) & 1)) * 8 + bz + (v >> 2));
-                        ms += w.source[n];
-                        mt += w.target[n];
+                        ms += w.source(n);
+                        mt += w.target(n);
                     }
                     const float d = (1.0f - mTau) * a(openvdb::Vec3R(ms * 0.125f)) + mTau * b(openvdb::Vec3R(mt * 0.125f));
                     ++samples;
@@ -766,7 +766,7 @@ public:
                     for (int j = by; j < by + 2; ++j)
                         for (int k = bz; k < bz + 2; ++k) {
                             const openvdb::Index n = openvdb::Index((i * 8 + j) * 8 + k);
-                            const openvdb::Vec3R ps(w.source[n]), pt(w.target[n]);
+                            const openvdb::Vec3R ps(w.source(n)), pt(w.target(n));
                             const float da = a(ps), db = b(pt);
                             ++samples;
                             blendVoxel(n, da, db, value, color, seen, [&] {

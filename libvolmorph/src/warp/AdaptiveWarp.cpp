@@ -23,12 +23,21 @@ constexpr double kBoundScale = 1.0;
 /// of the sums: the leaf is evaluated exactly (only with a zero or tiny epsilon).
 constexpr double kTinyRadius = 1e-6;
 
+/// The per-voxel helpers are inlined into each clone of the leaf kernel (see fillLeaf).
+#if defined(__GNUC__)
+#define VOLMORPH_ALWAYS_INLINE __attribute__((always_inline))
+#else
+#define VOLMORPH_ALWAYS_INLINE
+#endif
+
 /// Per-voxel sums of a leaf, channel-major: 0 the weight sum, 1-3 the weighted residuals on the
 /// source side, 4-6 on the target side. Single precision, as the warped points are stored: its
 /// rounding (about 1e-6 of a residual of some tens of voxels) is far below any tolerance.
 struct LeafSums {
     alignas(64) float v[7][512];
 };
+
+struct LeafJob;
 
 /// Everything the error bound needs of one pair over a cube.
 struct PairBounds {
@@ -67,6 +76,7 @@ struct AdaptiveWarp::Context {
     uint64_t evaluations = 0, near = 0, leaves = 0;
     // Per pair, per leaf (scratch).
     std::unique_ptr<LeafSums> sums = std::make_unique<LeafSums>();
+    std::unique_ptr<LeafJob> job = std::make_unique<LeafJob>();
     std::vector<PairBounds> bounds;
     std::vector<double> resid, slope, term, hessW, suffixTerm, suffixHess;
     std::vector<int> order;
@@ -103,7 +113,7 @@ bool boxContains(const Feature& e, const Vec3d& centre, double size)
 
 /// Distance in the element's frame, inlined per type for the per-voxel loop.
 template <FeatureType T>
-inline float frameDistance(float qx, float qy, float qz, float hx, float hy, float hz)
+VOLMORPH_ALWAYS_INLINE inline float frameDistance(float qx, float qy, float qz, float hx, float hy, float hz)
 {
     // max(|v| - half, 0), written without a branch (exact: a + |a| is 2a or 0) so the loops
     // over a leaf's voxels vectorize.
@@ -141,40 +151,133 @@ const LeafOffsets kOffsets;
 
 /// Adds one near pair's weight and weighted residuals at every voxel of the leaf at o. rs and rt
 /// are the residuals R = A - B at o; their steps along the axes are the columns of M_A - M_B.
-template <FeatureType T>
-void addNearPair(LeafSums& sums, const Feature& e, const Vec3d& o, double offset, double exponent, double scale,
-                 bool inverseSquare, const Vec3d& rs, const Vec3d drs[3], const Vec3d& rt, const Vec3d drt[3])
+/// Everything affine in the voxel (frame coordinates, residuals) is stepped once per row of 8
+/// voxels along z; the row's 8 voxels are one vectorized body.
+template <FeatureType T, bool InverseSquare>
+VOLMORPH_ALWAYS_INLINE inline void addNearPair(LeafSums& sums, const Feature& e, const Vec3d& o, double offset, double exponent, double scale,
+                 const Vec3d& rs, const Vec3d drs[3], const Vec3d& rt, const Vec3d drt[3])
 {
-    const Vec3f q0(e.frameCoordinates(o));
+    const Vec3d q0 = e.frameCoordinates(o);
     // Steps of the frame coordinates along x, y and z: the frame's rows.
-    const Vec3f dx(Vec3d(e.x.x(), e.y.x(), e.z.x())), dy(Vec3d(e.x.y(), e.y.y(), e.z.y())),
-        dz(Vec3d(e.x.z(), e.y.z(), e.z.z()));
+    const Vec3d dx(e.x.x(), e.y.x(), e.z.x()), dy(e.x.y(), e.y.y(), e.z.y());
+    const Vec3f dz(Vec3d(e.x.z(), e.y.z(), e.z.z()));
     const float hx = float(0.5 * e.scale.x()), hy = float(0.5 * e.scale.y()), hz = float(0.5 * e.scale.z());
-    const float* I = kOffsets.i;
-    const float* J = kOffsets.j;
+    const float off = float(offset);
     const float* K = kOffsets.k;
-    alignas(64) float w[512];
-    for (int n = 0; n < 512; ++n) {
-        const float qx = q0.x() + I[n] * dx.x() + J[n] * dy.x() + K[n] * dz.x();
-        const float qy = q0.y() + I[n] * dx.y() + J[n] * dy.y() + K[n] * dz.y();
-        const float qz = q0.z() + I[n] * dx.z() + J[n] * dy.z() + K[n] * dz.z();
-        w[n] = float(offset) + frameDistance<T>(qx, qy, qz, hx, hy, hz);
-    }
-    if (inverseSquare) {
-        for (int n = 0; n < 512; ++n) w[n] = 1.0f / (w[n] * w[n]);
-    } else {
-        for (int n = 0; n < 512; ++n) w[n] = float(scale * std::pow(double(w[n]), -exponent));
-    }
-    for (int n = 0; n < 512; ++n) sums.v[0][n] += w[n];
+    float zs[3], zt[3];
     for (int c = 0; c < 3; ++c) {
-        float* s = sums.v[1 + c];
-        float* t = sums.v[4 + c];
-        const float r0 = float(rs[c]), r1 = float(drs[0][c]), r2 = float(drs[1][c]), r3 = float(drs[2][c]);
-        const float u0 = float(rt[c]), u1 = float(drt[0][c]), u2 = float(drt[1][c]), u3 = float(drt[2][c]);
-        for (int n = 0; n < 512; ++n) {
-            s[n] += w[n] * (r0 + I[n] * r1 + J[n] * r2 + K[n] * r3);
-            t[n] += w[n] * (u0 + I[n] * u1 + J[n] * u2 + K[n] * u3);
+        zs[c] = float(drs[2][c]);
+        zt[c] = float(drt[2][c]);
+    }
+    for (int i = 0; i < 8; ++i)
+        for (int j = 0; j < 8; ++j) {
+            // The row's first voxel.
+            const Vec3f q(q0 + dx * i + dy * j);
+            const Vec3f r0(rs + drs[0] * i + drs[1] * j), u0(rt + drt[0] * i + drt[1] * j);
+            const int n0 = (i * 8 + j) * 8;
+            float* __restrict sw = sums.v[0] + n0;
+            float* __restrict s0 = sums.v[1] + n0;
+            float* __restrict s1 = sums.v[2] + n0;
+            float* __restrict s2 = sums.v[3] + n0;
+            float* __restrict t0 = sums.v[4] + n0;
+            float* __restrict t1 = sums.v[5] + n0;
+            float* __restrict t2 = sums.v[6] + n0;
+            for (int z = 0; z < 8; ++z) {
+                const float k = K[z];
+                const float r = off + frameDistance<T>(q.x() + k * dz.x(), q.y() + k * dz.y(), q.z() + k * dz.z(), hx, hy, hz);
+                float w;
+                if constexpr (InverseSquare) w = 1.0f / (r * r);
+                else w = float(scale * std::pow(double(r), -exponent));
+                sw[z] += w;
+                s0[z] += w * (r0.x() + k * zs[0]);
+                s1[z] += w * (r0.y() + k * zs[1]);
+                s2[z] += w * (r0.z() + k * zs[2]);
+                t0[z] += w * (u0.x() + k * zt[0]);
+                t1[z] += w * (u0.y() + k * zt[1]);
+                t2[z] += w * (u0.z() + k * zt[2]);
+            }
         }
+}
+
+/// One near pair's share of a leaf: its element, weight scale and residuals (as addNearPair).
+struct NearTerm {
+    const Feature* element;
+    double scale;
+    Vec3d rs, drs[3], rt, drt[3];
+};
+
+/// Everything that fills one leaf's points.
+struct LeafJob {
+    Vec3d origin;
+    double far[7][8];               ///< the far sums at the leaf's corners, channels as LeafSums
+    std::vector<NearTerm> near;
+    InverseWarp::Affine bS, bT;     ///< the dominant pair's affine maps
+    double offset, exponent;
+    bool inverseSquare;
+};
+
+template <FeatureType T>
+VOLMORPH_ALWAYS_INLINE inline void addNear(const LeafJob& job, const NearTerm& t, LeafSums& sums)
+{
+    if (job.inverseSquare)
+        addNearPair<T, true>(sums, *t.element, job.origin, job.offset, job.exponent, t.scale, t.rs, t.drs, t.rt, t.drt);
+    else
+        addNearPair<T, false>(sums, *t.element, job.origin, job.offset, job.exponent, t.scale, t.rs, t.drs, t.rt, t.drt);
+}
+
+/// Far sums interpolated (bilinear at each row's ends, linear along the row), near pairs added,
+/// then p = B(x) + residual sum / weight sum, in single precision as the points are stored (its
+/// rounding, some 1e-5 voxel at hundreds of voxels from the origin, is far below a tolerance).
+VOLMORPH_ALWAYS_INLINE inline void fillLeafBody(const LeafJob& job, LeafSums& sums, WarpLeaf& leaf)
+{
+    constexpr int Size = 8;
+    const double h = Size;
+    const float* K = kOffsets.k;
+    for (int c = 0; c < 7; ++c) {
+        const double* v = job.far[c];
+        float* out = sums.v[c];
+        for (int i = 0; i < Size; ++i) {
+            const double fx = i / h;
+            const double a0 = v[0] + fx * (v[1] - v[0]), c0 = v[2] + fx * (v[3] - v[2]);
+            const double a1 = v[4] + fx * (v[5] - v[4]), c1 = v[6] + fx * (v[7] - v[6]);
+            for (int j = 0; j < Size; ++j) {
+                const double fy = j / h;
+                const double z0 = a0 + fy * (c0 - a0), z1 = a1 + fy * (c1 - a1);
+                const float base = float(z0), step = float((z1 - z0) / h);
+                float* __restrict row = out + (i * Size + j) * Size;
+                for (int z = 0; z < Size; ++z) row[z] = base + K[z] * step;
+            }
+        }
+    }
+
+    for (const NearTerm& t : job.near) {
+        switch (t.element->type) {
+        case FeatureType::Point: addNear<FeatureType::Point>(job, t, sums); break;
+        case FeatureType::Segment: addNear<FeatureType::Segment>(job, t, sums); break;
+        case FeatureType::Rectangle: addNear<FeatureType::Rectangle>(job, t, sums); break;
+        case FeatureType::Box: addNear<FeatureType::Box>(job, t, sums); break;
+        }
+    }
+
+    const Vec3d bs0 = job.bS.apply(job.origin), bt0 = job.bT.apply(job.origin);
+    for (int c = 0; c < 3; ++c) {
+        const Vec3d sx = job.bS.col[0], sy = job.bS.col[1], tx = job.bT.col[0], ty = job.bT.col[1];
+        const float sz = float(job.bS.col[2][c]), tz = float(job.bT.col[2][c]);
+        for (int i = 0; i < Size; ++i)
+            for (int j = 0; j < Size; ++j) {
+                const int n0 = (i * Size + j) * Size;
+                const float s0 = float(bs0[c] + sx[c] * i + sy[c] * j), t0 = float(bt0[c] + tx[c] * i + ty[c] * j);
+                const float* __restrict w = sums.v[0] + n0;
+                const float* __restrict gs = sums.v[1 + c] + n0;
+                const float* __restrict gt = sums.v[4 + c] + n0;
+                float* __restrict os = leaf.s[c] + n0;
+                float* __restrict ot = leaf.t[c] + n0;
+                for (int z = 0; z < Size; ++z) {
+                    const float inv = 1.0f / w[z];
+                    os[z] = s0 + (K[z] * sz + gs[z] * inv);
+                    ot[z] = t0 + (K[z] * tz + gt[z] * inv);
+                }
+            }
     }
 }
 
@@ -201,8 +304,7 @@ void AdaptiveWarp::identityLeaf(Context& ctx) const
         for (int j = 0; j < 8; ++j)
             for (int k = 0; k < 8; ++k) {
                 const Vec3f p(float(o.x() + i), float(o.y() + j), float(o.z() + k));
-                ctx.leaf.source[(i * 8 + j) * 8 + k] = p;
-                ctx.leaf.target[(i * 8 + j) * 8 + k] = p;
+                ctx.leaf.set((i * 8 + j) * 8 + k, p, p);
             }
 }
 
@@ -214,8 +316,7 @@ void AdaptiveWarp::exactLeaf(Context& ctx) const
         for (int j = 0; j < 8; ++j)
             for (int k = 0; k < 8; ++k) {
                 mWarp.map(Vec3d(o.x() + i, o.y() + j, o.z() + k), s, t);
-                ctx.leaf.source[(i * 8 + j) * 8 + k] = Vec3f(s);
-                ctx.leaf.target[(i * 8 + j) * 8 + k] = Vec3f(t);
+                ctx.leaf.set((i * 8 + j) * 8 + k, Vec3f(s), Vec3f(t));
             }
     ctx.evaluations += 512;
 }
@@ -249,7 +350,49 @@ bool touches(const Occupancy* occ, const Vec3d& lo, const Vec3d& hi, double marg
     return occ && occ->anyIn(widened(lo, hi, margin));
 }
 
+// The leaf kernel is compiled twice on x86-64 with GCC: for AVX2 (8 voxels of a row in one
+// instruction) and for the baseline, and picked by the CPU at run time. Each lane does the same
+// IEEE operations in either (no FMA contraction: -ffp-contract=off on this file), so the points
+// are bit-identical whatever the machine; the warp tests check it with useBaselineKernel.
+#if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__)
+#define VOLMORPH_HAVE_AVX2_KERNEL 1
+__attribute__((target("avx2"))) void fillLeafAvx2(const LeafJob& job, LeafSums& sums, WarpLeaf& leaf)
+{
+    fillLeafBody(job, sums, leaf);
+}
+#endif
+
+void fillLeafBaseline(const LeafJob& job, LeafSums& sums, WarpLeaf& leaf) { fillLeafBody(job, sums, leaf); }
+
+std::atomic<bool> gBaselineKernel{false};
+
+void fillLeaf(const LeafJob& job, LeafSums& sums, WarpLeaf& leaf)
+{
+#ifdef VOLMORPH_HAVE_AVX2_KERNEL
+    static const bool avx2 = __builtin_cpu_supports("avx2");
+    if (avx2 && !gBaselineKernel.load(std::memory_order_relaxed)) return fillLeafAvx2(job, sums, leaf);
+#endif
+    fillLeafBaseline(job, sums, leaf);
+}
+
+/// The smallest and largest of a leaf's 512 values, in 8 lanes (the loop vectorizes; a scalar
+/// min_element chain had been a twentieth of the warp).
+void channelRange(const float* v, float& lo, float& hi)
+{
+    float l[8], u[8];
+    for (int z = 0; z < 8; ++z) l[z] = u[z] = v[z];
+    for (int m = 8; m < 512; m += 8)
+        for (int z = 0; z < 8; ++z) {
+            l[z] = v[m + z] < l[z] ? v[m + z] : l[z];
+            u[z] = v[m + z] > u[z] ? v[m + z] : u[z];
+        }
+    lo = *std::min_element(l, l + 8);
+    hi = *std::max_element(u, u + 8);
+}
+
 } // namespace
+
+void useBaselineKernel(bool baseline) { gBaselineKernel = baseline; }
 
 void AdaptiveWarp::analyze(Context& ctx, const LatticePoint* const corners[8], const Coord& origin, int size) const
 {
@@ -325,10 +468,11 @@ void AdaptiveWarp::analyze(Context& ctx, const LatticePoint* const corners[8], c
     resid.resize(n);
     slope.resize(n);
     double rhoSum = 0.0, residMax = 0.0;
+    const Vec3d bsc = bS.apply(centre), btc = bT.apply(centre);
     for (size_t i = 0; i < n; ++i) {
         slope[i] = mSlope[dominant * n + i];
-        resid[i] = std::max((mSource[i].apply(centre) - bS.apply(centre)).length(),
-                            (mTarget[i].apply(centre) - bT.apply(centre)).length()) + slope[i] * halfDiagonal;
+        resid[i] = std::sqrt(std::max((mSource[i].apply(centre) - bsc).lengthSqr(), (mTarget[i].apply(centre) - btc).lengthSqr())) +
+                   slope[i] * halfDiagonal;
         rhoSum += pb[i].wMax * resid[i];
         residMax = std::max(residMax, resid[i]);
     }
@@ -437,7 +581,8 @@ void AdaptiveWarp::fill(Context& ctx, const Coord& origin) const
 
     // Far sums at the corners: W_F = W - sum_E w_i, G = N - sum_E w_i A_i - W_F B; channels as
     // in LeafSums.
-    double far[7][8];
+    LeafJob& job = *ctx.job;
+    double (&far)[7][8] = job.far;
     bool anyNear = false;
     for (int c = 0; c < 8; ++c) {
         const Vec3d x = o + Vec3d((c & 1) * h, ((c >> 1) & 1) * h, ((c >> 2) & 1) * h);
@@ -460,74 +605,30 @@ void AdaptiveWarp::fill(Context& ctx, const Coord& origin) const
         }
     }
 
-    const double offset = mWarp.weightOffset(), b = mWarp.weightExponent();
-    const bool inverseSquare = mWarp.weighting() == Weighting::InverseSquare;
-
-    // Far sums at every voxel: bilinear at each row's ends (z = 0 and z = h), linear along the
-    // row; single precision, channel-major, so the row loops vectorize.
-    LeafSums& sums = *ctx.sums;
-    for (int c = 0; c < 7; ++c) {
-        const double* v = far[c];
-        float* out = sums.v[c];
-        for (int i = 0; i < Size; ++i) {
-            const double fx = i / h;
-            const double a0 = v[0] + fx * (v[1] - v[0]), c0 = v[2] + fx * (v[3] - v[2]);
-            const double a1 = v[4] + fx * (v[5] - v[4]), c1 = v[6] + fx * (v[7] - v[6]);
-            for (int j = 0; j < Size; ++j) {
-                const double fy = j / h;
-                const double z0 = a0 + fy * (c0 - a0), z1 = a1 + fy * (c1 - a1);
-                const float base = float(z0), step = float((z1 - z0) / h);
-                float* row = out + (i * Size + j) * Size;
-                for (int z = 0; z < Size; ++z) row[z] = base + kOffsets.k[z] * step;
-            }
-        }
-    }
-
-    // Near pairs at every voxel.
-    if (anyNear) {
+    job.origin = o;
+    job.bS = bS;
+    job.bT = bT;
+    job.offset = mWarp.weightOffset();
+    job.exponent = mWarp.weightExponent();
+    job.inverseSquare = mWarp.weighting() == Weighting::InverseSquare;
+    job.near.clear();
+    if (anyNear)
         for (size_t p = 0; p < n; ++p) {
             if (!ctx.isNear[p]) continue;
-            const Vec3d rs = mSource[p].apply(o) - bS.apply(o), rt = mTarget[p].apply(o) - bT.apply(o);
-            const Vec3d drs[3] = {mSource[p].col[0] - bS.col[0], mSource[p].col[1] - bS.col[1], mSource[p].col[2] - bS.col[2]};
-            const Vec3d drt[3] = {mTarget[p].col[0] - bT.col[0], mTarget[p].col[1] - bT.col[1], mTarget[p].col[2] - bT.col[2]};
-            const Feature& e = mWarp.interpolated(p);
-            auto add = [&](auto type) {
-                addNearPair<decltype(type)::value>(sums, e, o, offset, b, mWarp.weightScale(p), inverseSquare, rs, drs, rt, drt);
-            };
-            switch (e.type) {
-            case FeatureType::Point: add(std::integral_constant<FeatureType, FeatureType::Point>()); break;
-            case FeatureType::Segment: add(std::integral_constant<FeatureType, FeatureType::Segment>()); break;
-            case FeatureType::Rectangle: add(std::integral_constant<FeatureType, FeatureType::Rectangle>()); break;
-            case FeatureType::Box: add(std::integral_constant<FeatureType, FeatureType::Box>()); break;
+            NearTerm t;
+            t.element = &mWarp.interpolated(p);
+            t.scale = mWarp.weightScale(p);
+            t.rs = mSource[p].apply(o) - bS.apply(o);
+            t.rt = mTarget[p].apply(o) - bT.apply(o);
+            for (int k = 0; k < 3; ++k) {
+                t.drs[k] = mSource[p].col[k] - bS.col[k];
+                t.drt[k] = mTarget[p].col[k] - bT.col[k];
             }
+            job.near.push_back(t);
         }
-    }
-
-    // p = B(x) + residual sum / weight sum, in single precision as the points are stored (their
-    // rounding, some 1e-5 voxel at hundreds of voxels from the origin, is far below a tolerance).
-    const Vec3d bs0 = bS.apply(o), bt0 = bT.apply(o);
-    const float* I = kOffsets.i;
-    const float* J = kOffsets.j;
-    const float* K = kOffsets.k;
-    alignas(64) float inv[512];
-    for (int m = 0; m < 512; ++m) inv[m] = 1.0f / sums.v[0][m];
-    alignas(64) float out[6][512];
-    for (int c = 0; c < 3; ++c) {
-        const float s1 = float(bS.col[0][c]), s2 = float(bS.col[1][c]), s3 = float(bS.col[2][c]);
-        const float t1 = float(bT.col[0][c]), t2 = float(bT.col[1][c]), t3 = float(bT.col[2][c]);
-        const float s0 = float(bs0[c]), t0 = float(bt0[c]);
-        const float* gs = sums.v[1 + c];
-        const float* gt = sums.v[4 + c];
-        for (int m = 0; m < 512; ++m) {
-            out[c][m] = s0 + ((I[m] * s1 + J[m] * s2 + K[m] * s3) + gs[m] * inv[m]);
-            out[3 + c][m] = t0 + ((I[m] * t1 + J[m] * t2 + K[m] * t3) + gt[m] * inv[m]);
-        }
-    }
-    for (int m = 0; m < 512; ++m) {
-        ctx.leaf.source[m] = Vec3f(out[0][m], out[1][m], out[2][m]);
-        ctx.leaf.target[m] = Vec3f(out[3][m], out[4][m], out[5][m]);
-    }
+    fillLeaf(job, *ctx.sums, ctx.leaf);
 }
+
 void AdaptiveWarp::leaf(Context& ctx, const Lattice& lattice, const Coord& origin) const
 {
     ctx.leaf.origin = origin;
@@ -538,12 +639,10 @@ void AdaptiveWarp::leaf(Context& ctx, const Lattice& lattice, const Coord& origi
     auto visit = [&](double errorBound, bool recheck) {
         if (cull && recheck) {
             // The filled points' own bounding box, widened by what they may be off.
-            Vec3f slo = ctx.leaf.source[0], shi = slo, tlo = ctx.leaf.target[0], thi = tlo;
-            for (int i = 1; i < 512; ++i) {
-                slo = minComponent(slo, ctx.leaf.source[i]);
-                shi = maxComponent(shi, ctx.leaf.source[i]);
-                tlo = minComponent(tlo, ctx.leaf.target[i]);
-                thi = maxComponent(thi, ctx.leaf.target[i]);
+            Vec3f slo, shi, tlo, thi;
+            for (int c = 0; c < 3; ++c) {
+                channelRange(ctx.leaf.s[c], slo[c], shi[c]);
+                channelRange(ctx.leaf.t[c], tlo[c], thi[c]);
             }
             const double margin = kSamplerReach + errorBound;
             if (!touches(ctx.source, Vec3d(slo), Vec3d(shi), margin) && !touches(ctx.target, Vec3d(tlo), Vec3d(thi), margin))

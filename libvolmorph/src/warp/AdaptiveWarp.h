@@ -54,10 +54,21 @@
 namespace volmorph::detail {
 
 /// Warped positions of one output leaf's 8^3 voxels, in the index space of source and target.
-/// Voxel (i, j, k) of the leaf is at [(i * 8 + j) * 8 + k], as in OpenVDB's leaf nodes.
+/// Voxel (i, j, k) of the leaf is n = (i * 8 + j) * 8 + k, as in OpenVDB's leaf nodes. Stored
+/// channel-major (the warp's loops write whole channels).
 struct WarpLeaf {
     openvdb::Coord origin;
-    std::array<Vec3f, 512> source, target;
+    alignas(64) float s[3][512]; ///< source side: x, y, z of each voxel
+    alignas(64) float t[3][512]; ///< target side
+    Vec3f source(int n) const { return Vec3f(s[0][n], s[1][n], s[2][n]); }
+    Vec3f target(int n) const { return Vec3f(t[0][n], t[1][n], t[2][n]); }
+    void set(int n, const Vec3f& ps, const Vec3f& pt)
+    {
+        for (int c = 0; c < 3; ++c) {
+            s[c][n] = ps[c];
+            t[c][n] = pt[c];
+        }
+    }
 };
 
 struct AdaptiveWarpStats {
@@ -66,6 +77,10 @@ struct AdaptiveWarpStats {
     uint64_t nearEvaluations = 0;    ///< near pairs evaluated at single voxels (one pair each)
     uint64_t leaves = 0;             ///< leaves visited (the candidate domain)
 };
+
+/// The leaf kernel runs in AVX2 where the CPU has it, with the same bits as the baseline kernel;
+/// true forces the baseline (process-wide; for tests that compare the two).
+void useBaselineKernel(bool baseline);
 
 class AdaptiveWarp {
 public:
