@@ -149,6 +149,26 @@ struct LeafOffsets {
 };
 const LeafOffsets kOffsets;
 
+/// Each row's (i, j) in a leaf, row r = i * 8 + j, as doubles: the per-row set-ups (a value and
+/// a step for each row's 8 voxels) are loops over the 64 rows, which vectorize.
+struct RowOffsets {
+    double i[64], j[64];
+    RowOffsets()
+    {
+        for (int r = 0; r < 64; ++r) {
+            i[r] = r >> 3;
+            j[r] = r & 7;
+        }
+    }
+};
+const RowOffsets kRows;
+
+/// a + b i + c j at every row, in single precision (same operations as a + b * i + c * j).
+VOLMORPH_ALWAYS_INLINE inline void rowAffine(double a, double b, double c, float out[64])
+{
+    for (int r = 0; r < 64; ++r) out[r] = float(a + b * kRows.i[r] + c * kRows.j[r]);
+}
+
 /// Adds one near pair's weight and weighted residuals at every voxel of the leaf at o. rs and rt
 /// are the residuals R = A - B at o; their steps along the axes are the columns of M_A - M_B.
 /// Everything affine in the voxel (frame coordinates, residuals) is stepped once per row of 8
@@ -169,34 +189,39 @@ VOLMORPH_ALWAYS_INLINE inline void addNearPair(LeafSums& sums, const Feature& e,
         zs[c] = float(drs[2][c]);
         zt[c] = float(drt[2][c]);
     }
-    for (int i = 0; i < 8; ++i)
-        for (int j = 0; j < 8; ++j) {
-            // The row's first voxel.
-            const Vec3f q(q0 + dx * i + dy * j);
-            const Vec3f r0(rs + drs[0] * i + drs[1] * j), u0(rt + drt[0] * i + drt[1] * j);
-            const int n0 = (i * 8 + j) * 8;
-            float* __restrict sw = sums.v[0] + n0;
-            float* __restrict s0 = sums.v[1] + n0;
-            float* __restrict s1 = sums.v[2] + n0;
-            float* __restrict s2 = sums.v[3] + n0;
-            float* __restrict t0 = sums.v[4] + n0;
-            float* __restrict t1 = sums.v[5] + n0;
-            float* __restrict t2 = sums.v[6] + n0;
-            for (int z = 0; z < 8; ++z) {
-                const float k = K[z];
-                const float r = off + frameDistance<T>(q.x() + k * dz.x(), q.y() + k * dz.y(), q.z() + k * dz.z(), hx, hy, hz);
-                float w;
-                if constexpr (InverseSquare) w = 1.0f / (r * r);
-                else w = float(scale * std::pow(double(r), -exponent));
-                sw[z] += w;
-                s0[z] += w * (r0.x() + k * zs[0]);
-                s1[z] += w * (r0.y() + k * zs[1]);
-                s2[z] += w * (r0.z() + k * zs[2]);
-                t0[z] += w * (u0.x() + k * zt[0]);
-                t1[z] += w * (u0.y() + k * zt[1]);
-                t2[z] += w * (u0.z() + k * zt[2]);
-            }
+    // Each row's first voxel: frame coordinates and residuals.
+    alignas(64) float row[9][64];
+    for (int c = 0; c < 3; ++c) {
+        rowAffine(q0[c], dx[c], dy[c], row[c]);
+        rowAffine(rs[c], drs[0][c], drs[1][c], row[3 + c]);
+        rowAffine(rt[c], drt[0][c], drt[1][c], row[6 + c]);
+    }
+    for (int rw = 0; rw < 64; ++rw) {
+        const Vec3f q(row[0][rw], row[1][rw], row[2][rw]);
+        const Vec3f r0(row[3][rw], row[4][rw], row[5][rw]), u0(row[6][rw], row[7][rw], row[8][rw]);
+        const int n0 = rw * 8;
+        float* __restrict sw = sums.v[0] + n0;
+        float* __restrict s0 = sums.v[1] + n0;
+        float* __restrict s1 = sums.v[2] + n0;
+        float* __restrict s2 = sums.v[3] + n0;
+        float* __restrict t0 = sums.v[4] + n0;
+        float* __restrict t1 = sums.v[5] + n0;
+        float* __restrict t2 = sums.v[6] + n0;
+        for (int z = 0; z < 8; ++z) {
+            const float k = K[z];
+            const float r = off + frameDistance<T>(q.x() + k * dz.x(), q.y() + k * dz.y(), q.z() + k * dz.z(), hx, hy, hz);
+            float w;
+            if constexpr (InverseSquare) w = 1.0f / (r * r);
+            else w = float(scale * std::pow(double(r), -exponent));
+            sw[z] += w;
+            s0[z] += w * (r0.x() + k * zs[0]);
+            s1[z] += w * (r0.y() + k * zs[1]);
+            s2[z] += w * (r0.z() + k * zs[2]);
+            t0[z] += w * (u0.x() + k * zt[0]);
+            t1[z] += w * (u0.y() + k * zt[1]);
+            t2[z] += w * (u0.z() + k * zt[2]);
         }
+    }
 }
 
 /// One near pair's share of a leaf: its element, weight scale and residuals (as addNearPair).
@@ -235,18 +260,19 @@ VOLMORPH_ALWAYS_INLINE inline void fillLeafBody(const LeafJob& job, LeafSums& su
     const float* K = kOffsets.k;
     for (int c = 0; c < 7; ++c) {
         const double* v = job.far[c];
-        float* out = sums.v[c];
-        for (int i = 0; i < Size; ++i) {
-            const double fx = i / h;
+        // Bilinear at each row's ends (z = 0 and z = h), then linear along the row.
+        alignas(64) float base[64], step[64];
+        for (int r = 0; r < 64; ++r) {
+            const double fx = kRows.i[r] / h, fy = kRows.j[r] / h;
             const double a0 = v[0] + fx * (v[1] - v[0]), c0 = v[2] + fx * (v[3] - v[2]);
             const double a1 = v[4] + fx * (v[5] - v[4]), c1 = v[6] + fx * (v[7] - v[6]);
-            for (int j = 0; j < Size; ++j) {
-                const double fy = j / h;
-                const double z0 = a0 + fy * (c0 - a0), z1 = a1 + fy * (c1 - a1);
-                const float base = float(z0), step = float((z1 - z0) / h);
-                float* __restrict row = out + (i * Size + j) * Size;
-                for (int z = 0; z < Size; ++z) row[z] = base + K[z] * step;
-            }
+            const double z0 = a0 + fy * (c0 - a0), z1 = a1 + fy * (c1 - a1);
+            base[r] = float(z0);
+            step[r] = float((z1 - z0) / h);
+        }
+        for (int r = 0; r < 64; ++r) {
+            float* __restrict out = sums.v[c] + r * Size;
+            for (int z = 0; z < Size; ++z) out[z] = base[r] + K[z] * step[r];
         }
     }
 
@@ -261,23 +287,24 @@ VOLMORPH_ALWAYS_INLINE inline void fillLeafBody(const LeafJob& job, LeafSums& su
 
     const Vec3d bs0 = job.bS.apply(job.origin), bt0 = job.bT.apply(job.origin);
     for (int c = 0; c < 3; ++c) {
-        const Vec3d sx = job.bS.col[0], sy = job.bS.col[1], tx = job.bT.col[0], ty = job.bT.col[1];
         const float sz = float(job.bS.col[2][c]), tz = float(job.bT.col[2][c]);
-        for (int i = 0; i < Size; ++i)
-            for (int j = 0; j < Size; ++j) {
-                const int n0 = (i * Size + j) * Size;
-                const float s0 = float(bs0[c] + sx[c] * i + sy[c] * j), t0 = float(bt0[c] + tx[c] * i + ty[c] * j);
-                const float* __restrict w = sums.v[0] + n0;
-                const float* __restrict gs = sums.v[1 + c] + n0;
-                const float* __restrict gt = sums.v[4 + c] + n0;
-                float* __restrict os = leaf.s[c] + n0;
-                float* __restrict ot = leaf.t[c] + n0;
-                for (int z = 0; z < Size; ++z) {
-                    const float inv = 1.0f / w[z];
-                    os[z] = s0 + (K[z] * sz + gs[z] * inv);
-                    ot[z] = t0 + (K[z] * tz + gt[z] * inv);
-                }
+        alignas(64) float bs[64], bt[64]; // B(x) at each row's first voxel
+        rowAffine(bs0[c], job.bS.col[0][c], job.bS.col[1][c], bs);
+        rowAffine(bt0[c], job.bT.col[0][c], job.bT.col[1][c], bt);
+        for (int r = 0; r < 64; ++r) {
+            const int n0 = r * Size;
+            const float s0 = bs[r], t0 = bt[r];
+            const float* __restrict w = sums.v[0] + n0;
+            const float* __restrict gs = sums.v[1 + c] + n0;
+            const float* __restrict gt = sums.v[4 + c] + n0;
+            float* __restrict os = leaf.s[c] + n0;
+            float* __restrict ot = leaf.t[c] + n0;
+            for (int z = 0; z < Size; ++z) {
+                const float inv = 1.0f / w[z];
+                os[z] = s0 + (K[z] * sz + gs[z] * inv);
+                ot[z] = t0 + (K[z] * tz + gt[z] * inv);
             }
+        }
     }
 }
 
