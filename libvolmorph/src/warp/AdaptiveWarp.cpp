@@ -79,6 +79,7 @@ struct AdaptiveWarp::Context {
     std::unique_ptr<LeafJob> job = std::make_unique<LeafJob>();
     std::vector<PairBounds> bounds;
     std::vector<double> resid, slope, term, hessW, suffixTerm, suffixHess;
+    std::vector<Vec3d> residS, residT; ///< R_i at the cube's centre, each side
     std::vector<int> order;
     std::vector<char> isNear;
     // What analyze() found of the last cell.
@@ -496,10 +497,13 @@ void AdaptiveWarp::analyze(Context& ctx, const LatticePoint* const corners[8], c
     slope.resize(n);
     double rhoSum = 0.0, residMax = 0.0;
     const Vec3d bsc = bS.apply(centre), btc = bT.apply(centre);
+    ctx.residS.resize(n);
+    ctx.residT.resize(n);
     for (size_t i = 0; i < n; ++i) {
         slope[i] = mSlope[dominant * n + i];
-        resid[i] = std::sqrt(std::max((mSource[i].apply(centre) - bsc).lengthSqr(), (mTarget[i].apply(centre) - btc).lengthSqr())) +
-                   slope[i] * halfDiagonal;
+        ctx.residS[i] = mSource[i].apply(centre) - bsc;
+        ctx.residT[i] = mTarget[i].apply(centre) - btc;
+        resid[i] = std::sqrt(std::max(ctx.residS[i].lengthSqr(), ctx.residT[i].lengthSqr())) + slope[i] * halfDiagonal;
         rhoSum += pb[i].wMax * resid[i];
         residMax = std::max(residMax, resid[i]);
     }
@@ -524,6 +528,41 @@ void AdaptiveWarp::analyze(Context& ctx, const LatticePoint* const corners[8], c
         hess += ctx.hessW[i];
     }
     ctx.boundAllFar = bound(ctx, terms, hess);
+
+    // A second, tighter pass where that bound is finite. A far pair's share of the error is
+    // (R_i(c) - rho(x)) (I[w_i] - w_i) + D_i (I[w_i (x - c)] - w_i (x - c)), c the centre and
+    // D_i = M_i - M_B, so |R_i(c)| + |rho| above may be replaced by |R_i(c) - rho(x)|. The
+    // all-far interpolant's rho lies in the hull of the corners' rho_k and within boundAllFar of
+    // the true rho: |R_i(c) - rho(x)| <= |R_i(c) - rho_0| + r + boundAllFar, with rho_0 the
+    // centre of the corners' box and r its largest distance to a corner (each side).
+    if (!ctx.cornersOk || !std::isfinite(ctx.boundAllFar) || n == 1) return;
+    Vec3d mid[2];
+    double radius[2];
+    for (int side = 0; side < 2; ++side) {
+        const InverseWarp::Affine& bA = side == 0 ? bS : bT;
+        Vec3d rho[8], lo(std::numeric_limits<double>::max()), hi(-lo);
+        for (int c = 0; c < 8; ++c) {
+            const LatticePoint& p = *corners[c];
+            const Vec3d x = o + Vec3d((c & 1) * h, ((c >> 1) & 1) * h, ((c >> 2) & 1) * h);
+            rho[c] = (side == 0 ? p.s : p.t) / p.w - bA.apply(x);
+            lo = minComponent(lo, rho[c]);
+            hi = maxComponent(hi, rho[c]);
+        }
+        mid[side] = 0.5 * (lo + hi);
+        radius[side] = 0.0;
+        for (int c = 0; c < 8; ++c) radius[side] = std::max(radius[side], (rho[c] - mid[side]).length());
+    }
+    terms = 0.0;
+    for (size_t i = 0; i < n; ++i) {
+        if (std::isfinite(ctx.term[i]) && !pb[i].constant) {
+            const double apart = std::max((ctx.residS[i] - mid[0]).length() + radius[0],
+                                          (ctx.residT[i] - mid[1]).length() + radius[1]) +
+                                 slope[i] * halfDiagonal + ctx.boundAllFar;
+            if (apart < resid[i] + rhoMax) ctx.term[i] = k * (apart * pb[i].w2 + 2.0 * slope[i] * pb[i].w1);
+        }
+        terms += ctx.term[i];
+    }
+    ctx.boundAllFar = std::min(ctx.boundAllFar, bound(ctx, terms, hess));
 }
 
 // The domain, before any voxel. With every pair far the interpolant is B + I[G] / I[W], and
