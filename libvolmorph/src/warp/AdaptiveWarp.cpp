@@ -287,6 +287,8 @@ VOLMORPH_ALWAYS_INLINE inline void fillLeafBody(const LeafJob& job, LeafSums& su
     }
 
     const Vec3d bs0 = job.bS.apply(job.origin), bt0 = job.bT.apply(job.origin);
+    alignas(64) float inv[512]; // 1 / weight sum, once per voxel for all six channels
+    for (int m = 0; m < 512; ++m) inv[m] = 1.0f / sums.v[0][m];
     for (int c = 0; c < 3; ++c) {
         const float sz = float(job.bS.col[2][c]), tz = float(job.bT.col[2][c]);
         alignas(64) float bs[64], bt[64]; // B(x) at each row's first voxel
@@ -295,15 +297,14 @@ VOLMORPH_ALWAYS_INLINE inline void fillLeafBody(const LeafJob& job, LeafSums& su
         for (int r = 0; r < 64; ++r) {
             const int n0 = r * Size;
             const float s0 = bs[r], t0 = bt[r];
-            const float* __restrict w = sums.v[0] + n0;
+            const float* __restrict iw = inv + n0;
             const float* __restrict gs = sums.v[1 + c] + n0;
             const float* __restrict gt = sums.v[4 + c] + n0;
             float* __restrict os = leaf.s[c] + n0;
             float* __restrict ot = leaf.t[c] + n0;
             for (int z = 0; z < Size; ++z) {
-                const float inv = 1.0f / w[z];
-                os[z] = s0 + (K[z] * sz + gs[z] * inv);
-                ot[z] = t0 + (K[z] * tz + gt[z] * inv);
+                os[z] = s0 + (K[z] * sz + gs[z] * iw[z]);
+                ot[z] = t0 + (K[z] * tz + gt[z] * iw[z]);
             }
         }
     }
