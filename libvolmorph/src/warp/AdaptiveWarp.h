@@ -22,7 +22,11 @@
 //      |p~ - p| <= (3 h^2/8) sum_F [(|R_i| + |rho|) |Hess w_i| + 2 |M_i - M_B| |grad w_i|]
 //                  / (W_min - (3 h^2/8) sum_F |Hess w_i|),
 //    rho = p - B (a convex combination of the R_i), |R_i| and W_min bounded over the leaf, both
-//    sides. Pairs join E, largest term first, until the bound is within the tolerance. An
+//    sides. Where this all-far bound is finite, a second pass tightens it: a far pair's share is
+//    (R_i(c) - rho) (I[w_i] - w_i) + (M_i - M_B)(I[w_i (x - c)] - w_i (x - c)), c the centre,
+//    and the all-far interpolant's rho lies in the hull of the corners' rho_k, within the bound
+//    of the true rho, so |R_i| + |rho| becomes |R_i(c) - rho_0| + (hull radius) + bound.
+//    Pairs join E, largest term first, until the bound is within the tolerance. An
 //    element that touches the leaf (d_i = 0 somewhere, not containing it) has a kink there and
 //    is always near. One pair is its affine map: R = 0, no error, nothing near.
 // 4. The same bound decides the domain without evaluating any voxel. With every pair far, the
@@ -32,6 +36,9 @@
 //    occupied block of both sides (widened by the sampler's reach) is skipped; blocks of 2^3
 //    leaves are judged first, from every other lattice point. A leaf kept only by the bound's
 //    margin is checked again on its filled points.
+// 5. Each leaf is filled by one kernel (far sums along rows, near pairs, the points) whose loops
+//    run over rows of 8 voxels in single precision; it is compiled for AVX2 and for the baseline
+//    and picked by the CPU, with the same bits from both (no FMA contraction in this file).
 //
 // Lerios et al. (1995) interpolated the warp over an adaptive grid checked at the next finer
 // lattice; here no sample decides the error, and the exact warp is evaluated at about one point
