@@ -23,7 +23,7 @@ constexpr double kBoundScale = 1.0;
 /// of the sums: the leaf is evaluated exactly (only with a zero or tiny epsilon).
 constexpr double kTinyRadius = 1e-6;
 
-/// The per-voxel helpers are inlined into each clone of the leaf kernel (see fillLeaf).
+/// The per-voxel helpers are inlined into both builds of the leaf kernel (see fillLeaf).
 #if defined(__GNUC__)
 #define VOLMORPH_ALWAYS_INLINE __attribute__((always_inline))
 #else
@@ -87,6 +87,7 @@ struct AdaptiveWarp::Context {
     bool cornersOk = false, tiny = false, coreTouches = false;
     size_t dominant = 0;
     double wMinSum = 0.0, rhoMax = 0.0, boundAllFar = 0.0;
+    Vec3d rhoLo[2], rhoHi[2], rhoMid[2]; ///< the box of the corners' rho_k, source and target side
 };
 
 namespace {
@@ -135,20 +136,8 @@ VOLMORPH_ALWAYS_INLINE inline float frameDistance(float qx, float qy, float qz, 
     return std::sqrt(a * a + b * b + c * c);
 }
 
-/// Each voxel's offsets in its leaf, in OpenVDB's order (index (i * 8 + j) * 8 + k), as floats:
-/// loops over the 512 voxels of a leaf then vectorize.
-struct LeafOffsets {
-    float i[512], j[512], k[512];
-    LeafOffsets()
-    {
-        for (int n = 0; n < 512; ++n) {
-            i[n] = n >> 6;
-            j[n] = (n >> 3) & 7;
-            k[n] = n & 7;
-        }
-    }
-};
-const LeafOffsets kOffsets;
+/// The voxels' offsets along a row (z), as floats.
+constexpr float kZ[8] = {0, 1, 2, 3, 4, 5, 6, 7};
 
 /// Each row's (i, j) in a leaf, row r = i * 8 + j, as doubles: the per-row set-ups (a value and
 /// a step for each row's 8 voxels) are loops over the 64 rows, which vectorize.
@@ -184,7 +173,7 @@ VOLMORPH_ALWAYS_INLINE inline void addNearPair(LeafSums& sums, const Feature& e,
     const Vec3f dz(Vec3d(e.x.z(), e.y.z(), e.z.z()));
     const float hx = float(0.5 * e.scale.x()), hy = float(0.5 * e.scale.y()), hz = float(0.5 * e.scale.z());
     const float off = float(offset);
-    const float* K = kOffsets.k;
+    const float* K = kZ;
     float zs[3], zt[3];
     for (int c = 0; c < 3; ++c) {
         zs[c] = float(drs[2][c]);
@@ -258,7 +247,7 @@ VOLMORPH_ALWAYS_INLINE inline void fillLeafBody(const LeafJob& job, LeafSums& su
 {
     constexpr int Size = 8;
     const double h = Size;
-    const float* K = kOffsets.k;
+    const float* K = kZ;
     for (int c = 0; c < 7; ++c) {
         const double* v = job.far[c];
         // Bilinear at each row's ends (z = 0 and z = h), then linear along the row.
@@ -536,8 +525,9 @@ void AdaptiveWarp::analyze(Context& ctx, const LatticePoint* const corners[8], c
     // all-far interpolant's rho lies in the hull of the corners' rho_k and within boundAllFar of
     // the true rho: |R_i(c) - rho(x)| <= |R_i(c) - rho_0| + r + boundAllFar, with rho_0 the
     // centre of the corners' box and r its largest distance to a corner (each side).
-    if (!ctx.cornersOk || !std::isfinite(ctx.boundAllFar) || n == 1) return;
-    Vec3d mid[2];
+    // The corners' residuals rho_k = p_k - B(x_k): their box on each side (the domain test uses
+    // it too), its centre rho_0 and largest distance r.
+    if (!ctx.cornersOk) return;
     double radius[2];
     for (int side = 0; side < 2; ++side) {
         const InverseWarp::Affine& bA = side == 0 ? bS : bT;
@@ -549,10 +539,14 @@ void AdaptiveWarp::analyze(Context& ctx, const LatticePoint* const corners[8], c
             lo = minComponent(lo, rho[c]);
             hi = maxComponent(hi, rho[c]);
         }
-        mid[side] = 0.5 * (lo + hi);
+        ctx.rhoLo[side] = lo;
+        ctx.rhoHi[side] = hi;
+        ctx.rhoMid[side] = 0.5 * (lo + hi);
         radius[side] = 0.0;
-        for (int c = 0; c < 8; ++c) radius[side] = std::max(radius[side], (rho[c] - mid[side]).length());
+        for (int c = 0; c < 8; ++c) radius[side] = std::max(radius[side], (rho[c] - ctx.rhoMid[side]).length());
     }
+    if (!std::isfinite(ctx.boundAllFar) || n == 1) return;
+    const Vec3d* mid = ctx.rhoMid;
     terms = 0.0;
     for (size_t i = 0; i < n; ++i) {
         if (std::isfinite(ctx.term[i]) && !pb[i].constant) {
@@ -575,20 +569,13 @@ bool AdaptiveWarp::mayTouch(Context& ctx, const Coord& origin, int size) const
     const Vec3d o = origin.asVec3d();
     const InverseWarp::Affine& bS = mSource[ctx.dominant];
     const InverseWarp::Affine& bT = mTarget[ctx.dominant];
-    // The corners' residuals rho_k = p_k - B(x_k), each side.
+    // The corners' residuals rho_k = p_k - B(x_k), each side (their box from analyze()).
     Vec3d rsLo(-rhoMax), rsHi(rhoMax), rtLo(-rhoMax), rtHi(rhoMax);
     if (ctx.cornersOk) {
-        rsLo = rtLo = Vec3d(std::numeric_limits<double>::max());
-        rsHi = rtHi = -rsLo;
-        for (int c = 0; c < 8; ++c) {
-            const LatticePoint& p = *ctx.corner[c];
-            const Vec3d x = o + Vec3d((c & 1) * h, ((c >> 1) & 1) * h, ((c >> 2) & 1) * h);
-            const Vec3d rs = p.s / p.w - bS.apply(x), rt = p.t / p.w - bT.apply(x);
-            rsLo = minComponent(rsLo, rs);
-            rsHi = maxComponent(rsHi, rs);
-            rtLo = minComponent(rtLo, rt);
-            rtHi = maxComponent(rtHi, rt);
-        }
+        rsLo = ctx.rhoLo[0];
+        rsHi = ctx.rhoHi[0];
+        rtLo = ctx.rhoLo[1];
+        rtHi = ctx.rhoHi[1];
     }
     Vec3d sLo, sHi, tLo, tHi;
     affineImage(bS, o, h, sLo, sHi);
