@@ -30,13 +30,6 @@ constexpr double kTinyRadius = 1e-6;
 #define VOLMORPH_ALWAYS_INLINE
 #endif
 
-/// Per-voxel sums of a leaf, channel-major: 0 the weight sum, 1-3 the weighted residuals on the
-/// source side, 4-6 on the target side. Single precision, as the warped points are stored: its
-/// rounding (about 1e-6 of a residual of some tens of voxels) is far below any tolerance.
-struct LeafSums {
-    alignas(64) float v[7][512];
-};
-
 struct LeafJob;
 
 /// Everything the error bound needs of one pair over a cube.
@@ -75,7 +68,6 @@ struct AdaptiveWarp::Context {
     double maxError = 0.0;
     uint64_t evaluations = 0, near = 0, leaves = 0;
     // Per pair, per leaf (scratch).
-    std::unique_ptr<LeafSums> sums = std::make_unique<LeafSums>();
     std::unique_ptr<LeafJob> job = std::make_unique<LeafJob>();
     std::vector<PairBounds> bounds;
     std::vector<double> resid, slope, term, hessW, suffixTerm, suffixHess;
@@ -113,31 +105,51 @@ bool boxContains(const Feature& e, const Vec3d& centre, double size)
     return true;
 }
 
-/// Distance in the element's frame, inlined per type for the per-voxel loop.
-template <FeatureType T>
-VOLMORPH_ALWAYS_INLINE inline float frameDistance(float qx, float qy, float qz, float hx, float hy, float hz)
+#if defined(__GNUC__) && !defined(__clang__)
+// The 8-lane helpers below are always inlined; their by-value vector ABI never applies.
+#pragma GCC diagnostic ignored "-Wpsabi"
+#endif
+
+// The leaf kernel works on rows of 8 voxels along z, one 8-lane vector each (GCC's vector
+// extension: one AVX register, or two SSE ones in the baseline build; the same IEEE operations
+// per lane in both).
+typedef float v8f __attribute__((vector_size(32), __may_alias__));
+typedef int v8i __attribute__((vector_size(32), __may_alias__));
+
+/// The voxels' offsets along a row (z).
+constexpr v8f kZ = {0, 1, 2, 3, 4, 5, 6, 7};
+
+VOLMORPH_ALWAYS_INLINE inline v8f load(const float* p) { return *reinterpret_cast<const v8f*>(p); }
+VOLMORPH_ALWAYS_INLINE inline void store(float* p, v8f v) { *reinterpret_cast<v8f*>(p) = v; }
+VOLMORPH_ALWAYS_INLINE inline v8f vabs(v8f v) { return reinterpret_cast<v8f>(reinterpret_cast<v8i>(v) & 0x7fffffff); }
+VOLMORPH_ALWAYS_INLINE inline v8f vsqrt(v8f v)
 {
-    // max(|v| - half, 0), written without a branch (exact: a + |a| is 2a or 0) so the loops
-    // over a leaf's voxels vectorize.
-    auto out = [](float v, float half) {
-        const float a = std::abs(v) - half;
-        return 0.5f * (a + std::abs(a));
-    };
-    if constexpr (T == FeatureType::Point) return std::sqrt(qx * qx + qy * qy + qz * qz);
-    if constexpr (T == FeatureType::Segment) {
-        const float a = out(qx, hx);
-        return std::sqrt(a * a + qy * qy + qz * qz);
-    }
-    if constexpr (T == FeatureType::Rectangle) {
-        const float a = out(qx, hx), b = out(qy, hy);
-        return std::sqrt(a * a + b * b + qz * qz);
-    }
-    const float a = out(qx, hx), b = out(qy, hy), c = out(qz, hz);
-    return std::sqrt(a * a + b * b + c * c);
+    v8f r;
+    for (int l = 0; l < 8; ++l) r[l] = __builtin_sqrtf(v[l]); // one sqrtps per register (no errno)
+    return r;
 }
 
-/// The voxels' offsets along a row (z), as floats.
-constexpr float kZ[8] = {0, 1, 2, 3, 4, 5, 6, 7};
+/// Distance in the element's frame at a row's 8 voxels, per type.
+template <FeatureType T>
+VOLMORPH_ALWAYS_INLINE inline v8f frameDistance(v8f qx, v8f qy, v8f qz, float hx, float hy, float hz)
+{
+    // max(|v| - half, 0), written without a branch (exact: a + |a| is 2a or 0).
+    auto out = [](v8f v, float half) {
+        const v8f a = vabs(v) - half;
+        return 0.5f * (a + vabs(a));
+    };
+    if constexpr (T == FeatureType::Point) return vsqrt(qx * qx + qy * qy + qz * qz);
+    if constexpr (T == FeatureType::Segment) {
+        const v8f a = out(qx, hx);
+        return vsqrt(a * a + qy * qy + qz * qz);
+    }
+    if constexpr (T == FeatureType::Rectangle) {
+        const v8f a = out(qx, hx), b = out(qy, hy);
+        return vsqrt(a * a + b * b + qz * qz);
+    }
+    const v8f a = out(qx, hx), b = out(qy, hy), c = out(qz, hz);
+    return vsqrt(a * a + b * b + c * c);
+}
 
 /// Each row's (i, j) in a leaf, row r = i * 8 + j, as doubles: the per-row set-ups (a value and
 /// a step for each row's 8 voxels) are loops over the 64 rows, which vectorize.
@@ -159,142 +171,122 @@ VOLMORPH_ALWAYS_INLINE inline void rowAffine(double a, double b, double c, float
     for (int r = 0; r < 64; ++r) out[r] = float(a + b * kRows.i[r] + c * kRows.j[r]);
 }
 
-/// Adds one near pair's weight and weighted residuals at every voxel of the leaf at o. rs and rt
-/// are the residuals R = A - B at o; their steps along the axes are the columns of M_A - M_B.
-/// Everything affine in the voxel (frame coordinates, residuals) is stepped once per row of 8
-/// voxels along z; the row's 8 voxels are one vectorized body.
-template <FeatureType T, bool InverseSquare>
-VOLMORPH_ALWAYS_INLINE inline void addNearPair(LeafSums& sums, const Feature& e, const Vec3d& o, double offset, double exponent, double scale,
-                 const Vec3d& rs, const Vec3d drs[3], const Vec3d& rt, const Vec3d drt[3])
-{
-    const Vec3d q0 = e.frameCoordinates(o);
-    // Steps of the frame coordinates along x, y and z: the frame's rows.
-    const Vec3d dx(e.x.x(), e.y.x(), e.z.x()), dy(e.x.y(), e.y.y(), e.z.y());
-    const Vec3f dz(Vec3d(e.x.z(), e.y.z(), e.z.z()));
-    const float hx = float(0.5 * e.scale.x()), hy = float(0.5 * e.scale.y()), hz = float(0.5 * e.scale.z());
-    const float off = float(offset);
-    const float* K = kZ;
-    float zs[3], zt[3];
-    for (int c = 0; c < 3; ++c) {
-        zs[c] = float(drs[2][c]);
-        zt[c] = float(drt[2][c]);
-    }
-    // Each row's first voxel: frame coordinates and residuals.
-    alignas(64) float row[9][64];
-    for (int c = 0; c < 3; ++c) {
-        rowAffine(q0[c], dx[c], dy[c], row[c]);
-        rowAffine(rs[c], drs[0][c], drs[1][c], row[3 + c]);
-        rowAffine(rt[c], drt[0][c], drt[1][c], row[6 + c]);
-    }
-    for (int rw = 0; rw < 64; ++rw) {
-        const Vec3f q(row[0][rw], row[1][rw], row[2][rw]);
-        const Vec3f r0(row[3][rw], row[4][rw], row[5][rw]), u0(row[6][rw], row[7][rw], row[8][rw]);
-        const int n0 = rw * 8;
-        float* __restrict sw = sums.v[0] + n0;
-        float* __restrict s0 = sums.v[1] + n0;
-        float* __restrict s1 = sums.v[2] + n0;
-        float* __restrict s2 = sums.v[3] + n0;
-        float* __restrict t0 = sums.v[4] + n0;
-        float* __restrict t1 = sums.v[5] + n0;
-        float* __restrict t2 = sums.v[6] + n0;
-        for (int z = 0; z < 8; ++z) {
-            const float k = K[z];
-            const float r = off + frameDistance<T>(q.x() + k * dz.x(), q.y() + k * dz.y(), q.z() + k * dz.z(), hx, hy, hz);
-            float w;
-            if constexpr (InverseSquare) w = 1.0f / (r * r);
-            else w = float(scale * std::pow(double(r), -exponent));
-            sw[z] += w;
-            s0[z] += w * (r0.x() + k * zs[0]);
-            s1[z] += w * (r0.y() + k * zs[1]);
-            s2[z] += w * (r0.z() + k * zs[2]);
-            t0[z] += w * (u0.x() + k * zt[0]);
-            t1[z] += w * (u0.y() + k * zt[1]);
-            t2[z] += w * (u0.z() + k * zt[2]);
-        }
-    }
-}
-
-/// One near pair's share of a leaf: its element, weight scale and residuals (as addNearPair).
+/// One near pair's share of a leaf: its element, weight scale and residuals R = A - B at the
+/// leaf's origin, whose steps along the axes are the columns of M_A - M_B.
 struct NearTerm {
     const Feature* element;
     double scale;
     Vec3d rs, drs[3], rt, drt[3];
 };
 
+/// A near pair ready for the rows: its frame coordinates and residuals at each row's first voxel
+/// and their steps along the row.
+struct NearRows {
+    alignas(32) float start[9][64]; ///< frame coordinates q, source residual, target residual
+    float step[9];
+    float half[3];
+    float scale;
+};
+
 /// Everything that fills one leaf's points.
 struct LeafJob {
     Vec3d origin;
-    double far[7][8];               ///< the far sums at the leaf's corners, channels as LeafSums
-    std::vector<NearTerm> near;
-    InverseWarp::Affine bS, bT;     ///< the dominant pair's affine maps
+    double far[7][8];                  ///< the far sums at the leaf's corners (see fillLeafBody)
+    std::vector<NearTerm> near;        ///< grouped by type: Point, Segment, Rectangle, Box
+    size_t typeEnd[4];                 ///< where each type's near pairs end in `near`
+    std::vector<NearRows> rows;        ///< scratch, one per near pair
+    InverseWarp::Affine bS, bT;        ///< the dominant pair's affine maps
     double offset, exponent;
     bool inverseSquare;
 };
 
-template <FeatureType T>
-VOLMORPH_ALWAYS_INLINE inline void addNear(const LeafJob& job, const NearTerm& t, LeafSums& sums)
+/// Adds the near pairs of type T, [begin, end), at row r: weight into acc[0], weighted residuals
+/// into acc[1..6] (source x, y, z, target x, y, z).
+template <FeatureType T, bool InverseSquare>
+VOLMORPH_ALWAYS_INLINE inline void addNearRow(const LeafJob& job, size_t begin, size_t end, int r, v8f acc[7])
 {
-    if (job.inverseSquare)
-        addNearPair<T, true>(sums, *t.element, job.origin, job.offset, job.exponent, t.scale, t.rs, t.drs, t.rt, t.drt);
-    else
-        addNearPair<T, false>(sums, *t.element, job.origin, job.offset, job.exponent, t.scale, t.rs, t.drs, t.rt, t.drt);
+    const float off = float(job.offset);
+    for (size_t p = begin; p < end; ++p) {
+        const NearRows& n = job.rows[p];
+        const v8f qx = n.start[0][r] + kZ * n.step[0];
+        const v8f qy = n.start[1][r] + kZ * n.step[1];
+        const v8f qz = n.start[2][r] + kZ * n.step[2];
+        const v8f d = off + frameDistance<T>(qx, qy, qz, n.half[0], n.half[1], n.half[2]);
+        v8f w;
+        if constexpr (InverseSquare) {
+            w = 1.0f / (d * d);
+        } else {
+            for (int l = 0; l < 8; ++l) w[l] = float(double(n.scale) * std::pow(double(d[l]), -job.exponent));
+        }
+        acc[0] += w;
+        for (int c = 0; c < 6; ++c) acc[1 + c] += w * (n.start[3 + c][r] + kZ * n.step[3 + c]);
+    }
 }
 
-/// Far sums interpolated (bilinear at each row's ends, linear along the row), near pairs added,
-/// then p = B(x) + residual sum / weight sum, in single precision as the points are stored (its
-/// rounding, some 1e-5 voxel at hundreds of voxels from the origin, is far below a tolerance).
-VOLMORPH_ALWAYS_INLINE inline void fillLeafBody(const LeafJob& job, LeafSums& sums, WarpLeaf& leaf)
+/// Fills a leaf row by row: the far sums interpolated (bilinear at each row's first voxel, linear
+/// along the row), the near pairs added, then p = B(x) + residual sum / weight sum, all in single
+/// precision as the points are stored (its rounding, some 1e-5 voxel at hundreds of voxels from
+/// the origin, is far below a tolerance). Each row stays in registers from the sums to the point.
+template <bool InverseSquare>
+VOLMORPH_ALWAYS_INLINE inline void fillLeafBody(LeafJob& job, WarpLeaf& leaf)
 {
-    constexpr int Size = 8;
-    const double h = Size;
-    const float* K = kZ;
+    // The far sums at each row's first voxel and their step along it, channels as acc below:
+    // bilinear in x (the row's i) in double, then in y (lanes j) in single precision.
+    alignas(32) float farStart[7][64], farStep[7][64];
+    const v8f J = kZ * 0.125f;
     for (int c = 0; c < 7; ++c) {
         const double* v = job.far[c];
-        // Bilinear at each row's ends (z = 0 and z = h), then linear along the row.
-        alignas(64) float base[64], step[64];
-        for (int r = 0; r < 64; ++r) {
-            const double fx = kRows.i[r] / h, fy = kRows.j[r] / h;
-            const double a0 = v[0] + fx * (v[1] - v[0]), c0 = v[2] + fx * (v[3] - v[2]);
-            const double a1 = v[4] + fx * (v[5] - v[4]), c1 = v[6] + fx * (v[7] - v[6]);
-            const double z0 = a0 + fy * (c0 - a0), z1 = a1 + fy * (c1 - a1);
-            base[r] = float(z0);
-            step[r] = float((z1 - z0) / h);
-        }
-        for (int r = 0; r < 64; ++r) {
-            float* __restrict out = sums.v[c] + r * Size;
-            for (int z = 0; z < Size; ++z) out[z] = base[r] + K[z] * step[r];
+        for (int i = 0; i < 8; ++i) {
+            const double fx = i / 8.0;
+            const float a0 = float(v[0] + fx * (v[1] - v[0])), c0 = float(v[2] + fx * (v[3] - v[2]));
+            const float a1 = float(v[4] + fx * (v[5] - v[4])), c1 = float(v[6] + fx * (v[7] - v[6]));
+            const v8f z0 = a0 + J * (c0 - a0), z1 = a1 + J * (c1 - a1);
+            store(farStart[c] + 8 * i, z0);
+            store(farStep[c] + 8 * i, (z1 - z0) * 0.125f);
         }
     }
-
-    for (const NearTerm& t : job.near) {
-        switch (t.element->type) {
-        case FeatureType::Point: addNear<FeatureType::Point>(job, t, sums); break;
-        case FeatureType::Segment: addNear<FeatureType::Segment>(job, t, sums); break;
-        case FeatureType::Rectangle: addNear<FeatureType::Rectangle>(job, t, sums); break;
-        case FeatureType::Box: addNear<FeatureType::Box>(job, t, sums); break;
+    // The near pairs' frame coordinates and residuals at each row's first voxel.
+    job.rows.resize(job.near.size());
+    for (size_t p = 0; p < job.near.size(); ++p) {
+        const NearTerm& t = job.near[p];
+        const Feature& e = *t.element;
+        NearRows& n = job.rows[p];
+        const Vec3d q0 = e.frameCoordinates(job.origin);
+        // Steps of the frame coordinates along x, y and z: the frame's rows.
+        const Vec3d dx(e.x.x(), e.y.x(), e.z.x()), dy(e.x.y(), e.y.y(), e.z.y()), dz(e.x.z(), e.y.z(), e.z.z());
+        for (int c = 0; c < 3; ++c) {
+            rowAffine(q0[c], dx[c], dy[c], n.start[c]);
+            rowAffine(t.rs[c], t.drs[0][c], t.drs[1][c], n.start[3 + c]);
+            rowAffine(t.rt[c], t.drt[0][c], t.drt[1][c], n.start[6 + c]);
+            n.step[c] = float(dz[c]);
+            n.step[3 + c] = float(t.drs[2][c]);
+            n.step[6 + c] = float(t.drt[2][c]);
+            n.half[c] = float(0.5 * e.scale[c]);
         }
+        n.scale = float(t.scale);
     }
-
+    // B at each row's first voxel, each side.
+    alignas(32) float bStart[6][64];
+    float bStep[6];
     const Vec3d bs0 = job.bS.apply(job.origin), bt0 = job.bT.apply(job.origin);
-    alignas(64) float inv[512]; // 1 / weight sum, once per voxel for all six channels
-    for (int m = 0; m < 512; ++m) inv[m] = 1.0f / sums.v[0][m];
     for (int c = 0; c < 3; ++c) {
-        const float sz = float(job.bS.col[2][c]), tz = float(job.bT.col[2][c]);
-        alignas(64) float bs[64], bt[64]; // B(x) at each row's first voxel
-        rowAffine(bs0[c], job.bS.col[0][c], job.bS.col[1][c], bs);
-        rowAffine(bt0[c], job.bT.col[0][c], job.bT.col[1][c], bt);
-        for (int r = 0; r < 64; ++r) {
-            const int n0 = r * Size;
-            const float s0 = bs[r], t0 = bt[r];
-            const float* __restrict iw = inv + n0;
-            const float* __restrict gs = sums.v[1 + c] + n0;
-            const float* __restrict gt = sums.v[4 + c] + n0;
-            float* __restrict os = leaf.s[c] + n0;
-            float* __restrict ot = leaf.t[c] + n0;
-            for (int z = 0; z < Size; ++z) {
-                os[z] = s0 + (K[z] * sz + gs[z] * iw[z]);
-                ot[z] = t0 + (K[z] * tz + gt[z] * iw[z]);
-            }
+        rowAffine(bs0[c], job.bS.col[0][c], job.bS.col[1][c], bStart[c]);
+        rowAffine(bt0[c], job.bT.col[0][c], job.bT.col[1][c], bStart[3 + c]);
+        bStep[c] = float(job.bS.col[2][c]);
+        bStep[3 + c] = float(job.bT.col[2][c]);
+    }
+
+    for (int r = 0; r < 64; ++r) {
+        v8f acc[7];
+        for (int c = 0; c < 7; ++c) acc[c] = farStart[c][r] + kZ * farStep[c][r];
+        addNearRow<FeatureType::Point, InverseSquare>(job, 0, job.typeEnd[0], r, acc);
+        addNearRow<FeatureType::Segment, InverseSquare>(job, job.typeEnd[0], job.typeEnd[1], r, acc);
+        addNearRow<FeatureType::Rectangle, InverseSquare>(job, job.typeEnd[1], job.typeEnd[2], r, acc);
+        addNearRow<FeatureType::Box, InverseSquare>(job, job.typeEnd[2], job.typeEnd[3], r, acc);
+        const v8f inv = 1.0f / acc[0];
+        for (int c = 0; c < 3; ++c) {
+            store(leaf.s[c] + 8 * r, bStart[c][r] + (kZ * bStep[c] + acc[1 + c] * inv));
+            store(leaf.t[c] + 8 * r, bStart[3 + c][r] + (kZ * bStep[3 + c] + acc[4 + c] * inv));
         }
     }
 }
@@ -374,23 +366,28 @@ bool touches(const Occupancy* occ, const Vec3d& lo, const Vec3d& hi, double marg
 // are bit-identical whatever the machine; the warp tests check it with useBaselineKernel.
 #if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__)
 #define VOLMORPH_HAVE_AVX2_KERNEL 1
-__attribute__((target("avx2"))) void fillLeafAvx2(const LeafJob& job, LeafSums& sums, WarpLeaf& leaf)
+__attribute__((target("avx2"))) void fillLeafAvx2(LeafJob& job, WarpLeaf& leaf)
 {
-    fillLeafBody(job, sums, leaf);
+    if (job.inverseSquare) fillLeafBody<true>(job, leaf);
+    else fillLeafBody<false>(job, leaf);
 }
 #endif
 
-void fillLeafBaseline(const LeafJob& job, LeafSums& sums, WarpLeaf& leaf) { fillLeafBody(job, sums, leaf); }
+void fillLeafBaseline(LeafJob& job, WarpLeaf& leaf)
+{
+    if (job.inverseSquare) fillLeafBody<true>(job, leaf);
+    else fillLeafBody<false>(job, leaf);
+}
 
 std::atomic<bool> gBaselineKernel{false};
 
-void fillLeaf(const LeafJob& job, LeafSums& sums, WarpLeaf& leaf)
+void fillLeaf(LeafJob& job, WarpLeaf& leaf)
 {
 #ifdef VOLMORPH_HAVE_AVX2_KERNEL
     static const bool avx2 = __builtin_cpu_supports("avx2");
-    if (avx2 && !gBaselineKernel.load(std::memory_order_relaxed)) return fillLeafAvx2(job, sums, leaf);
+    if (avx2 && !gBaselineKernel.load(std::memory_order_relaxed)) return fillLeafAvx2(job, leaf);
 #endif
-    fillLeafBaseline(job, sums, leaf);
+    fillLeafBaseline(job, leaf);
 }
 
 /// The smallest and largest of a leaf's 512 values, in 8 lanes (the loop vectorizes; a scalar
@@ -666,9 +663,9 @@ void AdaptiveWarp::fill(Context& ctx, const Coord& origin) const
     job.exponent = mWarp.weightExponent();
     job.inverseSquare = mWarp.weighting() == Weighting::InverseSquare;
     job.near.clear();
-    if (anyNear)
-        for (size_t p = 0; p < n; ++p) {
-            if (!ctx.isNear[p]) continue;
+    for (int type = 0; type < 4; ++type) {
+        for (size_t p = 0; anyNear && p < n; ++p) {
+            if (!ctx.isNear[p] || int(mWarp.interpolated(p).type) != type) continue;
             NearTerm t;
             t.element = &mWarp.interpolated(p);
             t.scale = mWarp.weightScale(p);
@@ -680,7 +677,9 @@ void AdaptiveWarp::fill(Context& ctx, const Coord& origin) const
             }
             job.near.push_back(t);
         }
-    fillLeaf(job, *ctx.sums, ctx.leaf);
+        job.typeEnd[type] = job.near.size();
+    }
+    fillLeaf(job, ctx.leaf);
 }
 
 void AdaptiveWarp::leaf(Context& ctx, const Lattice& lattice, const Coord& origin) const
