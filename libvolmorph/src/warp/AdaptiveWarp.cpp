@@ -32,10 +32,21 @@ constexpr double kTinyRadius = 1e-6;
 
 struct LeafJob;
 
-/// Everything the error bound needs of one pair over a cube.
+/// Everything the error bound needs of each pair over a cube, one column per quantity.
 struct PairBounds {
-    double dMin, wMax, wMin, w1, w2; ///< d and w over the leaf, |grad w|, |Hess w| bounds
-    bool constant;                   ///< a box containing the whole leaf: d = 0, w constant
+    std::vector<double> dc, dMin, rMin, rMax; ///< d at the centre, smallest d; offset + d, smallest and largest
+    std::vector<double> wMax, wMin, wc;       ///< w over the cube and at its centre
+    std::vector<double> w1, w2;               ///< |grad w| and |Hess w| bounds
+    std::vector<double> constant;             ///< 1: a box containing the whole cube (d = 0, w constant)
+    std::vector<double> resid;                ///< |R_i| over the cube, the larger side
+    std::vector<double> rs[3], rt[3];         ///< R_i at the centre, each side
+    std::vector<double> term, hess;           ///< the pair's share of the bound and of the Hessian sum
+    void resize(size_t n)
+    {
+        for (auto* v : {&dc, &dMin, &rMin, &rMax, &wMax, &wMin, &wc, &w1, &w2, &constant, &resid, &rs[0], &rs[1], &rs[2],
+                        &rt[0], &rt[1], &rt[2], &term, &hess})
+            v->resize(n);
+    }
 };
 
 } // namespace
@@ -60,6 +71,19 @@ struct AdaptiveWarp::Lattice {
     }
 };
 
+/// The pairs, one column per quantity, padded to a multiple of 4 (the loops of analyze() take
+/// 4 pairs at a time; padding lanes compute harmless values that are never read).
+struct AdaptiveWarp::Columns {
+    size_t padded = 0;
+    std::vector<double> origin[3];  ///< the element's origin, index axes
+    std::vector<double> axis[3][3]; ///< [k][a]: component a of the frame's axis k
+    std::vector<double> half[3];    ///< half the scale along axis k, 0 where the type does not extend
+    std::vector<double> reach[3];   ///< half the extent along axis k of a unit axis-aligned cube
+    std::vector<double> box;        ///< 1 for boxes
+    std::vector<double> affine[2][4][3]; ///< [side][column][a]: the affine maps (column 3: offset)
+    std::vector<double> slope;      ///< [j * padded + i]: |M_i - M_j|, the larger side
+};
+
 struct AdaptiveWarp::Context {
     const Occupancy* source;
     const Occupancy* target;
@@ -69,9 +93,8 @@ struct AdaptiveWarp::Context {
     uint64_t evaluations = 0, near = 0, leaves = 0;
     // Per pair, per leaf (scratch).
     std::unique_ptr<LeafJob> job = std::make_unique<LeafJob>();
-    std::vector<PairBounds> bounds;
-    std::vector<double> resid, slope, term, hessW, suffixTerm, suffixHess;
-    std::vector<Vec3d> residS, residT; ///< R_i at the cube's centre, each side
+    PairBounds bounds;
+    std::vector<double> suffixTerm, suffixHess;
     std::vector<int> order;
     std::vector<char> isNear;
     // What analyze() found of the last cell.
@@ -89,20 +112,6 @@ double linearDistance(const InverseWarp::Affine& a, const InverseWarp::Affine& b
 {
     return std::sqrt((a.col[0] - b.col[0]).lengthSqr() + (a.col[1] - b.col[1]).lengthSqr() +
                      (a.col[2] - b.col[2]).lengthSqr());
-}
-
-/// True when the box element contains the axis-aligned cube of side `size` centred at `centre`:
-/// in the box's frame, the cube's extent along axis a is size/2 (|a_x| + |a_y| + |a_z|).
-bool boxContains(const Feature& e, const Vec3d& centre, double size)
-{
-    const Vec3d q = e.frameCoordinates(centre);
-    const Vec3d* axes[3] = {&e.x, &e.y, &e.z};
-    for (int k = 0; k < 3; ++k) {
-        const Vec3d& a = *axes[k];
-        const double reach = 0.5 * size * (std::abs(a.x()) + std::abs(a.y()) + std::abs(a.z()));
-        if (std::abs(q[k]) + reach > 0.5 * e.scale[k]) return false;
-    }
-    return true;
 }
 
 #if defined(__GNUC__) && !defined(__clang__)
@@ -293,6 +302,8 @@ VOLMORPH_ALWAYS_INLINE inline void fillLeafBody(LeafJob& job, WarpLeaf& leaf)
 
 } // namespace
 
+AdaptiveWarp::~AdaptiveWarp() = default;
+
 AdaptiveWarp::AdaptiveWarp(const InverseWarp& warp, double toleranceVoxels)
     : mWarp(warp), mTolerance(toleranceVoxels)
 {
@@ -301,10 +312,36 @@ AdaptiveWarp::AdaptiveWarp(const InverseWarp& warp, double toleranceVoxels)
         mSource.push_back(warp.sourceAffine(i));
         mTarget.push_back(warp.targetAffine(i));
     }
-    mSlope.resize(n * n);
-    for (size_t i = 0; i < n; ++i)
-        for (size_t j = 0; j < n; ++j)
-            mSlope[i * n + j] = std::max(linearDistance(mSource[i], mSource[j]), linearDistance(mTarget[i], mTarget[j]));
+    auto columns = std::make_unique<Columns>();
+    Columns& c = *columns;
+    const size_t padded = c.padded = (n + 3) / 4 * 4;
+    for (size_t i = 0; i < padded; ++i) {
+        // Padding: a point at the origin with identity maps.
+        const Feature e = i < n ? warp.interpolated(i) : Feature();
+        InverseWarp::Affine zero;
+        zero.col[0] = zero.col[1] = zero.col[2] = zero.offset = Vec3d(0.0);
+        const InverseWarp::Affine maps[2] = {i < n ? mSource[i] : zero, i < n ? mTarget[i] : zero};
+        const int extent = e.type == FeatureType::Point ? 0 : e.type == FeatureType::Segment ? 1 : e.type == FeatureType::Rectangle ? 2 : 3;
+        const Vec3d* axes[3] = {&e.x, &e.y, &e.z};
+        for (int k = 0; k < 3; ++k) {
+            c.origin[k].push_back(e.origin[k]);
+            for (int a = 0; a < 3; ++a) c.axis[k][a].push_back((*axes[k])[a]);
+            c.half[k].push_back(k < extent ? 0.5 * e.scale[k] : 0.0);
+            const Vec3d& ax = *axes[k];
+            c.reach[k].push_back(0.5 * (std::abs(ax.x()) + std::abs(ax.y()) + std::abs(ax.z())));
+        }
+        c.box.push_back(e.type == FeatureType::Box ? 1.0 : 0.0);
+        for (int side = 0; side < 2; ++side)
+            for (int a = 0; a < 3; ++a) {
+                for (int k = 0; k < 3; ++k) c.affine[side][k][a].push_back(maps[side].col[k][a]);
+                c.affine[side][3][a].push_back(maps[side].offset[a]);
+            }
+    }
+    c.slope.assign(n * padded, 0.0);
+    for (size_t j = 0; j < n; ++j)
+        for (size_t i = 0; i < n; ++i)
+            c.slope[j * padded + i] = std::max(linearDistance(mSource[i], mSource[j]), linearDistance(mTarget[i], mTarget[j]));
+    mColumns = std::move(columns);
 }
 
 void AdaptiveWarp::identityLeaf(Context& ctx) const
@@ -381,11 +418,21 @@ void fillLeafBaseline(LeafJob& job, WarpLeaf& leaf)
 
 std::atomic<bool> gBaselineKernel{false};
 
-void fillLeaf(LeafJob& job, WarpLeaf& leaf)
+/// True where the AVX2 builds of the kernels run.
+bool avx2Kernel()
 {
 #ifdef VOLMORPH_HAVE_AVX2_KERNEL
     static const bool avx2 = __builtin_cpu_supports("avx2");
-    if (avx2 && !gBaselineKernel.load(std::memory_order_relaxed)) return fillLeafAvx2(job, leaf);
+    return avx2 && !gBaselineKernel.load(std::memory_order_relaxed);
+#else
+    return false;
+#endif
+}
+
+void fillLeaf(LeafJob& job, WarpLeaf& leaf)
+{
+#ifdef VOLMORPH_HAVE_AVX2_KERNEL
+    if (avx2Kernel()) return fillLeafAvx2(job, leaf);
 #endif
     fillLeafBaseline(job, leaf);
 }
@@ -409,110 +456,186 @@ void channelRange(const float* v, float& lo, float& hi)
 
 void useBaselineKernel(bool baseline) { gBaselineKernel = baseline; }
 
-void AdaptiveWarp::analyze(Context& ctx, const LatticePoint* const corners[8], const Coord& origin, int size) const
+namespace {
+
+// The bound's per-pair loops take 4 pairs at a time in double precision (one AVX register, or
+// two SSE ones in the baseline build; the same IEEE operations per lane in both).
+typedef double v4d __attribute__((vector_size(32), __may_alias__));
+typedef long long v4l __attribute__((vector_size(32), __may_alias__));
+
+// std::vector's storage is only 16-byte aligned: unaligned loads and stores.
+VOLMORPH_ALWAYS_INLINE inline v4d load4(const double* p)
+{
+    v4d v;
+    __builtin_memcpy(&v, p, sizeof v);
+    return v;
+}
+VOLMORPH_ALWAYS_INLINE inline void store4(double* p, v4d v) { __builtin_memcpy(p, &v, sizeof v); }
+VOLMORPH_ALWAYS_INLINE inline v4d vabs(v4d v)
+{
+    return reinterpret_cast<v4d>(reinterpret_cast<v4l>(v) & 0x7fffffffffffffffLL);
+}
+VOLMORPH_ALWAYS_INLINE inline v4d vsqrt(v4d v)
+{
+    v4d r;
+    for (int l = 0; l < 4; ++l) r[l] = __builtin_sqrt(v[l]);
+    return r;
+}
+VOLMORPH_ALWAYS_INLINE inline v4d vmax(v4d a, v4d b) { return a > b ? a : b; }
+VOLMORPH_ALWAYS_INLINE inline v4d vmin(v4d a, v4d b) { return a < b ? a : b; }
+VOLMORPH_ALWAYS_INLINE inline v4d splat(double v) { return v4d{v, v, v, v}; }
+
+} // namespace
+
+/// The bound's terms of every pair over the cube [o, o + size]^3 (a leaf: its voxels and its far
+/// corners), into ctx; see the header for the derivation.
+VOLMORPH_ALWAYS_INLINE inline void AdaptiveWarp::analyzeBody(Context& ctx, const LatticePoint* const corners[8], const Coord& origin, int size) const
 {
     const size_t n = mWarp.pairCount();
+    const Columns& col = *mColumns;
+    const size_t padded = col.padded;
     ctx.cornersOk = true;
     for (int k = 0; k < 8; ++k) {
         ctx.corner[k] = corners[k];
         ctx.cornersOk = ctx.cornersOk && corners[k]->ok;
     }
-
-    // Each pair over the cube [o, o + size]^3 (a leaf: its voxels and its far corners).
     const Vec3d o = origin.asVec3d();
     const double h = size, halfDiagonal = 0.5 * h * std::sqrt(3.0);
     const Vec3d centre = o + Vec3d(0.5 * h);
     const double offset = mWarp.weightOffset(), b = mWarp.weightExponent();
-    std::vector<PairBounds>& pb = ctx.bounds;
-    pb.resize(n);
+    const bool inverseSquare = mWarp.weighting() == Weighting::InverseSquare;
+    PairBounds& pb = ctx.bounds;
+    pb.resize(padded);
+    const v4d zero = splat(0.0), one = splat(1.0), half = splat(0.5), infinity = splat(std::numeric_limits<double>::infinity());
+
+    // Per pair: frame coordinates q of the centre, the distance dc = |max(|q| - half, 0)| (half 0
+    // on the axes a type does not extend along), its gradient g in index axes, the smallest
+    // distance over the cube, and whether a box contains the whole cube (d = 0, w constant).
+    for (size_t i = 0; i < padded; i += 4) {
+        const v4d p[3] = {centre.x() - load4(&col.origin[0][i]), centre.y() - load4(&col.origin[1][i]),
+                          centre.z() - load4(&col.origin[2][i])};
+        v4d q[3], v[3], out2 = zero;
+        v4l inside = load4(&col.box[i]) != zero;
+        for (int k = 0; k < 3; ++k) {
+            q[k] = load4(&col.axis[k][0][i]) * p[0] + load4(&col.axis[k][1][i]) * p[1] + load4(&col.axis[k][2][i]) * p[2];
+            const v4d a = vabs(q[k]) - load4(&col.half[k][i]);
+            const v4d outside = half * (a + vabs(a));
+            out2 += outside * outside;
+            v[k] = q[k] < zero ? -outside : outside;
+            inside &= vabs(q[k]) + h * load4(&col.reach[k][i]) <= load4(&col.half[k][i]);
+        }
+        const v4d d = vsqrt(out2);
+        const v4l positive = d > zero;
+        const v4d inv = positive ? one / d : zero;
+        v4d gL1 = zero, g[3];
+        for (int a = 0; a < 3; ++a) {
+            g[a] = (load4(&col.axis[0][a][i]) * v[0] + load4(&col.axis[1][a][i]) * v[1] + load4(&col.axis[2][a][i]) * v[2]) * inv;
+            gL1 += vabs(g[a]);
+        }
+        // d is convex (the distance to a convex set), so it lies above its tangent plane at the
+        // centre: over the cube, d >= dc - h/2 |g|_1.
+        const v4d dMin = positive ? vmax(zero, d - (0.5 * h) * gL1) : zero;
+        const v4d rMin = offset + dMin, rMax = offset + (inside ? zero : d + halfDiagonal);
+        store4(&pb.dc[i], d);
+        store4(&pb.dMin[i], dMin);
+        store4(&pb.rMin[i], rMin);
+        store4(&pb.rMax[i], rMax);
+        store4(&pb.constant[i], inside ? one : zero);
+        // Weights at the smallest and largest distance and at the centre.
+        v4d wMax, wMin, wc;
+        if (inverseSquare) {
+            const v4d r0 = vmax(dMin, splat(kTinyRadius - offset)) + offset, r2 = d + offset;
+            wMax = one / (r0 * r0);
+            wMin = one / (rMax * rMax);
+            wc = one / (r2 * r2);
+        } else {
+            for (int l = 0; l < 4; ++l) {
+                const size_t j = std::min(i + l, n - 1); // padding lanes: any pair's values
+                wMax[l] = mWarp.weightAt(j, std::max(dMin[l], kTinyRadius - offset));
+                wMin[l] = mWarp.weightAt(j, rMax[l] - offset);
+                wc[l] = mWarp.weightAt(j, d[l]);
+            }
+        }
+        store4(&pb.wMax[i], wMax);
+        store4(&pb.wMin[i], wMin);
+        store4(&pb.wc[i], wc);
+        // |grad w| and |Hess w| over the cube. Per axis a: |w_a| <= b w / r |d_a| and
+        // |w_aa| <= w (b (b + 1) / r^2 (d_a)^2 + b / r |d_aa|). grad d is the unit vector from
+        // the element's nearest point; over the cube it turns by at most |Hess d| halfDiagonal <=
+        // halfDiagonal / dMin, so sup |d_a| <= |g_a| + turn; and sum_a |d_aa| <= 3 / dMin.
+        // w1 bounds sqrt(sum_a sup (w_a)^2), w2 bounds sum_a sup |w_aa|; where the cube touches
+        // the element (dMin = 0) there is a kink: w2 is infinite.
+        const v4l apart = dMin > zero;
+        const v4d dm = apart ? dMin : one;
+        const v4d turn = vmin(one, halfDiagonal / dm);
+        v4d axial = zero;
+        for (int a = 0; a < 3; ++a) {
+            const v4d ga = vmin(one, vabs(g[a]) + turn);
+            axial += ga * ga;
+        }
+        const v4d slopeBound = b * wMax / rMin;
+        const v4d first = apart ? slopeBound * vsqrt(axial) : slopeBound;
+        const v4d second = apart ? wMax * ((b * (b + 1.0)) / (rMin * rMin) * axial + (3.0 * b) / (rMin * dm)) : infinity;
+        store4(&pb.w1[i], inside ? zero : first);
+        store4(&pb.w2[i], inside ? zero : second);
+    }
     double& wMinSum = ctx.wMinSum;
-    double wCentreMax = -1.0;
     size_t& dominant = ctx.dominant;
     bool& tiny = ctx.tiny;
     wMinSum = 0.0;
     dominant = 0;
     tiny = false;
+    double wCentreMax = -1.0;
     for (size_t i = 0; i < n; ++i) {
-        const Feature& e = mWarp.interpolated(i);
-        const Vec3d q = e.frameCoordinates(centre);
-        const double dc = e.distanceInFrame(q);
-        PairBounds& p = pb[i];
-        p.constant = e.type == FeatureType::Box && dc == 0.0 && boxContains(e, centre, h);
-        // d is convex (the distance to a convex set), so it lies above its tangent plane at the
-        // centre: over the cube, d >= dc - h/2 |g|_1, g = grad d at the centre.
-        const Vec3d g = dc > 0.0 ? e.gradientInFrame(q, dc) : Vec3d(0.0);
-        const double gL1 = std::abs(g.x()) + std::abs(g.y()) + std::abs(g.z());
-        p.dMin = dc > 0.0 ? std::max(0.0, dc - 0.5 * h * gL1) : 0.0;
-        const double rMin = offset + p.dMin, rMax = offset + (p.constant ? 0.0 : dc + halfDiagonal);
-        if (rMin < kTinyRadius) tiny = true;
-        p.wMax = mWarp.weightAt(i, std::max(p.dMin, kTinyRadius - offset));
-        p.wMin = mWarp.weightAt(i, rMax - offset);
-        wMinSum += p.wMin;
-        if (p.constant) {
-            p.w1 = p.w2 = 0.0;
-        } else if (p.dMin > 0.0) {
-            // Per axis a: |w_a| <= b w / r |d_a| and |w_aa| <= w (b (b + 1) / r^2 (d_a)^2 +
-            // b / r |d_aa|). grad d is the unit vector from the element's nearest point; over the
-            // leaf it turns by at most |Hess d| halfDiagonal <= halfDiagonal / dMin, so
-            // sup |d_a| <= |g_a| + turn; and sum_a |d_aa| <= 3 / dMin.
-            // w1 bounds sqrt(sum_a sup (w_a)^2), w2 bounds sum_a sup |w_aa|.
-            const double turn = std::min(1.0, halfDiagonal / p.dMin);
-            double axial = 0.0;
-            for (int a = 0; a < 3; ++a) {
-                const double ga = std::min(1.0, std::abs(g[a]) + turn);
-                axial += ga * ga;
-            }
-            p.w1 = b * p.wMax / rMin * std::sqrt(axial);
-            p.w2 = p.wMax * (b * (b + 1.0) / (rMin * rMin) * axial + 3.0 * b / (rMin * p.dMin));
-        } else {
-            p.w1 = b * p.wMax / rMin;
-            p.w2 = std::numeric_limits<double>::infinity(); // the leaf touches the element: a kink
-        }
-        const double wc = mWarp.weightAt(i, dc);
-        if (wc > wCentreMax) {
-            wCentreMax = wc;
+        wMinSum += pb.wMin[i];
+        tiny = tiny || pb.rMin[i] < kTinyRadius;
+        if (pb.wc[i] > wCentreMax) {
+            wCentreMax = pb.wc[i];
             dominant = i;
         }
     }
     const InverseWarp::Affine& bS = mSource[dominant];
     const InverseWarp::Affine& bT = mTarget[dominant];
+    const double* slope = &col.slope[dominant * padded];
 
-    // |R_i| over the leaf on either side, |M_i - M_B|, and |rho| = |p - B| <= sum w_i |R_i| / W.
-    std::vector<double>& resid = ctx.resid;
-    std::vector<double>& slope = ctx.slope;
-    resid.resize(n);
-    slope.resize(n);
+    // R_i = A_i - B at the centre, |R_i| over the cube on either side (|M_i - M_B| the slope),
+    // and |rho| = |p - B| <= sum w_i |R_i| / W.
+    const Vec3d bc[2] = {bS.apply(centre), bT.apply(centre)};
+    for (size_t i = 0; i < padded; i += 4) {
+        v4d length2[2];
+        for (int side = 0; side < 2; ++side) {
+            const auto& m = col.affine[side];
+            length2[side] = zero;
+            for (int a = 0; a < 3; ++a) {
+                const v4d r = load4(&m[0][a][i]) * centre.x() + load4(&m[1][a][i]) * centre.y() +
+                              load4(&m[2][a][i]) * centre.z() + load4(&m[3][a][i]) - bc[side][a];
+                store4(side == 0 ? &pb.rs[a][i] : &pb.rt[a][i], r);
+                length2[side] += r * r;
+            }
+        }
+        store4(&pb.resid[i], vsqrt(vmax(length2[0], length2[1])) + load4(&slope[i]) * halfDiagonal);
+    }
     double rhoSum = 0.0, residMax = 0.0;
-    const Vec3d bsc = bS.apply(centre), btc = bT.apply(centre);
-    ctx.residS.resize(n);
-    ctx.residT.resize(n);
     for (size_t i = 0; i < n; ++i) {
-        slope[i] = mSlope[dominant * n + i];
-        ctx.residS[i] = mSource[i].apply(centre) - bsc;
-        ctx.residT[i] = mTarget[i].apply(centre) - btc;
-        resid[i] = std::sqrt(std::max(ctx.residS[i].lengthSqr(), ctx.residT[i].lengthSqr())) + slope[i] * halfDiagonal;
-        rhoSum += pb[i].wMax * resid[i];
-        residMax = std::max(residMax, resid[i]);
+        rhoSum += pb.wMax[i] * pb.resid[i];
+        residMax = std::max(residMax, pb.resid[i]);
     }
     const double rhoMax = ctx.rhoMax = std::min(residMax, rhoSum / wMinSum);
 
     // Each far pair's share of the bound; one pair is its own affine map (R = 0, rho = 0).
     const double k = kBoundScale * h * h / 8.0;
-    ctx.term.assign(n, 0.0);
-    ctx.hessW.assign(n, 0.0);
-    ctx.order.resize(n);
-    ctx.isNear.assign(n, 0);
-    for (size_t i = 0; i < n; ++i) {
-        ctx.order[i] = int(i);
-        if (n == 1 || pb[i].constant) continue;
-        ctx.hessW[i] = k * pb[i].w2;
-        ctx.term[i] = std::isfinite(pb[i].w2) ? k * ((resid[i] + rhoMax) * pb[i].w2 + 2.0 * slope[i] * pb[i].w1)
-                                              : std::numeric_limits<double>::infinity();
+    const v4d none = n == 1 ? one : zero;
+    for (size_t i = 0; i < padded; i += 4) {
+        const v4d w1 = load4(&pb.w1[i]), w2 = load4(&pb.w2[i]);
+        const v4l skip = (load4(&pb.constant[i]) != zero) | (none != zero);
+        const v4d term = k * ((load4(&pb.resid[i]) + rhoMax) * w2 + 2.0 * load4(&slope[i]) * w1);
+        store4(&pb.hess[i], skip ? zero : k * w2);
+        store4(&pb.term[i], skip ? zero : w2 == infinity ? infinity : term);
     }
     double terms = 0.0, hess = 0.0;
     for (size_t i = 0; i < n; ++i) {
-        terms += ctx.term[i];
-        hess += ctx.hessW[i];
+        terms += pb.term[i];
+        hess += pb.hess[i];
     }
     ctx.boundAllFar = bound(ctx, terms, hess);
 
@@ -544,17 +667,38 @@ void AdaptiveWarp::analyze(Context& ctx, const LatticePoint* const corners[8], c
     }
     if (!std::isfinite(ctx.boundAllFar) || n == 1) return;
     const Vec3d* mid = ctx.rhoMid;
-    terms = 0.0;
-    for (size_t i = 0; i < n; ++i) {
-        if (std::isfinite(ctx.term[i]) && !pb[i].constant) {
-            const double apart = std::max((ctx.residS[i] - mid[0]).length() + radius[0],
-                                          (ctx.residT[i] - mid[1]).length() + radius[1]) +
-                                 slope[i] * halfDiagonal + ctx.boundAllFar;
-            if (apart < resid[i] + rhoMax) ctx.term[i] = k * (apart * pb[i].w2 + 2.0 * slope[i] * pb[i].w1);
+    const double boundAllFar = ctx.boundAllFar;
+    for (size_t i = 0; i < padded; i += 4) {
+        v4d length2[2] = {zero, zero};
+        for (int a = 0; a < 3; ++a) {
+            const v4d ds = load4(&pb.rs[a][i]) - mid[0][a], dt = load4(&pb.rt[a][i]) - mid[1][a];
+            length2[0] += ds * ds;
+            length2[1] += dt * dt;
         }
-        terms += ctx.term[i];
+        const v4d w1 = load4(&pb.w1[i]), w2 = load4(&pb.w2[i]), term = load4(&pb.term[i]);
+        const v4d apart = vmax(vsqrt(length2[0]) + radius[0], vsqrt(length2[1]) + radius[1]) +
+                          load4(&slope[i]) * halfDiagonal + boundAllFar;
+        const v4l tighter = (term != infinity) & (load4(&pb.constant[i]) == zero) & (apart < load4(&pb.resid[i]) + rhoMax);
+        store4(&pb.term[i], tighter ? k * (apart * w2 + 2.0 * load4(&slope[i]) * w1) : term);
     }
+    terms = 0.0;
+    for (size_t i = 0; i < n; ++i) terms += pb.term[i];
     ctx.boundAllFar = std::min(ctx.boundAllFar, bound(ctx, terms, hess));
+}
+
+#ifdef VOLMORPH_HAVE_AVX2_KERNEL
+__attribute__((target("avx2"))) void AdaptiveWarp::analyzeAvx2(Context& ctx, const LatticePoint* const corners[8], const Coord& origin, int size) const
+{
+    analyzeBody(ctx, corners, origin, size);
+}
+#endif
+
+void AdaptiveWarp::analyze(Context& ctx, const LatticePoint* const corners[8], const Coord& origin, int size) const
+{
+#ifdef VOLMORPH_HAVE_AVX2_KERNEL
+    if (avx2Kernel()) return analyzeAvx2(ctx, corners, origin, size);
+#endif
+    analyzeBody(ctx, corners, origin, size);
 }
 
 // The domain, before any voxel. With every pair far the interpolant is B + I[G] / I[W], and
@@ -602,14 +746,18 @@ double AdaptiveWarp::selectNear(Context& ctx, size_t& nearCount) const
     // Largest share first: the far set is a suffix of that order, so its sums are suffix sums;
     // the near set is the shortest prefix whose suffix is within the tolerance.
     const size_t n = mWarp.pairCount();
+    const std::vector<double>& term = ctx.bounds.term;
+    ctx.order.resize(n);
+    for (size_t i = 0; i < n; ++i) ctx.order[i] = int(i);
+    ctx.isNear.assign(n, 0);
     std::sort(ctx.order.begin(), ctx.order.end(), [&](int a, int c) {
-        return ctx.term[a] > ctx.term[c] || (ctx.term[a] == ctx.term[c] && a < c);
+        return term[a] > term[c] || (term[a] == term[c] && a < c);
     });
     ctx.suffixTerm.assign(n + 1, 0.0);
     ctx.suffixHess.assign(n + 1, 0.0);
     for (size_t j = n; j-- > 0;) {
-        ctx.suffixTerm[j] = ctx.suffixTerm[j + 1] + ctx.term[ctx.order[j]];
-        ctx.suffixHess[j] = ctx.suffixHess[j + 1] + ctx.hessW[ctx.order[j]];
+        ctx.suffixTerm[j] = ctx.suffixTerm[j + 1] + term[ctx.order[j]];
+        ctx.suffixHess[j] = ctx.suffixHess[j + 1] + ctx.bounds.hess[ctx.order[j]];
     }
     nearCount = 0;
     double b = ctx.boundAllFar;

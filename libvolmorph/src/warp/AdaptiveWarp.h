@@ -56,6 +56,7 @@
 #include <array>
 #include <atomic>
 #include <functional>
+#include <memory>
 #include <vector>
 
 namespace volmorph::detail {
@@ -94,6 +95,7 @@ public:
     /// `warp` must map output index space to source and target index space (built with unit
     /// 1 / voxel size). Tolerance 0 means exact: every voxel is evaluated.
     AdaptiveWarp(const InverseWarp& warp, double toleranceVoxels);
+    ~AdaptiveWarp();
 
     using LeafFunction = std::function<void(const WarpLeaf&)>;
     /// "Is any leaf of this cell (output index space) wanted?"; cells answered no are skipped
@@ -113,12 +115,16 @@ public:
     static constexpr int kTopCell = 64;
 
 private:
+    struct Columns;
     struct Context;
     struct LatticePoint;
     struct Lattice;
     /// The bound's terms for the cube of `size` (4, 8 or 16) voxels at origin, from the exact
     /// sums at its corners (bit 0: +x, bit 1: +y, bit 2: +z), into ctx.
     void analyze(Context& ctx, const LatticePoint* const corners[8], const openvdb::Coord& origin, int size) const;
+    /// analyze() in its two builds (AVX2 and the baseline; see the kernel).
+    void analyzeBody(Context& ctx, const LatticePoint* const corners[8], const openvdb::Coord& origin, int size) const;
+    void analyzeAvx2(Context& ctx, const LatticePoint* const corners[8], const openvdb::Coord& origin, int size) const;
     /// False when the analysed cube's image misses both sides' occupied blocks.
     bool mayTouch(Context& ctx, const openvdb::Coord& origin, int size) const;
     /// The error bound of the analysed cube from its far pairs' summed terms and Hessian bounds.
@@ -134,7 +140,7 @@ private:
     const InverseWarp& mWarp;
     double mTolerance;
     std::vector<InverseWarp::Affine> mSource, mTarget; ///< each pair's affine map on each side
-    std::vector<double> mSlope; ///< [i * n + j]: |M_i - M_j| (Frobenius), the larger side
+    std::unique_ptr<const Columns> mColumns; ///< the interpolated elements, by column
 };
 
 } // namespace volmorph::detail
