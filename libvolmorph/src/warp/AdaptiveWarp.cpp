@@ -138,6 +138,33 @@ VOLMORPH_ALWAYS_INLINE inline v8f vsqrt(v8f v)
     return r;
 }
 
+// The bound's per-pair loops take 4 pairs at a time in double precision (one AVX register, or
+// two SSE ones in the baseline build; the same IEEE operations per lane in both).
+typedef double v4d __attribute__((vector_size(32), __may_alias__));
+typedef long long v4l __attribute__((vector_size(32), __may_alias__));
+
+// std::vector's storage is only 16-byte aligned: unaligned loads and stores.
+VOLMORPH_ALWAYS_INLINE inline v4d load4(const double* p)
+{
+    v4d v;
+    __builtin_memcpy(&v, p, sizeof v);
+    return v;
+}
+VOLMORPH_ALWAYS_INLINE inline void store4(double* p, v4d v) { __builtin_memcpy(p, &v, sizeof v); }
+VOLMORPH_ALWAYS_INLINE inline v4d vabs(v4d v)
+{
+    return reinterpret_cast<v4d>(reinterpret_cast<v4l>(v) & 0x7fffffffffffffffLL);
+}
+VOLMORPH_ALWAYS_INLINE inline v4d vsqrt(v4d v)
+{
+    v4d r;
+    for (int l = 0; l < 4; ++l) r[l] = __builtin_sqrt(v[l]);
+    return r;
+}
+VOLMORPH_ALWAYS_INLINE inline v4d vmax(v4d a, v4d b) { return a > b ? a : b; }
+VOLMORPH_ALWAYS_INLINE inline v4d vmin(v4d a, v4d b) { return a < b ? a : b; }
+VOLMORPH_ALWAYS_INLINE inline v4d splat(double v) { return v4d{v, v, v, v}; }
+
 /// Distance in the element's frame at a row's 8 voxels, per type.
 template <FeatureType T>
 VOLMORPH_ALWAYS_INLINE inline v8f frameDistance(v8f qx, v8f qy, v8f qz, float hx, float hy, float hz)
@@ -160,24 +187,12 @@ VOLMORPH_ALWAYS_INLINE inline v8f frameDistance(v8f qx, v8f qy, v8f qz, float hx
     return vsqrt(a * a + b * b + c * c);
 }
 
-/// Each row's (i, j) in a leaf, row r = i * 8 + j, as doubles: the per-row set-ups (a value and
-/// a step for each row's 8 voxels) are loops over the 64 rows, which vectorize.
-struct RowOffsets {
-    double i[64], j[64];
-    RowOffsets()
-    {
-        for (int r = 0; r < 64; ++r) {
-            i[r] = r >> 3;
-            j[r] = r & 7;
-        }
-    }
-};
-const RowOffsets kRows;
-
-/// a + b i + c j at every row, in single precision (same operations as a + b * i + c * j).
+/// a + b i + c j at every row r = i * 8 + j of a leaf: a + b i in double, then the 8 rows of
+/// each i as one vector in single precision.
 VOLMORPH_ALWAYS_INLINE inline void rowAffine(double a, double b, double c, float out[64])
 {
-    for (int r = 0; r < 64; ++r) out[r] = float(a + b * kRows.i[r] + c * kRows.j[r]);
+    const v8f step = kZ * float(c);
+    for (int i = 0; i < 8; ++i) store(out + 8 * i, float(a + b * i) + step);
 }
 
 /// One near pair's share of a leaf: its element, weight scale and residuals R = A - B at the
@@ -185,6 +200,7 @@ VOLMORPH_ALWAYS_INLINE inline void rowAffine(double a, double b, double c, float
 struct NearTerm {
     const Feature* element;
     double scale;
+    double half[3]; ///< half the scales, 0 on the axes the type does not extend along
     Vec3d rs, drs[3], rt, drt[3];
 };
 
@@ -200,7 +216,9 @@ struct NearRows {
 /// Everything that fills one leaf's points.
 struct LeafJob {
     Vec3d origin;
-    double far[7][8];                  ///< the far sums at the leaf's corners (see fillLeafBody)
+    /// At the leaf's corners (bit 0: +x, bit 1: +y, bit 2: +z), channels as the kernel's sums:
+    /// the exact W, S - W B and T - W B, less the near pairs in fillLeafBody: the far sums.
+    double far[7][8];
     std::vector<NearTerm> near;        ///< grouped by type: Point, Segment, Rectangle, Box
     size_t typeEnd[4];                 ///< where each type's near pairs end in `near`
     std::vector<NearRows> rows;        ///< scratch, one per near pair
@@ -239,6 +257,42 @@ VOLMORPH_ALWAYS_INLINE inline void addNearRow(const LeafJob& job, size_t begin, 
 template <bool InverseSquare>
 VOLMORPH_ALWAYS_INLINE inline void fillLeafBody(LeafJob& job, WarpLeaf& leaf)
 {
+    // The far sums at the corners: the exact sums less each near pair's weight w and w R (R =
+    // A - B), in double, 4 corners at a time (z = 0, then z = 8).
+    const v4d cx = {0, 8, 0, 8}, cy = {0, 0, 8, 8};
+    for (const NearTerm& t : job.near) {
+        const Feature& e = *t.element;
+        const Vec3d q0 = e.frameCoordinates(job.origin);
+        const Vec3d* axes[3] = {&e.x, &e.y, &e.z};
+        for (int m = 0; m < 2; ++m) {
+            const double cz = 8.0 * m;
+            v4d out2 = splat(0.0);
+            for (int k = 0; k < 3; ++k) {
+                const Vec3d& a = *axes[k];
+                const v4d q = q0[k] + cx * a.x() + cy * a.y() + cz * a.z();
+                const v4d outside = vabs(q) - t.half[k];
+                const v4d d = 0.5 * (outside + vabs(outside));
+                out2 += d * d;
+            }
+            const v4d r = job.offset + vsqrt(out2);
+            v4d w;
+            if constexpr (InverseSquare) {
+                w = 1.0 / (r * r);
+            } else {
+                for (int l = 0; l < 4; ++l) w[l] = t.scale * std::pow(r[l], -job.exponent);
+            }
+            double* far0 = job.far[0] + 4 * m;
+            store4(far0, load4(far0) - w);
+            for (int c = 0; c < 3; ++c) {
+                const v4d rs = t.rs[c] + cx * t.drs[0][c] + cy * t.drs[1][c] + cz * t.drs[2][c];
+                const v4d rt = t.rt[c] + cx * t.drt[0][c] + cy * t.drt[1][c] + cz * t.drt[2][c];
+                double* fs = job.far[1 + c] + 4 * m;
+                double* ft = job.far[4 + c] + 4 * m;
+                store4(fs, load4(fs) - w * rs);
+                store4(ft, load4(ft) - w * rt);
+            }
+        }
+    }
     // The far sums at each row's first voxel and their step along it, channels as acc below:
     // bilinear in x (the row's i) in double, then in y (lanes j) in single precision.
     alignas(32) float farStart[7][64], farStep[7][64];
@@ -455,37 +509,6 @@ void channelRange(const float* v, float& lo, float& hi)
 } // namespace
 
 void useBaselineKernel(bool baseline) { gBaselineKernel = baseline; }
-
-namespace {
-
-// The bound's per-pair loops take 4 pairs at a time in double precision (one AVX register, or
-// two SSE ones in the baseline build; the same IEEE operations per lane in both).
-typedef double v4d __attribute__((vector_size(32), __may_alias__));
-typedef long long v4l __attribute__((vector_size(32), __may_alias__));
-
-// std::vector's storage is only 16-byte aligned: unaligned loads and stores.
-VOLMORPH_ALWAYS_INLINE inline v4d load4(const double* p)
-{
-    v4d v;
-    __builtin_memcpy(&v, p, sizeof v);
-    return v;
-}
-VOLMORPH_ALWAYS_INLINE inline void store4(double* p, v4d v) { __builtin_memcpy(p, &v, sizeof v); }
-VOLMORPH_ALWAYS_INLINE inline v4d vabs(v4d v)
-{
-    return reinterpret_cast<v4d>(reinterpret_cast<v4l>(v) & 0x7fffffffffffffffLL);
-}
-VOLMORPH_ALWAYS_INLINE inline v4d vsqrt(v4d v)
-{
-    v4d r;
-    for (int l = 0; l < 4; ++l) r[l] = __builtin_sqrt(v[l]);
-    return r;
-}
-VOLMORPH_ALWAYS_INLINE inline v4d vmax(v4d a, v4d b) { return a > b ? a : b; }
-VOLMORPH_ALWAYS_INLINE inline v4d vmin(v4d a, v4d b) { return a < b ? a : b; }
-VOLMORPH_ALWAYS_INLINE inline v4d splat(double v) { return v4d{v, v, v, v}; }
-
-} // namespace
 
 /// The bound's terms of every pair over the cube [o, o + size]^3 (a leaf: its voxels and its far
 /// corners), into ctx; see the header for the derivation.
@@ -778,31 +801,21 @@ void AdaptiveWarp::fill(Context& ctx, const Coord& origin) const
     const InverseWarp::Affine& bS = mSource[ctx.dominant];
     const InverseWarp::Affine& bT = mTarget[ctx.dominant];
 
-    // Far sums at the corners: W_F = W - sum_E w_i, G = N - sum_E w_i A_i - W_F B; channels as
-    // in LeafSums.
+    // The exact sums at the corners, as W, S - W B and T - W B; the kernel takes the near pairs
+    // off them (G = N - W B - sum_E w_i R_i, W_F = W - sum_E w_i).
     LeafJob& job = *ctx.job;
-    double (&far)[7][8] = job.far;
-    bool anyNear = false;
     for (int c = 0; c < 8; ++c) {
         const Vec3d x = o + Vec3d((c & 1) * h, ((c >> 1) & 1) * h, ((c >> 2) & 1) * h);
-        double w = ctx.corner[c]->w;
-        Vec3d s = ctx.corner[c]->s, t = ctx.corner[c]->t;
-        for (size_t i = 0; i < n; ++i) {
-            if (!ctx.isNear[i]) continue;
-            anyNear = true;
-            const double wi = mWarp.weightAt(i, mWarp.interpolated(i).distance(x));
-            w -= wi;
-            s -= wi * mSource[i].apply(x);
-            t -= wi * mTarget[i].apply(x);
-        }
-        s -= w * bS.apply(x);
-        t -= w * bT.apply(x);
-        far[0][c] = w;
+        const LatticePoint& p = *ctx.corner[c];
+        const Vec3d s = p.s - p.w * bS.apply(x), t = p.t - p.w * bT.apply(x);
+        job.far[0][c] = p.w;
         for (int k = 0; k < 3; ++k) {
-            far[1 + k][c] = s[k];
-            far[4 + k][c] = t[k];
+            job.far[1 + k][c] = s[k];
+            job.far[4 + k][c] = t[k];
         }
     }
+    bool anyNear = false;
+    for (size_t i = 0; i < n; ++i) anyNear = anyNear || ctx.isNear[i];
 
     job.origin = o;
     job.bS = bS;
@@ -817,6 +830,7 @@ void AdaptiveWarp::fill(Context& ctx, const Coord& origin) const
             NearTerm t;
             t.element = &mWarp.interpolated(p);
             t.scale = mWarp.weightScale(p);
+            for (int k = 0; k < 3; ++k) t.half[k] = mColumns->half[k][p];
             t.rs = mSource[p].apply(o) - bS.apply(o);
             t.rt = mTarget[p].apply(o) - bT.apply(o);
             for (int k = 0; k < 3; ++k) {
