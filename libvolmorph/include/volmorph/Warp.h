@@ -19,6 +19,10 @@ public:
     /// (the normalized weights do not depend on it; epsilon and a are scaled with it).
     InverseWarp(const std::vector<FeaturePairSpec>& pairs, const WarpSpec& spec, double t, double unit = 1.0);
 
+    /// Below this, d + offset counts as zero: the point lies on an element and that pair alone
+    /// decides (with several such pairs, their mean). Keeps every weight finite when epsilon = 0.
+    static constexpr double kOnElement = 1e-12;
+
     /// The exact warp: p' -> (source point, target point).
     void map(const Vec3d& p, Vec3d& source, Vec3d& target) const;
 

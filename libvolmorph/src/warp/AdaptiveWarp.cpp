@@ -80,6 +80,7 @@ struct AdaptiveWarp::Columns {
     std::vector<double> half[3];    ///< half the scale along axis k, 0 where the type does not extend
     std::vector<double> reach[3];   ///< half the extent along axis k of a unit axis-aligned cube
     std::vector<double> box;        ///< 1 for boxes
+    std::vector<double> live;       ///< 1 for the pairs, 0 for the padding
     std::vector<double> affine[2][4][3]; ///< [side][column][a]: the affine maps (column 3: offset)
     std::vector<double> slope;      ///< [j * padded + i]: |M_i - M_j|, the larger side
 };
@@ -143,14 +144,11 @@ VOLMORPH_ALWAYS_INLINE inline v8f vsqrt(v8f v)
 typedef double v4d __attribute__((vector_size(32), __may_alias__));
 typedef long long v4l __attribute__((vector_size(32), __may_alias__));
 
-// std::vector's storage is only 16-byte aligned: unaligned loads and stores.
-VOLMORPH_ALWAYS_INLINE inline v4d load4(const double* p)
-{
-    v4d v;
-    __builtin_memcpy(&v, p, sizeof v);
-    return v;
-}
-VOLMORPH_ALWAYS_INLINE inline void store4(double* p, v4d v) { __builtin_memcpy(p, &v, sizeof v); }
+// std::vector's storage is only 16-byte aligned: unaligned loads and stores, through a type
+// that aliases doubles only (not the vectors' own pointers, as memcpy would).
+typedef double v4du __attribute__((vector_size(32), aligned(8)));
+VOLMORPH_ALWAYS_INLINE inline v4d load4(const double* p) { return *reinterpret_cast<const v4du*>(p); }
+VOLMORPH_ALWAYS_INLINE inline void store4(double* p, v4d v) { *reinterpret_cast<v4du*>(p) = v; }
 VOLMORPH_ALWAYS_INLINE inline v4d vabs(v4d v)
 {
     return reinterpret_cast<v4d>(reinterpret_cast<v4l>(v) & 0x7fffffffffffffffLL);
@@ -385,6 +383,7 @@ AdaptiveWarp::AdaptiveWarp(const InverseWarp& warp, double toleranceVoxels)
             c.reach[k].push_back(0.5 * (std::abs(ax.x()) + std::abs(ax.y()) + std::abs(ax.z())));
         }
         c.box.push_back(e.type == FeatureType::Box ? 1.0 : 0.0);
+        c.live.push_back(i < n ? 1.0 : 0.0);
         for (int side = 0; side < 2; ++side)
             for (int a = 0; a < 3; ++a) {
                 for (int k = 0; k < 3; ++k) c.affine[side][k][a].push_back(maps[side].col[k][a]);
@@ -529,6 +528,22 @@ VOLMORPH_ALWAYS_INLINE inline void AdaptiveWarp::analyzeBody(Context& ctx, const
     const bool inverseSquare = mWarp.weighting() == Weighting::InverseSquare;
     PairBounds& pb = ctx.bounds;
     pb.resize(padded);
+    // The columns as plain pointers: stores through them cannot move the vectors' storage.
+    double* const __restrict c_dc = pb.dc.data();
+    double* const __restrict c_dMin = pb.dMin.data();
+    double* const __restrict c_rMin = pb.rMin.data();
+    double* const __restrict c_rMax = pb.rMax.data();
+    double* const __restrict c_wMax = pb.wMax.data();
+    double* const __restrict c_wMin = pb.wMin.data();
+    double* const __restrict c_wc = pb.wc.data();
+    double* const __restrict c_w1 = pb.w1.data();
+    double* const __restrict c_w2 = pb.w2.data();
+    double* const __restrict c_constant = pb.constant.data();
+    double* const __restrict c_resid = pb.resid.data();
+    double* const __restrict c_term = pb.term.data();
+    double* const __restrict c_hess = pb.hess.data();
+    double* const rs[3] = {pb.rs[0].data(), pb.rs[1].data(), pb.rs[2].data()};
+    double* const rt[3] = {pb.rt[0].data(), pb.rt[1].data(), pb.rt[2].data()};
     const v4d zero = splat(0.0), one = splat(1.0), half = splat(0.5), infinity = splat(std::numeric_limits<double>::infinity());
 
     // Per pair: frame coordinates q of the centre, the distance dc = |max(|q| - half, 0)| (half 0
@@ -559,11 +574,11 @@ VOLMORPH_ALWAYS_INLINE inline void AdaptiveWarp::analyzeBody(Context& ctx, const
         // centre: over the cube, d >= dc - h/2 |g|_1.
         const v4d dMin = positive ? vmax(zero, d - (0.5 * h) * gL1) : zero;
         const v4d rMin = offset + dMin, rMax = offset + (inside ? zero : d + halfDiagonal);
-        store4(&pb.dc[i], d);
-        store4(&pb.dMin[i], dMin);
-        store4(&pb.rMin[i], rMin);
-        store4(&pb.rMax[i], rMax);
-        store4(&pb.constant[i], inside ? one : zero);
+        store4(c_dc + i, d);
+        store4(c_dMin + i, dMin);
+        store4(c_rMin + i, rMin);
+        store4(c_rMax + i, rMax);
+        store4(c_constant + i, inside ? one : zero);
         // Weights at the smallest and largest distance and at the centre.
         v4d wMax, wMin, wc;
         if (inverseSquare) {
@@ -579,9 +594,9 @@ VOLMORPH_ALWAYS_INLINE inline void AdaptiveWarp::analyzeBody(Context& ctx, const
                 wc[l] = mWarp.weightAt(j, d[l]);
             }
         }
-        store4(&pb.wMax[i], wMax);
-        store4(&pb.wMin[i], wMin);
-        store4(&pb.wc[i], wc);
+        store4(c_wMax + i, wMax);
+        store4(c_wMin + i, wMin);
+        store4(c_wc + i, wc);
         // |grad w| and |Hess w| over the cube. Per axis a: |w_a| <= b w / r |d_a| and
         // |w_aa| <= w (b (b + 1) / r^2 (d_a)^2 + b / r |d_aa|). grad d is the unit vector from
         // the element's nearest point; over the cube it turns by at most |Hess d| halfDiagonal <=
@@ -599,8 +614,8 @@ VOLMORPH_ALWAYS_INLINE inline void AdaptiveWarp::analyzeBody(Context& ctx, const
         const v4d slopeBound = b * wMax / rMin;
         const v4d first = apart ? slopeBound * vsqrt(axial) : slopeBound;
         const v4d second = apart ? wMax * ((b * (b + 1.0)) / (rMin * rMin) * axial + (3.0 * b) / (rMin * dm)) : infinity;
-        store4(&pb.w1[i], inside ? zero : first);
-        store4(&pb.w2[i], inside ? zero : second);
+        store4(c_w1 + i, inside ? zero : first);
+        store4(c_w2 + i, inside ? zero : second);
     }
     double& wMinSum = ctx.wMinSum;
     size_t& dominant = ctx.dominant;
@@ -610,10 +625,10 @@ VOLMORPH_ALWAYS_INLINE inline void AdaptiveWarp::analyzeBody(Context& ctx, const
     tiny = false;
     double wCentreMax = -1.0;
     for (size_t i = 0; i < n; ++i) {
-        wMinSum += pb.wMin[i];
-        tiny = tiny || pb.rMin[i] < kTinyRadius;
-        if (pb.wc[i] > wCentreMax) {
-            wCentreMax = pb.wc[i];
+        wMinSum += c_wMin[i];
+        tiny = tiny || c_rMin[i] < kTinyRadius;
+        if (c_wc[i] > wCentreMax) {
+            wCentreMax = c_wc[i];
             dominant = i;
         }
     }
@@ -632,16 +647,16 @@ VOLMORPH_ALWAYS_INLINE inline void AdaptiveWarp::analyzeBody(Context& ctx, const
             for (int a = 0; a < 3; ++a) {
                 const v4d r = load4(&m[0][a][i]) * centre.x() + load4(&m[1][a][i]) * centre.y() +
                               load4(&m[2][a][i]) * centre.z() + load4(&m[3][a][i]) - bc[side][a];
-                store4(side == 0 ? &pb.rs[a][i] : &pb.rt[a][i], r);
+                store4((side == 0 ? rs[a] : rt[a]) + i, r);
                 length2[side] += r * r;
             }
         }
-        store4(&pb.resid[i], vsqrt(vmax(length2[0], length2[1])) + load4(&slope[i]) * halfDiagonal);
+        store4(c_resid + i, vsqrt(vmax(length2[0], length2[1])) + load4(&slope[i]) * halfDiagonal);
     }
     double rhoSum = 0.0, residMax = 0.0;
     for (size_t i = 0; i < n; ++i) {
-        rhoSum += pb.wMax[i] * pb.resid[i];
-        residMax = std::max(residMax, pb.resid[i]);
+        rhoSum += c_wMax[i] * c_resid[i];
+        residMax = std::max(residMax, c_resid[i]);
     }
     const double rhoMax = ctx.rhoMax = std::min(residMax, rhoSum / wMinSum);
 
@@ -649,16 +664,16 @@ VOLMORPH_ALWAYS_INLINE inline void AdaptiveWarp::analyzeBody(Context& ctx, const
     const double k = kBoundScale * h * h / 8.0;
     const v4d none = n == 1 ? one : zero;
     for (size_t i = 0; i < padded; i += 4) {
-        const v4d w1 = load4(&pb.w1[i]), w2 = load4(&pb.w2[i]);
-        const v4l skip = (load4(&pb.constant[i]) != zero) | (none != zero);
-        const v4d term = k * ((load4(&pb.resid[i]) + rhoMax) * w2 + 2.0 * load4(&slope[i]) * w1);
-        store4(&pb.hess[i], skip ? zero : k * w2);
-        store4(&pb.term[i], skip ? zero : w2 == infinity ? infinity : term);
+        const v4d w1 = load4(c_w1 + i), w2 = load4(c_w2 + i);
+        const v4l skip = (load4(c_constant + i) != zero) | (none != zero);
+        const v4d term = k * ((load4(c_resid + i) + rhoMax) * w2 + 2.0 * load4(&slope[i]) * w1);
+        store4(c_hess + i, skip ? zero : k * w2);
+        store4(c_term + i, skip ? zero : w2 == infinity ? infinity : term);
     }
     double terms = 0.0, hess = 0.0;
     for (size_t i = 0; i < n; ++i) {
-        terms += pb.term[i];
-        hess += pb.hess[i];
+        terms += c_term[i];
+        hess += c_hess[i];
     }
     ctx.boundAllFar = bound(ctx, terms, hess);
 
@@ -694,19 +709,64 @@ VOLMORPH_ALWAYS_INLINE inline void AdaptiveWarp::analyzeBody(Context& ctx, const
     for (size_t i = 0; i < padded; i += 4) {
         v4d length2[2] = {zero, zero};
         for (int a = 0; a < 3; ++a) {
-            const v4d ds = load4(&pb.rs[a][i]) - mid[0][a], dt = load4(&pb.rt[a][i]) - mid[1][a];
+            const v4d ds = load4(rs[a] + i) - mid[0][a], dt = load4(rt[a] + i) - mid[1][a];
             length2[0] += ds * ds;
             length2[1] += dt * dt;
         }
-        const v4d w1 = load4(&pb.w1[i]), w2 = load4(&pb.w2[i]), term = load4(&pb.term[i]);
+        const v4d w1 = load4(c_w1 + i), w2 = load4(c_w2 + i), term = load4(c_term + i);
         const v4d apart = vmax(vsqrt(length2[0]) + radius[0], vsqrt(length2[1]) + radius[1]) +
                           load4(&slope[i]) * halfDiagonal + boundAllFar;
-        const v4l tighter = (term != infinity) & (load4(&pb.constant[i]) == zero) & (apart < load4(&pb.resid[i]) + rhoMax);
-        store4(&pb.term[i], tighter ? k * (apart * w2 + 2.0 * load4(&slope[i]) * w1) : term);
+        const v4l tighter = (term != infinity) & (load4(c_constant + i) == zero) & (apart < load4(c_resid + i) + rhoMax);
+        store4(c_term + i, tighter ? k * (apart * w2 + 2.0 * load4(&slope[i]) * w1) : term);
     }
     terms = 0.0;
-    for (size_t i = 0; i < n; ++i) terms += pb.term[i];
+    for (size_t i = 0; i < n; ++i) terms += c_term[i];
     ctx.boundAllFar = std::min(ctx.boundAllFar, bound(ctx, terms, hess));
+}
+
+/// InverseWarp::sums over the pairs' columns, 4 pairs at a time.
+VOLMORPH_ALWAYS_INLINE inline bool AdaptiveWarp::exactSumsBody(const Vec3d& x, LatticePoint& out) const
+{
+    const size_t n = mWarp.pairCount();
+    const Columns& col = *mColumns;
+    const double offset = mWarp.weightOffset();
+    const bool inverseSquare = mWarp.weighting() == Weighting::InverseSquare;
+    const v4d zero = splat(0.0), one = splat(1.0);
+    v4d W = zero, S[3] = {zero, zero, zero}, T[3] = {zero, zero, zero};
+    v4l onElement = v4l{0, 0, 0, 0};
+    for (size_t i = 0; i < col.padded; i += 4) {
+        const v4d p[3] = {x.x() - load4(&col.origin[0][i]), x.y() - load4(&col.origin[1][i]), x.z() - load4(&col.origin[2][i])};
+        v4d out2 = zero;
+        for (int k = 0; k < 3; ++k) {
+            const v4d q = load4(&col.axis[k][0][i]) * p[0] + load4(&col.axis[k][1][i]) * p[1] + load4(&col.axis[k][2][i]) * p[2];
+            const v4d a = vabs(q) - load4(&col.half[k][i]);
+            const v4d outside = 0.5 * (a + vabs(a));
+            out2 += outside * outside;
+        }
+        const v4d d = vsqrt(out2), r = d + offset;
+        const v4l live = load4(&col.live[i]) != zero;
+        onElement |= live & (r < InverseWarp::kOnElement);
+        v4d w;
+        if (inverseSquare) {
+            w = one / (r * r);
+        } else {
+            for (int l = 0; l < 4; ++l) w[l] = mWarp.weightAt(std::min(i + l, n - 1), d[l]);
+        }
+        w = live ? w : zero;
+        W += w;
+        for (int a = 0; a < 3; ++a) {
+            const auto& ms = col.affine[0];
+            const auto& mt = col.affine[1];
+            S[a] += w * (load4(&ms[0][a][i]) * x.x() + load4(&ms[1][a][i]) * x.y() + load4(&ms[2][a][i]) * x.z() + load4(&ms[3][a][i]));
+            T[a] += w * (load4(&mt[0][a][i]) * x.x() + load4(&mt[1][a][i]) * x.y() + load4(&mt[2][a][i]) * x.z() + load4(&mt[3][a][i]));
+        }
+    }
+    auto total = [](v4d v) { return (v[0] + v[1]) + (v[2] + v[3]); };
+    out.w = total(W);
+    out.s = Vec3d(total(S[0]), total(S[1]), total(S[2]));
+    out.t = Vec3d(total(T[0]), total(T[1]), total(T[2]));
+    const bool on = onElement[0] || onElement[1] || onElement[2] || onElement[3];
+    return !on && std::isfinite(out.w) && out.w > 0.0;
 }
 
 #ifdef VOLMORPH_HAVE_AVX2_KERNEL
@@ -715,6 +775,21 @@ __attribute__((target("avx2"))) void AdaptiveWarp::analyzeAvx2(Context& ctx, con
     analyzeBody(ctx, corners, origin, size);
 }
 #endif
+
+#ifdef VOLMORPH_HAVE_AVX2_KERNEL
+__attribute__((target("avx2"))) bool AdaptiveWarp::exactSumsAvx2(const Vec3d& x, LatticePoint& out) const
+{
+    return exactSumsBody(x, out);
+}
+#endif
+
+bool AdaptiveWarp::exactSums(const Vec3d& x, LatticePoint& out) const
+{
+#ifdef VOLMORPH_HAVE_AVX2_KERNEL
+    if (avx2Kernel()) return exactSumsAvx2(x, out);
+#endif
+    return exactSumsBody(x, out);
+}
 
 void AdaptiveWarp::analyze(Context& ctx, const LatticePoint* const corners[8], const Coord& origin, int size) const
 {
@@ -990,7 +1065,7 @@ void AdaptiveWarp::forEachLeaf(const CoordBBox& box, const Occupancy* source, co
                     const Coord l(lattice.lo.x() + int(idx / yz), lattice.lo.y() + int(idx % yz) / lattice.dim.z(),
                                   lattice.lo.z() + int(idx % lattice.dim.z()));
                     Lattice::Point& p = lattice.points[idx];
-                    p.ok = mWarp.sums(Vec3d(l.x() * 8.0, l.y() * 8.0, l.z() * 8.0), p.w, p.s, p.t);
+                    p.ok = exactSums(Vec3d(l.x() * 8.0, l.y() * 8.0, l.z() * 8.0), p);
                 }
             });
             if (stopped) throw Interrupted();

@@ -4,13 +4,6 @@
 #include <limits>
 
 namespace volmorph {
-namespace {
-
-/// Below this, d + epsilon counts as zero: the point lies on an element and that pair alone
-/// decides (with several such pairs, their mean). Keeps every weight finite when epsilon = 0.
-constexpr double kOnElement = 1e-12;
-
-} // namespace
 
 InverseWarp::InverseWarp(const std::vector<FeaturePairSpec>& pairs, const WarpSpec& spec, double t, double unit)
     : mWeighting(spec.weighting), mEpsilon(spec.epsilon * unit), mA(spec.a * unit), mB(spec.b)
@@ -56,7 +49,7 @@ bool InverseWarp::sums(const Vec3d& p, double& W, Vec3d& S, Vec3d& T) const
     for (const Pair& pair : mPairs) {
         const Vec3d q = pair.element.frameCoordinates(p);
         const double d = pair.element.distanceInFrame(q);
-        if (d + weightOffset() < kOnElement) return false;
+        if (d + weightOffset() < InverseWarp::kOnElement) return false;
         const double w = weight(pair, d);
         Vec3d ps, pt;
         images(pair, q, ps, pt);
@@ -82,7 +75,7 @@ void InverseWarp::map(const Vec3d& p, Vec3d& source, Vec3d& target) const
         Vec3d ps, pt;
         images(pair, q, ps, pt);
         const double d = pair.element.distanceInFrame(q);
-        if (mWeighting == Weighting::InverseSquare && d + mEpsilon < kOnElement) {
+        if (mWeighting == Weighting::InverseSquare && d + mEpsilon < InverseWarp::kOnElement) {
             hitS += ps;
             hitT += pt;
             ++hits;
