@@ -32,21 +32,19 @@ constexpr double kTinyRadius = 1e-6;
 
 struct LeafJob;
 
-/// Everything the error bound needs of each pair over a cube, one column per quantity.
+/// Everything the error bound needs of each pair over a cube, one column per quantity (single
+/// precision: its rounding, some 1e-7 of each term, is far inside the bound's slack).
 struct PairBounds {
-    std::vector<double> dc, dMin, rMin, rMax; ///< d at the centre, smallest d; offset + d, smallest and largest
-    std::vector<double> wMax, wMin, wc;       ///< w over the cube and at its centre
-    std::vector<double> w1, w2;               ///< |grad w| and |Hess w| bounds
-    std::vector<double> constant;             ///< 1: a box containing the whole cube (d = 0, w constant)
-    std::vector<double> resid;                ///< |R_i| over the cube, the larger side
-    std::vector<double> rs[3], rt[3];         ///< R_i at the centre, each side
-    std::vector<double> term, hess;           ///< the pair's share of the bound and of the Hessian sum
+    enum Column { DC, DMin, RMin, RMax, WMax, WMin, WC, W1, W2, Constant, Resid, RS0, RS1, RS2, RT0, RT1, RT2, Term, Hess, Count };
+    std::vector<float> storage;
+    size_t stride = 0;
     void resize(size_t n)
     {
-        for (auto* v : {&dc, &dMin, &rMin, &rMax, &wMax, &wMin, &wc, &w1, &w2, &constant, &resid, &rs[0], &rs[1], &rs[2],
-                        &rt[0], &rt[1], &rt[2], &term, &hess})
-            v->resize(n);
+        stride = n;
+        storage.resize(n * Count);
     }
+    float* operator[](Column c) { return storage.data() + c * stride; }
+    const float* operator[](Column c) const { return storage.data() + c * stride; }
 };
 
 } // namespace
@@ -71,18 +69,31 @@ struct AdaptiveWarp::Lattice {
     }
 };
 
-/// The pairs, one column per quantity, padded to a multiple of 4 (the loops of analyze() take
-/// 4 pairs at a time; padding lanes compute harmless values that are never read).
-struct AdaptiveWarp::Columns {
+namespace {
+
+/// The pairs, one column per quantity, padded to a multiple of 8 (the bound's loops take 8 pairs
+/// at a time in single precision, the exact sums 4 at a time in double; padding lanes compute
+/// harmless values that are never read, or are masked by `live`).
+template <class Real>
+struct PairColumns {
     size_t padded = 0;
-    std::vector<double> origin[3];  ///< the element's origin, index axes
-    std::vector<double> axis[3][3]; ///< [k][a]: component a of the frame's axis k
-    std::vector<double> half[3];    ///< half the scale along axis k, 0 where the type does not extend
-    std::vector<double> reach[3];   ///< half the extent along axis k of a unit axis-aligned cube
-    std::vector<double> box;        ///< 1 for boxes
-    std::vector<double> live;       ///< 1 for the pairs, 0 for the padding
-    std::vector<double> affine[2][4][3]; ///< [side][column][a]: the affine maps (column 3: offset)
-    std::vector<double> slope;      ///< [j * padded + i]: |M_i - M_j|, the larger side
+    std::vector<Real> origin[3];       ///< the element's origin, index axes
+    std::vector<Real> axis[3][3];      ///< [k][a]: component a of the frame's axis k
+    std::vector<Real> half[3];         ///< half the scale along axis k, 0 where the type does not extend
+    std::vector<Real> reach[3];        ///< half the extent along axis k of a unit axis-aligned cube
+    std::vector<Real> box;             ///< 1 for boxes
+    std::vector<Real> live;            ///< 1 for the pairs, 0 for the padding
+    std::vector<Real> affine[2][4][3]; ///< [side][column][a]: the affine maps (column 3: offset)
+    std::vector<Real> slope;           ///< [j * padded + i]: |M_i - M_j|, the larger side
+
+    PairColumns(const InverseWarp& warp, const std::vector<InverseWarp::Affine> maps[2]);
+};
+
+} // namespace
+
+struct AdaptiveWarp::Columns {
+    PairColumns<double> exact; ///< for the lattice's exact sums
+    PairColumns<float> bound;  ///< for the bound (analyze())
 };
 
 struct AdaptiveWarp::Context {
@@ -160,6 +171,12 @@ VOLMORPH_ALWAYS_INLINE inline v4d vsqrt(v4d v)
     return r;
 }
 VOLMORPH_ALWAYS_INLINE inline v4d vmax(v4d a, v4d b) { return a > b ? a : b; }
+typedef float v8fu __attribute__((vector_size(32), aligned(4)));
+VOLMORPH_ALWAYS_INLINE inline v8f load8(const float* p) { return *reinterpret_cast<const v8fu*>(p); }
+VOLMORPH_ALWAYS_INLINE inline void store8(float* p, v8f v) { *reinterpret_cast<v8fu*>(p) = v; }
+VOLMORPH_ALWAYS_INLINE inline v8f vmax(v8f a, v8f b) { return a > b ? a : b; }
+VOLMORPH_ALWAYS_INLINE inline v8f vmin(v8f a, v8f b) { return a < b ? a : b; }
+VOLMORPH_ALWAYS_INLINE inline v8f splat8(float v) { return v8f{v, v, v, v, v, v, v, v}; }
 VOLMORPH_ALWAYS_INLINE inline v4d vmin(v4d a, v4d b) { return a < b ? a : b; }
 VOLMORPH_ALWAYS_INLINE inline v4d splat(double v) { return v4d{v, v, v, v}; }
 
@@ -167,10 +184,10 @@ VOLMORPH_ALWAYS_INLINE inline v4d splat(double v) { return v4d{v, v, v, v}; }
 template <FeatureType T>
 VOLMORPH_ALWAYS_INLINE inline v8f frameDistance(v8f qx, v8f qy, v8f qz, float hx, float hy, float hz)
 {
-    // max(|v| - half, 0), written without a branch (exact: a + |a| is 2a or 0).
+    // max(|v| - half, 0), one vector max.
     auto out = [](v8f v, float half) {
         const v8f a = vabs(v) - half;
-        return 0.5f * (a + vabs(a));
+        return a > 0.0f ? a : v8f{};
     };
     if constexpr (T == FeatureType::Point) return vsqrt(qx * qx + qy * qy + qz * qz);
     if constexpr (T == FeatureType::Segment) {
@@ -206,7 +223,7 @@ struct NearTerm {
 /// and their steps along the row.
 struct NearRows {
     alignas(32) float start[9][64]; ///< frame coordinates q, source residual, target residual
-    float step[9];
+    v8f step[9];                    ///< their steps at each voxel of a row (0, 1, ..., 7 steps)
     float half[3];
     float scale;
 };
@@ -233,9 +250,9 @@ VOLMORPH_ALWAYS_INLINE inline void addNearRow(const LeafJob& job, size_t begin, 
     const float off = float(job.offset);
     for (size_t p = begin; p < end; ++p) {
         const NearRows& n = job.rows[p];
-        const v8f qx = n.start[0][r] + kZ * n.step[0];
-        const v8f qy = n.start[1][r] + kZ * n.step[1];
-        const v8f qz = n.start[2][r] + kZ * n.step[2];
+        const v8f qx = n.start[0][r] + n.step[0];
+        const v8f qy = n.start[1][r] + n.step[1];
+        const v8f qz = n.start[2][r] + n.step[2];
         const v8f d = off + frameDistance<T>(qx, qy, qz, n.half[0], n.half[1], n.half[2]);
         v8f w;
         if constexpr (InverseSquare) {
@@ -244,7 +261,7 @@ VOLMORPH_ALWAYS_INLINE inline void addNearRow(const LeafJob& job, size_t begin, 
             for (int l = 0; l < 8; ++l) w[l] = float(double(n.scale) * std::pow(double(d[l]), -job.exponent));
         }
         acc[0] += w;
-        for (int c = 0; c < 6; ++c) acc[1 + c] += w * (n.start[3 + c][r] + kZ * n.step[3 + c]);
+        for (int c = 0; c < 6; ++c) acc[1 + c] += w * (n.start[3 + c][r] + n.step[3 + c]);
     }
 }
 
@@ -319,9 +336,9 @@ VOLMORPH_ALWAYS_INLINE inline void fillLeafBody(LeafJob& job, WarpLeaf& leaf)
             rowAffine(q0[c], dx[c], dy[c], n.start[c]);
             rowAffine(t.rs[c], t.drs[0][c], t.drs[1][c], n.start[3 + c]);
             rowAffine(t.rt[c], t.drt[0][c], t.drt[1][c], n.start[6 + c]);
-            n.step[c] = float(dz[c]);
-            n.step[3 + c] = float(t.drs[2][c]);
-            n.step[6 + c] = float(t.drt[2][c]);
+            n.step[c] = kZ * float(dz[c]);
+            n.step[3 + c] = kZ * float(t.drs[2][c]);
+            n.step[6 + c] = kZ * float(t.drt[2][c]);
             n.half[c] = float(0.5 * e.scale[c]);
         }
         n.scale = float(t.scale);
@@ -364,38 +381,49 @@ AdaptiveWarp::AdaptiveWarp(const InverseWarp& warp, double toleranceVoxels)
         mSource.push_back(warp.sourceAffine(i));
         mTarget.push_back(warp.targetAffine(i));
     }
-    auto columns = std::make_unique<Columns>();
-    Columns& c = *columns;
-    const size_t padded = c.padded = (n + 3) / 4 * 4;
+    const std::vector<InverseWarp::Affine> maps[2] = {mSource, mTarget};
+    mColumns.reset(new Columns{PairColumns<double>(warp, maps), PairColumns<float>(warp, maps)});
+}
+
+namespace {
+
+template <class Real>
+PairColumns<Real>::PairColumns(const InverseWarp& warp, const std::vector<InverseWarp::Affine> maps[2])
+{
+    const size_t n = warp.pairCount();
+    padded = (n + 7) / 8 * 8;
+    InverseWarp::Affine zero;
+    zero.col[0] = zero.col[1] = zero.col[2] = zero.offset = Vec3d(0.0);
     for (size_t i = 0; i < padded; ++i) {
-        // Padding: a point at the origin with identity maps.
+        // Padding: a point at the origin with zero maps.
         const Feature e = i < n ? warp.interpolated(i) : Feature();
-        InverseWarp::Affine zero;
-        zero.col[0] = zero.col[1] = zero.col[2] = zero.offset = Vec3d(0.0);
-        const InverseWarp::Affine maps[2] = {i < n ? mSource[i] : zero, i < n ? mTarget[i] : zero};
         const int extent = e.type == FeatureType::Point ? 0 : e.type == FeatureType::Segment ? 1 : e.type == FeatureType::Rectangle ? 2 : 3;
         const Vec3d* axes[3] = {&e.x, &e.y, &e.z};
         for (int k = 0; k < 3; ++k) {
-            c.origin[k].push_back(e.origin[k]);
-            for (int a = 0; a < 3; ++a) c.axis[k][a].push_back((*axes[k])[a]);
-            c.half[k].push_back(k < extent ? 0.5 * e.scale[k] : 0.0);
+            origin[k].push_back(Real(e.origin[k]));
+            for (int a = 0; a < 3; ++a) axis[k][a].push_back(Real((*axes[k])[a]));
+            half[k].push_back(Real(k < extent ? 0.5 * e.scale[k] : 0.0));
             const Vec3d& ax = *axes[k];
-            c.reach[k].push_back(0.5 * (std::abs(ax.x()) + std::abs(ax.y()) + std::abs(ax.z())));
+            reach[k].push_back(Real(0.5 * (std::abs(ax.x()) + std::abs(ax.y()) + std::abs(ax.z()))));
         }
-        c.box.push_back(e.type == FeatureType::Box ? 1.0 : 0.0);
-        c.live.push_back(i < n ? 1.0 : 0.0);
-        for (int side = 0; side < 2; ++side)
+        box.push_back(e.type == FeatureType::Box ? 1 : 0);
+        live.push_back(i < n ? 1 : 0);
+        for (int side = 0; side < 2; ++side) {
+            const InverseWarp::Affine& m = i < n ? maps[side][i] : zero;
             for (int a = 0; a < 3; ++a) {
-                for (int k = 0; k < 3; ++k) c.affine[side][k][a].push_back(maps[side].col[k][a]);
-                c.affine[side][3][a].push_back(maps[side].offset[a]);
+                for (int k = 0; k < 3; ++k) affine[side][k][a].push_back(Real(m.col[k][a]));
+                affine[side][3][a].push_back(Real(m.offset[a]));
             }
+        }
     }
-    c.slope.assign(n * padded, 0.0);
+    slope.assign(n * padded, 0);
     for (size_t j = 0; j < n; ++j)
         for (size_t i = 0; i < n; ++i)
-            c.slope[j * padded + i] = std::max(linearDistance(mSource[i], mSource[j]), linearDistance(mTarget[i], mTarget[j]));
-    mColumns = std::move(columns);
+            slope[j * padded + i] = Real(std::max(linearDistance(maps[0][i], maps[0][j]), linearDistance(maps[1][i], maps[1][j])));
 }
+
+} // namespace
+
 
 void AdaptiveWarp::identityLeaf(Context& ctx) const
 {
@@ -510,11 +538,12 @@ void channelRange(const float* v, float& lo, float& hi)
 void useBaselineKernel(bool baseline) { gBaselineKernel = baseline; }
 
 /// The bound's terms of every pair over the cube [o, o + size]^3 (a leaf: its voxels and its far
-/// corners), into ctx; see the header for the derivation.
+/// corners), into ctx; see the header for the derivation. The per-pair loops take 8 pairs at a
+/// time in single precision; the sums over pairs are in double.
 VOLMORPH_ALWAYS_INLINE inline void AdaptiveWarp::analyzeBody(Context& ctx, const LatticePoint* const corners[8], const Coord& origin, int size) const
 {
     const size_t n = mWarp.pairCount();
-    const Columns& col = *mColumns;
+    const PairColumns<float>& col = mColumns->bound;
     const size_t padded = col.padded;
     ctx.cornersOk = true;
     for (int k = 0; k < 8; ++k) {
@@ -524,98 +553,98 @@ VOLMORPH_ALWAYS_INLINE inline void AdaptiveWarp::analyzeBody(Context& ctx, const
     const Vec3d o = origin.asVec3d();
     const double h = size, halfDiagonal = 0.5 * h * std::sqrt(3.0);
     const Vec3d centre = o + Vec3d(0.5 * h);
-    const double offset = mWarp.weightOffset(), b = mWarp.weightExponent();
+    const Vec3f cf(centre);
+    const float hf = float(h), halfDiagonalF = float(halfDiagonal);
+    const float offset = float(mWarp.weightOffset()), b = float(mWarp.weightExponent());
     const bool inverseSquare = mWarp.weighting() == Weighting::InverseSquare;
     PairBounds& pb = ctx.bounds;
     pb.resize(padded);
-    // The columns as plain pointers: stores through them cannot move the vectors' storage.
-    double* const __restrict c_dc = pb.dc.data();
-    double* const __restrict c_dMin = pb.dMin.data();
-    double* const __restrict c_rMin = pb.rMin.data();
-    double* const __restrict c_rMax = pb.rMax.data();
-    double* const __restrict c_wMax = pb.wMax.data();
-    double* const __restrict c_wMin = pb.wMin.data();
-    double* const __restrict c_wc = pb.wc.data();
-    double* const __restrict c_w1 = pb.w1.data();
-    double* const __restrict c_w2 = pb.w2.data();
-    double* const __restrict c_constant = pb.constant.data();
-    double* const __restrict c_resid = pb.resid.data();
-    double* const __restrict c_term = pb.term.data();
-    double* const __restrict c_hess = pb.hess.data();
-    double* const rs[3] = {pb.rs[0].data(), pb.rs[1].data(), pb.rs[2].data()};
-    double* const rt[3] = {pb.rt[0].data(), pb.rt[1].data(), pb.rt[2].data()};
-    const v4d zero = splat(0.0), one = splat(1.0), half = splat(0.5), infinity = splat(std::numeric_limits<double>::infinity());
+    using C = PairBounds::Column;
+    float* const __restrict dc = pb[C::DC];
+    float* const __restrict dMinC = pb[C::DMin];
+    float* const __restrict rMinC = pb[C::RMin];
+    float* const __restrict rMaxC = pb[C::RMax];
+    float* const __restrict wMaxC = pb[C::WMax];
+    float* const __restrict wMinC = pb[C::WMin];
+    float* const __restrict wcC = pb[C::WC];
+    float* const __restrict w1C = pb[C::W1];
+    float* const __restrict w2C = pb[C::W2];
+    float* const __restrict constantC = pb[C::Constant];
+    float* const __restrict residC = pb[C::Resid];
+    float* const __restrict termC = pb[C::Term];
+    float* const __restrict hessC = pb[C::Hess];
+    float* const rs[3] = {pb[C::RS0], pb[C::RS1], pb[C::RS2]};
+    float* const rt[3] = {pb[C::RT0], pb[C::RT1], pb[C::RT2]};
+    const v8f zero = splat8(0.0f), one = splat8(1.0f), infinity = splat8(std::numeric_limits<float>::infinity());
 
     // Per pair: frame coordinates q of the centre, the distance dc = |max(|q| - half, 0)| (half 0
     // on the axes a type does not extend along), its gradient g in index axes, the smallest
     // distance over the cube, and whether a box contains the whole cube (d = 0, w constant).
-    for (size_t i = 0; i < padded; i += 4) {
-        const v4d p[3] = {centre.x() - load4(&col.origin[0][i]), centre.y() - load4(&col.origin[1][i]),
-                          centre.z() - load4(&col.origin[2][i])};
-        v4d q[3], v[3], out2 = zero;
-        v4l inside = load4(&col.box[i]) != zero;
+    for (size_t i = 0; i < padded; i += 8) {
+        const v8f p[3] = {cf.x() - load8(&col.origin[0][i]), cf.y() - load8(&col.origin[1][i]), cf.z() - load8(&col.origin[2][i])};
+        v8f q[3], v[3], out2 = zero;
+        v8i inside = load8(&col.box[i]) != zero;
         for (int k = 0; k < 3; ++k) {
-            q[k] = load4(&col.axis[k][0][i]) * p[0] + load4(&col.axis[k][1][i]) * p[1] + load4(&col.axis[k][2][i]) * p[2];
-            const v4d a = vabs(q[k]) - load4(&col.half[k][i]);
-            const v4d outside = half * (a + vabs(a));
+            q[k] = load8(&col.axis[k][0][i]) * p[0] + load8(&col.axis[k][1][i]) * p[1] + load8(&col.axis[k][2][i]) * p[2];
+            const v8f outside = vmax(vabs(q[k]) - load8(&col.half[k][i]), zero);
             out2 += outside * outside;
             v[k] = q[k] < zero ? -outside : outside;
-            inside &= vabs(q[k]) + h * load4(&col.reach[k][i]) <= load4(&col.half[k][i]);
+            inside &= vabs(q[k]) + hf * load8(&col.reach[k][i]) <= load8(&col.half[k][i]);
         }
-        const v4d d = vsqrt(out2);
-        const v4l positive = d > zero;
-        const v4d inv = positive ? one / d : zero;
-        v4d gL1 = zero, g[3];
+        const v8f d = vsqrt(out2);
+        const v8i positive = d > zero;
+        const v8f inv = positive ? one / d : zero;
+        v8f gL1 = zero, g[3];
         for (int a = 0; a < 3; ++a) {
-            g[a] = (load4(&col.axis[0][a][i]) * v[0] + load4(&col.axis[1][a][i]) * v[1] + load4(&col.axis[2][a][i]) * v[2]) * inv;
+            g[a] = (load8(&col.axis[0][a][i]) * v[0] + load8(&col.axis[1][a][i]) * v[1] + load8(&col.axis[2][a][i]) * v[2]) * inv;
             gL1 += vabs(g[a]);
         }
         // d is convex (the distance to a convex set), so it lies above its tangent plane at the
         // centre: over the cube, d >= dc - h/2 |g|_1.
-        const v4d dMin = positive ? vmax(zero, d - (0.5 * h) * gL1) : zero;
-        const v4d rMin = offset + dMin, rMax = offset + (inside ? zero : d + halfDiagonal);
-        store4(c_dc + i, d);
-        store4(c_dMin + i, dMin);
-        store4(c_rMin + i, rMin);
-        store4(c_rMax + i, rMax);
-        store4(c_constant + i, inside ? one : zero);
+        const v8f dMin = positive ? vmax(zero, d - (0.5f * hf) * gL1) : zero;
+        const v8f rMin = offset + dMin, rMax = offset + (inside ? zero : d + halfDiagonalF);
+        store8(dc + i, d);
+        store8(dMinC + i, dMin);
+        store8(rMinC + i, rMin);
+        store8(rMaxC + i, rMax);
+        store8(constantC + i, inside ? one : zero);
         // Weights at the smallest and largest distance and at the centre.
-        v4d wMax, wMin, wc;
+        v8f wMax, wMin, wc;
         if (inverseSquare) {
-            const v4d r0 = vmax(dMin, splat(kTinyRadius - offset)) + offset, r2 = d + offset;
+            const v8f r0 = vmax(dMin, splat8(float(kTinyRadius) - offset)) + offset, r2 = d + offset;
             wMax = one / (r0 * r0);
             wMin = one / (rMax * rMax);
             wc = one / (r2 * r2);
         } else {
-            for (int l = 0; l < 4; ++l) {
+            for (int l = 0; l < 8; ++l) {
                 const size_t j = std::min(i + l, n - 1); // padding lanes: any pair's values
-                wMax[l] = mWarp.weightAt(j, std::max(dMin[l], kTinyRadius - offset));
-                wMin[l] = mWarp.weightAt(j, rMax[l] - offset);
-                wc[l] = mWarp.weightAt(j, d[l]);
+                wMax[l] = float(mWarp.weightAt(j, std::max(double(dMin[l]), kTinyRadius - offset)));
+                wMin[l] = float(mWarp.weightAt(j, double(rMax[l]) - offset));
+                wc[l] = float(mWarp.weightAt(j, d[l]));
             }
         }
-        store4(c_wMax + i, wMax);
-        store4(c_wMin + i, wMin);
-        store4(c_wc + i, wc);
+        store8(wMaxC + i, wMax);
+        store8(wMinC + i, wMin);
+        store8(wcC + i, wc);
         // |grad w| and |Hess w| over the cube. Per axis a: |w_a| <= b w / r |d_a| and
         // |w_aa| <= w (b (b + 1) / r^2 (d_a)^2 + b / r |d_aa|). grad d is the unit vector from
         // the element's nearest point; over the cube it turns by at most |Hess d| halfDiagonal <=
         // halfDiagonal / dMin, so sup |d_a| <= |g_a| + turn; and sum_a |d_aa| <= 3 / dMin.
         // w1 bounds sqrt(sum_a sup (w_a)^2), w2 bounds sum_a sup |w_aa|; where the cube touches
         // the element (dMin = 0) there is a kink: w2 is infinite.
-        const v4l apart = dMin > zero;
-        const v4d dm = apart ? dMin : one;
-        const v4d turn = vmin(one, halfDiagonal / dm);
-        v4d axial = zero;
+        const v8i apart = dMin > zero;
+        const v8f invD = one / (apart ? dMin : one), invR = one / rMin;
+        const v8f turn = vmin(one, halfDiagonalF * invD);
+        v8f axial = zero;
         for (int a = 0; a < 3; ++a) {
-            const v4d ga = vmin(one, vabs(g[a]) + turn);
+            const v8f ga = vmin(one, vabs(g[a]) + turn);
             axial += ga * ga;
         }
-        const v4d slopeBound = b * wMax / rMin;
-        const v4d first = apart ? slopeBound * vsqrt(axial) : slopeBound;
-        const v4d second = apart ? wMax * ((b * (b + 1.0)) / (rMin * rMin) * axial + (3.0 * b) / (rMin * dm)) : infinity;
-        store4(c_w1 + i, inside ? zero : first);
-        store4(c_w2 + i, inside ? zero : second);
+        const v8f slopeBound = b * wMax * invR;
+        const v8f first = apart ? slopeBound * vsqrt(axial) : slopeBound;
+        const v8f second = apart ? wMax * invR * ((b * (b + 1.0f)) * invR * axial + (3.0f * b) * invD) : infinity;
+        store8(w1C + i, inside ? zero : first);
+        store8(w2C + i, inside ? zero : second);
     }
     double& wMinSum = ctx.wMinSum;
     size_t& dominant = ctx.dominant;
@@ -623,57 +652,58 @@ VOLMORPH_ALWAYS_INLINE inline void AdaptiveWarp::analyzeBody(Context& ctx, const
     wMinSum = 0.0;
     dominant = 0;
     tiny = false;
-    double wCentreMax = -1.0;
+    float wCentreMax = -1.0f;
     for (size_t i = 0; i < n; ++i) {
-        wMinSum += c_wMin[i];
-        tiny = tiny || c_rMin[i] < kTinyRadius;
-        if (c_wc[i] > wCentreMax) {
-            wCentreMax = c_wc[i];
+        wMinSum += wMinC[i];
+        // Below kTinyRadius (or weights beyond single precision) the leaf is evaluated exactly.
+        tiny = tiny || rMinC[i] < float(kTinyRadius) || !std::isfinite(wMaxC[i]);
+        if (wcC[i] > wCentreMax) {
+            wCentreMax = wcC[i];
             dominant = i;
         }
     }
     const InverseWarp::Affine& bS = mSource[dominant];
     const InverseWarp::Affine& bT = mTarget[dominant];
-    const double* slope = &col.slope[dominant * padded];
+    const float* slope = &col.slope[dominant * padded];
 
     // R_i = A_i - B at the centre, |R_i| over the cube on either side (|M_i - M_B| the slope),
     // and |rho| = |p - B| <= sum w_i |R_i| / W.
-    const Vec3d bc[2] = {bS.apply(centre), bT.apply(centre)};
-    for (size_t i = 0; i < padded; i += 4) {
-        v4d length2[2];
+    const Vec3f bc[2] = {Vec3f(bS.apply(centre)), Vec3f(bT.apply(centre))};
+    for (size_t i = 0; i < padded; i += 8) {
+        v8f length2[2];
         for (int side = 0; side < 2; ++side) {
             const auto& m = col.affine[side];
             length2[side] = zero;
             for (int a = 0; a < 3; ++a) {
-                const v4d r = load4(&m[0][a][i]) * centre.x() + load4(&m[1][a][i]) * centre.y() +
-                              load4(&m[2][a][i]) * centre.z() + load4(&m[3][a][i]) - bc[side][a];
-                store4((side == 0 ? rs[a] : rt[a]) + i, r);
+                const v8f r = load8(&m[0][a][i]) * cf.x() + load8(&m[1][a][i]) * cf.y() +
+                              load8(&m[2][a][i]) * cf.z() + load8(&m[3][a][i]) - bc[side][a];
+                store8((side == 0 ? rs[a] : rt[a]) + i, r);
                 length2[side] += r * r;
             }
         }
-        store4(c_resid + i, vsqrt(vmax(length2[0], length2[1])) + load4(&slope[i]) * halfDiagonal);
+        store8(residC + i, vsqrt(vmax(length2[0], length2[1])) + load8(&slope[i]) * halfDiagonalF);
     }
     double rhoSum = 0.0, residMax = 0.0;
     for (size_t i = 0; i < n; ++i) {
-        rhoSum += c_wMax[i] * c_resid[i];
-        residMax = std::max(residMax, c_resid[i]);
+        rhoSum += double(wMaxC[i]) * residC[i];
+        residMax = std::max(residMax, double(residC[i]));
     }
     const double rhoMax = ctx.rhoMax = std::min(residMax, rhoSum / wMinSum);
 
     // Each far pair's share of the bound; one pair is its own affine map (R = 0, rho = 0).
-    const double k = kBoundScale * h * h / 8.0;
-    const v4d none = n == 1 ? one : zero;
-    for (size_t i = 0; i < padded; i += 4) {
-        const v4d w1 = load4(c_w1 + i), w2 = load4(c_w2 + i);
-        const v4l skip = (load4(c_constant + i) != zero) | (none != zero);
-        const v4d term = k * ((load4(c_resid + i) + rhoMax) * w2 + 2.0 * load4(&slope[i]) * w1);
-        store4(c_hess + i, skip ? zero : k * w2);
-        store4(c_term + i, skip ? zero : w2 == infinity ? infinity : term);
+    const float k = float(kBoundScale * h * h / 8.0), rhoMaxF = float(rhoMax);
+    const v8f none = n == 1 ? one : zero;
+    for (size_t i = 0; i < padded; i += 8) {
+        const v8f w1 = load8(w1C + i), w2 = load8(w2C + i);
+        const v8i skip = (load8(constantC + i) != zero) | (none != zero);
+        const v8f term = k * ((load8(residC + i) + rhoMaxF) * w2 + 2.0f * load8(&slope[i]) * w1);
+        store8(hessC + i, skip ? zero : k * w2);
+        store8(termC + i, skip ? zero : w2 == infinity ? infinity : term);
     }
     double terms = 0.0, hess = 0.0;
     for (size_t i = 0; i < n; ++i) {
-        terms += c_term[i];
-        hess += c_hess[i];
+        terms += termC[i];
+        hess += hessC[i];
     }
     ctx.boundAllFar = bound(ctx, terms, hess);
 
@@ -693,34 +723,35 @@ VOLMORPH_ALWAYS_INLINE inline void AdaptiveWarp::analyzeBody(Context& ctx, const
         for (int c = 0; c < 8; ++c) {
             const LatticePoint& p = *corners[c];
             const Vec3d x = o + Vec3d((c & 1) * h, ((c >> 1) & 1) * h, ((c >> 2) & 1) * h);
-            rho[c] = (side == 0 ? p.s : p.t) / p.w - bA.apply(x);
+            rho[c] = (side == 0 ? p.s : p.t) * (1.0 / p.w) - bA.apply(x);
             lo = minComponent(lo, rho[c]);
             hi = maxComponent(hi, rho[c]);
         }
         ctx.rhoLo[side] = lo;
         ctx.rhoHi[side] = hi;
         ctx.rhoMid[side] = 0.5 * (lo + hi);
-        radius[side] = 0.0;
-        for (int c = 0; c < 8; ++c) radius[side] = std::max(radius[side], (rho[c] - ctx.rhoMid[side]).length());
+        double r2 = 0.0;
+        for (int c = 0; c < 8; ++c) r2 = std::max(r2, (rho[c] - ctx.rhoMid[side]).lengthSqr());
+        radius[side] = std::sqrt(r2);
     }
     if (!std::isfinite(ctx.boundAllFar) || n == 1) return;
-    const Vec3d* mid = ctx.rhoMid;
-    const double boundAllFar = ctx.boundAllFar;
-    for (size_t i = 0; i < padded; i += 4) {
-        v4d length2[2] = {zero, zero};
+    const Vec3f mid[2] = {Vec3f(ctx.rhoMid[0]), Vec3f(ctx.rhoMid[1])};
+    const float boundAllFar = float(ctx.boundAllFar), radiusS = float(radius[0]), radiusT = float(radius[1]);
+    for (size_t i = 0; i < padded; i += 8) {
+        v8f length2[2] = {zero, zero};
         for (int a = 0; a < 3; ++a) {
-            const v4d ds = load4(rs[a] + i) - mid[0][a], dt = load4(rt[a] + i) - mid[1][a];
+            const v8f ds = load8(rs[a] + i) - mid[0][a], dt = load8(rt[a] + i) - mid[1][a];
             length2[0] += ds * ds;
             length2[1] += dt * dt;
         }
-        const v4d w1 = load4(c_w1 + i), w2 = load4(c_w2 + i), term = load4(c_term + i);
-        const v4d apart = vmax(vsqrt(length2[0]) + radius[0], vsqrt(length2[1]) + radius[1]) +
-                          load4(&slope[i]) * halfDiagonal + boundAllFar;
-        const v4l tighter = (term != infinity) & (load4(c_constant + i) == zero) & (apart < load4(c_resid + i) + rhoMax);
-        store4(c_term + i, tighter ? k * (apart * w2 + 2.0 * load4(&slope[i]) * w1) : term);
+        const v8f w1 = load8(w1C + i), w2 = load8(w2C + i), term = load8(termC + i);
+        const v8f apart = vmax(vsqrt(length2[0]) + radiusS, vsqrt(length2[1]) + radiusT) +
+                          load8(&slope[i]) * halfDiagonalF + boundAllFar;
+        const v8i tighter = (term != infinity) & (load8(constantC + i) == zero) & (apart < load8(residC + i) + rhoMaxF);
+        store8(termC + i, tighter ? k * (apart * w2 + 2.0f * load8(&slope[i]) * w1) : term);
     }
     terms = 0.0;
-    for (size_t i = 0; i < n; ++i) terms += c_term[i];
+    for (size_t i = 0; i < n; ++i) terms += termC[i];
     ctx.boundAllFar = std::min(ctx.boundAllFar, bound(ctx, terms, hess));
 }
 
@@ -728,7 +759,7 @@ VOLMORPH_ALWAYS_INLINE inline void AdaptiveWarp::analyzeBody(Context& ctx, const
 VOLMORPH_ALWAYS_INLINE inline bool AdaptiveWarp::exactSumsBody(const Vec3d& x, LatticePoint& out) const
 {
     const size_t n = mWarp.pairCount();
-    const Columns& col = *mColumns;
+    const PairColumns<double>& col = mColumns->exact;
     const double offset = mWarp.weightOffset();
     const bool inverseSquare = mWarp.weighting() == Weighting::InverseSquare;
     const v4d zero = splat(0.0), one = splat(1.0);
@@ -844,7 +875,7 @@ double AdaptiveWarp::selectNear(Context& ctx, size_t& nearCount) const
     // Largest share first: the far set is a suffix of that order, so its sums are suffix sums;
     // the near set is the shortest prefix whose suffix is within the tolerance.
     const size_t n = mWarp.pairCount();
-    const std::vector<double>& term = ctx.bounds.term;
+    const float* term = ctx.bounds[PairBounds::Term];
     ctx.order.resize(n);
     for (size_t i = 0; i < n; ++i) ctx.order[i] = int(i);
     ctx.isNear.assign(n, 0);
@@ -855,7 +886,7 @@ double AdaptiveWarp::selectNear(Context& ctx, size_t& nearCount) const
     ctx.suffixHess.assign(n + 1, 0.0);
     for (size_t j = n; j-- > 0;) {
         ctx.suffixTerm[j] = ctx.suffixTerm[j + 1] + term[ctx.order[j]];
-        ctx.suffixHess[j] = ctx.suffixHess[j + 1] + ctx.bounds.hess[ctx.order[j]];
+        ctx.suffixHess[j] = ctx.suffixHess[j + 1] + ctx.bounds[PairBounds::Hess][ctx.order[j]];
     }
     nearCount = 0;
     double b = ctx.boundAllFar;
@@ -905,7 +936,7 @@ void AdaptiveWarp::fill(Context& ctx, const Coord& origin) const
             NearTerm t;
             t.element = &mWarp.interpolated(p);
             t.scale = mWarp.weightScale(p);
-            for (int k = 0; k < 3; ++k) t.half[k] = mColumns->half[k][p];
+            for (int k = 0; k < 3; ++k) t.half[k] = mColumns->exact.half[k][p];
             t.rs = mSource[p].apply(o) - bS.apply(o);
             t.rt = mTarget[p].apply(o) - bT.apply(o);
             for (int k = 0; k < 3; ++k) {
