@@ -106,8 +106,6 @@ struct AdaptiveWarp::Context {
     // Per pair, per leaf (scratch).
     std::unique_ptr<LeafJob> job = std::make_unique<LeafJob>();
     PairBounds bounds;
-    std::vector<double> suffixTerm, suffixHess;
-    std::vector<int> order;
     std::vector<char> isNear;
     // What analyze() found of the last cell.
     const LatticePoint* corner[8];
@@ -518,19 +516,41 @@ void fillLeaf(LeafJob& job, WarpLeaf& leaf)
     fillLeafBaseline(job, leaf);
 }
 
-/// The smallest and largest of a leaf's 512 values, in 8 lanes (the loop vectorizes; a scalar
-/// min_element chain had been a twentieth of the warp).
-void channelRange(const float* v, float& lo, float& hi)
+/// The box of a leaf's warped points on each side (0 source, 1 target), 8 lanes at a time.
+VOLMORPH_ALWAYS_INLINE inline void leafRangeBody(const WarpLeaf& leaf, Vec3f lo[2], Vec3f hi[2])
 {
-    float l[8], u[8];
-    for (int z = 0; z < 8; ++z) l[z] = u[z] = v[z];
-    for (int m = 8; m < 512; m += 8)
-        for (int z = 0; z < 8; ++z) {
-            l[z] = v[m + z] < l[z] ? v[m + z] : l[z];
-            u[z] = v[m + z] > u[z] ? v[m + z] : u[z];
+    for (int side = 0; side < 2; ++side)
+        for (int c = 0; c < 3; ++c) {
+            const float* v = side == 0 ? leaf.s[c] : leaf.t[c];
+            v8f l = load(v), u = l;
+            for (int m = 8; m < 512; m += 8) {
+                const v8f x = load(v + m);
+                l = x < l ? x : l;
+                u = x > u ? x : u;
+            }
+            float a = l[0], b = u[0];
+            for (int z = 1; z < 8; ++z) {
+                a = std::min(a, l[z]);
+                b = std::max(b, u[z]);
+            }
+            lo[side][c] = a;
+            hi[side][c] = b;
         }
-    lo = *std::min_element(l, l + 8);
-    hi = *std::max_element(u, u + 8);
+}
+
+#ifdef VOLMORPH_HAVE_AVX2_KERNEL
+__attribute__((target("avx2"))) void leafRangeAvx2(const WarpLeaf& leaf, Vec3f lo[2], Vec3f hi[2])
+{
+    leafRangeBody(leaf, lo, hi);
+}
+#endif
+
+void leafRange(const WarpLeaf& leaf, Vec3f lo[2], Vec3f hi[2])
+{
+#ifdef VOLMORPH_HAVE_AVX2_KERNEL
+    if (avx2Kernel()) return leafRangeAvx2(leaf, lo, hi);
+#endif
+    leafRangeBody(leaf, lo, hi);
 }
 
 } // namespace
@@ -872,28 +892,37 @@ double AdaptiveWarp::bound(const Context& ctx, double terms, double hess) const
 
 double AdaptiveWarp::selectNear(Context& ctx, size_t& nearCount) const
 {
-    // Largest share first: the far set is a suffix of that order, so its sums are suffix sums;
-    // the near set is the shortest prefix whose suffix is within the tolerance.
+    // Largest share first, until the far pairs' bound is within the tolerance: the far sums are
+    // the totals less the near pairs' shares (infinite shares, kinks, counted apart).
     const size_t n = mWarp.pairCount();
     const float* term = ctx.bounds[PairBounds::Term];
-    ctx.order.resize(n);
-    for (size_t i = 0; i < n; ++i) ctx.order[i] = int(i);
+    const float* hess = ctx.bounds[PairBounds::Hess];
     ctx.isNear.assign(n, 0);
-    std::sort(ctx.order.begin(), ctx.order.end(), [&](int a, int c) {
-        return term[a] > term[c] || (term[a] == term[c] && a < c);
-    });
-    ctx.suffixTerm.assign(n + 1, 0.0);
-    ctx.suffixHess.assign(n + 1, 0.0);
-    for (size_t j = n; j-- > 0;) {
-        ctx.suffixTerm[j] = ctx.suffixTerm[j + 1] + term[ctx.order[j]];
-        ctx.suffixHess[j] = ctx.suffixHess[j + 1] + ctx.bounds[PairBounds::Hess][ctx.order[j]];
+    double terms = 0.0, hessSum = 0.0;
+    size_t kinks = 0;
+    for (size_t i = 0; i < n; ++i) {
+        if (std::isfinite(term[i])) {
+            terms += term[i];
+            hessSum += hess[i];
+        } else {
+            ++kinks;
+        }
     }
     nearCount = 0;
     double b = ctx.boundAllFar;
     while (b > mTolerance && nearCount < n) {
-        ctx.isNear[ctx.order[nearCount]] = 1;
+        size_t best = n;
+        for (size_t i = 0; i < n; ++i)
+            if (!ctx.isNear[i] && (best == n || term[i] > term[best])) best = i;
+        ctx.isNear[best] = 1;
         ++nearCount;
-        b = bound(ctx, ctx.suffixTerm[nearCount], ctx.suffixHess[nearCount]);
+        if (std::isfinite(term[best])) {
+            terms = std::max(0.0, terms - term[best]);
+            hessSum = std::max(0.0, hessSum - hess[best]);
+        } else {
+            --kinks;
+        }
+        b = kinks > 0 ? std::numeric_limits<double>::infinity() : bound(ctx, terms, hessSum);
     }
     return nearCount == n ? 0.0 : b; // every pair near: exact at every voxel but for rounding
 }
@@ -960,13 +989,10 @@ void AdaptiveWarp::leaf(Context& ctx, const Lattice& lattice, const Coord& origi
     auto visit = [&](double errorBound, bool recheck) {
         if (cull && recheck) {
             // The filled points' own bounding box, widened by what they may be off.
-            Vec3f slo, shi, tlo, thi;
-            for (int c = 0; c < 3; ++c) {
-                channelRange(ctx.leaf.s[c], slo[c], shi[c]);
-                channelRange(ctx.leaf.t[c], tlo[c], thi[c]);
-            }
+            Vec3f lo[2], hi[2];
+            leafRange(ctx.leaf, lo, hi);
             const double margin = kSamplerReach + errorBound;
-            if (!touches(ctx.source, Vec3d(slo), Vec3d(shi), margin) && !touches(ctx.target, Vec3d(tlo), Vec3d(thi), margin))
+            if (!touches(ctx.source, Vec3d(lo[0]), Vec3d(hi[0]), margin) && !touches(ctx.target, Vec3d(lo[1]), Vec3d(hi[1]), margin))
                 return;
         }
         ++ctx.leaves;
