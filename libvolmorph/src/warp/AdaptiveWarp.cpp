@@ -343,13 +343,13 @@ VOLMORPH_ALWAYS_INLINE inline void fillLeafBody(LeafJob& job, WarpLeaf& leaf)
     }
     // B at each row's first voxel, each side.
     alignas(32) float bStart[6][64];
-    float bStep[6];
+    v8f bStep[6]; // B's steps at each voxel of a row
     const Vec3d bs0 = job.bS.apply(job.origin), bt0 = job.bT.apply(job.origin);
     for (int c = 0; c < 3; ++c) {
         rowAffine(bs0[c], job.bS.col[0][c], job.bS.col[1][c], bStart[c]);
         rowAffine(bt0[c], job.bT.col[0][c], job.bT.col[1][c], bStart[3 + c]);
-        bStep[c] = float(job.bS.col[2][c]);
-        bStep[3 + c] = float(job.bT.col[2][c]);
+        bStep[c] = kZ * float(job.bS.col[2][c]);
+        bStep[3 + c] = kZ * float(job.bT.col[2][c]);
     }
 
     for (int r = 0; r < 64; ++r) {
@@ -361,8 +361,8 @@ VOLMORPH_ALWAYS_INLINE inline void fillLeafBody(LeafJob& job, WarpLeaf& leaf)
         addNearRow<FeatureType::Box, InverseSquare>(job, job.typeEnd[2], job.typeEnd[3], r, acc);
         const v8f inv = 1.0f / acc[0];
         for (int c = 0; c < 3; ++c) {
-            store(leaf.s[c] + 8 * r, bStart[c][r] + (kZ * bStep[c] + acc[1 + c] * inv));
-            store(leaf.t[c] + 8 * r, bStart[3 + c][r] + (kZ * bStep[3 + c] + acc[4 + c] * inv));
+            store(leaf.s[c] + 8 * r, bStart[c][r] + (bStep[c] + acc[1 + c] * inv));
+            store(leaf.t[c] + 8 * r, bStart[3 + c][r] + (bStep[3 + c] + acc[4 + c] * inv));
         }
     }
 }
