@@ -36,9 +36,14 @@
 //    occupied block of both sides (widened by the sampler's reach) is skipped; blocks of 2^3
 //    leaves are judged first, from every other lattice point. A leaf kept only by the bound's
 //    margin is checked again on its filled points.
-// 5. Each leaf is filled by one kernel (far sums along rows, near pairs, the points) whose loops
-//    run over rows of 8 voxels in single precision; it is compiled for AVX2 and for the baseline
-//    and picked by the CPU, with the same bits from both (no FMA contraction in this file).
+// 5. The arithmetic runs on 8-lane vectors (GCC's vector extension). The bound's per-pair terms
+//    take 8 pairs at a time in single precision (its rounding, about 1e-7 of each term, is far
+//    inside its slack; weights beyond single precision send the leaf to the exact path); the
+//    lattice's exact sums take 4 pairs at a time in double. Each leaf is filled by one kernel, row
+//    by row (a row of 8 voxels along z is one vector, kept in registers from the far sums through
+//    the near pairs to the point), in single precision as the points are stored. Each of these is
+//    compiled for AVX2 and for the baseline and picked by the CPU, with the same bits from both (no
+//    FMA contraction in this file).
 //
 // Lerios et al. (1995) interpolated the warp over an adaptive grid checked at the next finer
 // lattice; here no sample decides the error, and the exact warp is evaluated at about one point
@@ -86,8 +91,9 @@ struct AdaptiveWarpStats {
     uint64_t leaves = 0;             ///< leaves visited (the candidate domain)
 };
 
-/// The leaf kernel runs in AVX2 where the CPU has it, with the same bits as the baseline kernel;
-/// true forces the baseline (process-wide; for tests that compare the two).
+/// The leaf kernel, the bound and the lattice's sums run in AVX2 where the CPU has it, with the
+/// same bits as their baseline builds; true forces the baselines (process-wide; for tests that
+/// compare the two).
 void useBaselineKernel(bool baseline);
 
 class AdaptiveWarp {
