@@ -175,6 +175,13 @@ VOLMORPH_ALWAYS_INLINE inline void store8(float* p, v8f v) { *reinterpret_cast<v
 VOLMORPH_ALWAYS_INLINE inline v8f vmax(v8f a, v8f b) { return a > b ? a : b; }
 VOLMORPH_ALWAYS_INLINE inline v8f vmin(v8f a, v8f b) { return a < b ? a : b; }
 VOLMORPH_ALWAYS_INLINE inline v8f splat8(float v) { return v8f{v, v, v, v, v, v, v, v}; }
+
+/// max(|q| - half, 0): how far a point lies beyond an element's half-extent along one of its axes.
+template <class V>
+VOLMORPH_ALWAYS_INLINE inline V outside(V q, V half)
+{
+    return vmax(vabs(q) - half, V{});
+}
 VOLMORPH_ALWAYS_INLINE inline v4d vmin(v4d a, v4d b) { return a < b ? a : b; }
 VOLMORPH_ALWAYS_INLINE inline v4d splat(double v) { return v4d{v, v, v, v}; }
 
@@ -182,11 +189,7 @@ VOLMORPH_ALWAYS_INLINE inline v4d splat(double v) { return v4d{v, v, v, v}; }
 template <FeatureType T>
 VOLMORPH_ALWAYS_INLINE inline v8f frameDistance(v8f qx, v8f qy, v8f qz, float hx, float hy, float hz)
 {
-    // max(|v| - half, 0), one vector max.
-    auto out = [](v8f v, float half) {
-        const v8f a = vabs(v) - half;
-        return a > 0.0f ? a : v8f{};
-    };
+    auto out = [](v8f v, float half) { return outside(v, splat8(half)); };
     if constexpr (T == FeatureType::Point) return vsqrt(qx * qx + qy * qy + qz * qz);
     if constexpr (T == FeatureType::Segment) {
         const v8f a = out(qx, hx);
@@ -283,8 +286,7 @@ VOLMORPH_ALWAYS_INLINE inline void fillLeafBody(LeafJob& job, WarpLeaf& leaf)
             for (int k = 0; k < 3; ++k) {
                 const Vec3d& a = *axes[k];
                 const v4d q = q0[k] + cx * a.x() + cy * a.y() + cz * a.z();
-                const v4d outside = vabs(q) - t.half[k];
-                const v4d d = 0.5 * (outside + vabs(outside));
+                const v4d d = outside(q, splat(t.half[k]));
                 out2 += d * d;
             }
             const v4d r = job.offset + vsqrt(out2);
@@ -606,9 +608,9 @@ VOLMORPH_ALWAYS_INLINE inline void AdaptiveWarp::analyzeBody(Context& ctx, const
         v8i inside = load8(&col.box[i]) != zero;
         for (int k = 0; k < 3; ++k) {
             q[k] = load8(&col.axis[k][0][i]) * p[0] + load8(&col.axis[k][1][i]) * p[1] + load8(&col.axis[k][2][i]) * p[2];
-            const v8f outside = vmax(vabs(q[k]) - load8(&col.half[k][i]), zero);
-            out2 += outside * outside;
-            v[k] = q[k] < zero ? -outside : outside;
+            const v8f d = outside(q[k], load8(&col.half[k][i]));
+            out2 += d * d;
+            v[k] = q[k] < zero ? -d : d;
             inside &= vabs(q[k]) + hf * load8(&col.reach[k][i]) <= load8(&col.half[k][i]);
         }
         const v8f d = vsqrt(out2);
@@ -790,9 +792,8 @@ VOLMORPH_ALWAYS_INLINE inline bool AdaptiveWarp::exactSumsBody(const Vec3d& x, L
         v4d out2 = zero;
         for (int k = 0; k < 3; ++k) {
             const v4d q = load4(&col.axis[k][0][i]) * p[0] + load4(&col.axis[k][1][i]) * p[1] + load4(&col.axis[k][2][i]) * p[2];
-            const v4d a = vabs(q) - load4(&col.half[k][i]);
-            const v4d outside = 0.5 * (a + vabs(a));
-            out2 += outside * outside;
+            const v4d d = outside(q, load4(&col.half[k][i]));
+            out2 += d * d;
         }
         const v4d d = vsqrt(out2), r = d + offset;
         const v4l live = load4(&col.live[i]) != zero;
