@@ -182,7 +182,6 @@ VOLMORPH_ALWAYS_INLINE inline V outside(V q, V half)
 {
     return vmax(vabs(q) - half, V{});
 }
-VOLMORPH_ALWAYS_INLINE inline v4d vmin(v4d a, v4d b) { return a < b ? a : b; }
 VOLMORPH_ALWAYS_INLINE inline v4d splat(double v) { return v4d{v, v, v, v}; }
 
 /// Distance in the element's frame at a row's 8 voxels, per type.
@@ -499,16 +498,14 @@ void fillLeafBaseline(LeafJob& job, WarpLeaf& leaf)
 
 std::atomic<bool> gBaselineKernel{false};
 
+#ifdef VOLMORPH_HAVE_AVX2_KERNEL
 /// True where the AVX2 builds of the kernels run.
 bool avx2Kernel()
 {
-#ifdef VOLMORPH_HAVE_AVX2_KERNEL
     static const bool avx2 = __builtin_cpu_supports("avx2");
     return avx2 && !gBaselineKernel.load(std::memory_order_relaxed);
-#else
-    return false;
-#endif
 }
+#endif
 
 void fillLeaf(LeafJob& job, WarpLeaf& leaf)
 {
