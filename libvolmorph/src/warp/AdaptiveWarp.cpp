@@ -124,10 +124,6 @@ double linearDistance(const InverseWarp::Affine& a, const InverseWarp::Affine& b
                      (a.col[2] - b.col[2]).lengthSqr());
 }
 
-#if defined(__GNUC__) && !defined(__clang__)
-// The 8-lane helpers below are always inlined; their by-value vector ABI never applies.
-#pragma GCC diagnostic ignored "-Wpsabi"
-#endif
 
 // The leaf kernel works on rows of 8 voxels along z, one 8-lane vector each (GCC's vector
 // extension: one AVX register, or two SSE ones in the baseline build; the same IEEE operations
@@ -188,17 +184,16 @@ VOLMORPH_ALWAYS_INLINE inline v4d splat(double v) { return v4d{v, v, v, v}; }
 template <FeatureType T>
 VOLMORPH_ALWAYS_INLINE inline v8f frameDistance(v8f qx, v8f qy, v8f qz, float hx, float hy, float hz)
 {
-    auto out = [](v8f v, float half) { return outside(v, splat8(half)); };
     if constexpr (T == FeatureType::Point) return vsqrt(qx * qx + qy * qy + qz * qz);
     if constexpr (T == FeatureType::Segment) {
-        const v8f a = out(qx, hx);
+        const v8f a = outside(qx, splat8(hx));
         return vsqrt(a * a + qy * qy + qz * qz);
     }
     if constexpr (T == FeatureType::Rectangle) {
-        const v8f a = out(qx, hx), b = out(qy, hy);
+        const v8f a = outside(qx, splat8(hx)), b = outside(qy, splat8(hy));
         return vsqrt(a * a + b * b + qz * qz);
     }
-    const v8f a = out(qx, hx), b = out(qy, hy), c = out(qz, hz);
+    const v8f a = outside(qx, splat8(hx)), b = outside(qy, splat8(hy)), c = outside(qz, splat8(hz));
     return vsqrt(a * a + b * b + c * c);
 }
 
