@@ -26,11 +26,6 @@ public:
     /// The exact warp: p' -> (source point, target point).
     void map(const Vec3d& p, Vec3d& source, Vec3d& target) const;
 
-    /// The exact warp's unnormalized sums at p: W = sum w_i, S = sum w_i p_S,i, T = sum w_i p_T,i, so
-    /// that map() gives S / W and T / W. False where p lies on an element and the weight law has no
-    /// offset (the weight is infinite there; map() takes the mean of such pairs).
-    bool sums(const Vec3d& p, double& W, Vec3d& S, Vec3d& T) const;
-
     /// Every weight follows w_i(d) = scale_i (offset + d)^-exponent: inverse square is scale 1,
     /// offset epsilon, exponent 2; Beier-Neely is scale length_i^(p b), offset a, exponent b.
     /// Lengths (offset, d) are in the units the warp was built with.

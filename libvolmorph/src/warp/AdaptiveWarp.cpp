@@ -35,7 +35,7 @@ struct LeafJob;
 /// Everything the error bound needs of each pair over a cube, one column per quantity (single
 /// precision: its rounding, some 1e-7 of each term, is far inside the bound's slack).
 struct PairBounds {
-    enum Column { DC, DMin, RMin, RMax, WMax, WMin, WC, W1, W2, Constant, Resid, RS0, RS1, RS2, RT0, RT1, RT2, Term, Hess, Count };
+    enum Column { RMin, WMax, WMin, WC, W1, W2, Constant, Resid, RS0, RS1, RS2, RT0, RT1, RT2, Term, Hess, Count };
     std::vector<float> storage;
     size_t stride = 0;
     void resize(size_t n)
@@ -84,7 +84,6 @@ struct PairColumns {
     std::vector<Real> box;             ///< 1 for boxes
     std::vector<Real> live;            ///< 1 for the pairs, 0 for the padding
     std::vector<Real> affine[2][4][3]; ///< [side][column][a]: the affine maps (column 3: offset)
-    std::vector<Real> slope;           ///< [j * padded + i]: |M_i - M_j|, the larger side
 
     PairColumns(const InverseWarp& warp, const std::vector<InverseWarp::Affine> maps[2]);
 };
@@ -94,6 +93,7 @@ struct PairColumns {
 struct AdaptiveWarp::Columns {
     PairColumns<double> exact; ///< for the lattice's exact sums
     PairColumns<float> bound;  ///< for the bound (analyze())
+    std::vector<float> slope;  ///< [j * padded + i]: |M_i - M_j|, the larger side (the bound's)
 };
 
 struct AdaptiveWarp::Context {
@@ -125,18 +125,27 @@ double linearDistance(const InverseWarp::Affine& a, const InverseWarp::Affine& b
 }
 
 
-// The leaf kernel works on rows of 8 voxels along z, one 8-lane vector each (GCC's vector
-// extension: one AVX register, or two SSE ones in the baseline build; the same IEEE operations
-// per lane in both).
-typedef float v8f __attribute__((vector_size(32), __may_alias__));
-typedef int v8i __attribute__((vector_size(32), __may_alias__));
+// The warp's vector arithmetic uses GCC's vector extension: one AVX register, or two SSE ones in
+// the baseline build, with the same IEEE operations per lane in both. 8 floats: the kernel's rows
+// of 8 voxels along z and the bound's 8 pairs; 4 doubles: the exact sums' 4 pairs and a leaf's 4
+// corners. Loads and stores are unaligned (std::vector's storage is only 16-byte aligned) and go
+// through types that alias their element type only, not the vectors' own pointers.
+typedef float v8f __attribute__((vector_size(32)));
+typedef int v8i __attribute__((vector_size(32)));
+typedef float v8fu __attribute__((vector_size(32), aligned(4)));
+typedef double v4d __attribute__((vector_size(32)));
+typedef long long v4l __attribute__((vector_size(32)));
+typedef double v4du __attribute__((vector_size(32), aligned(8)));
 
 /// The voxels' offsets along a row (z).
 constexpr v8f kZ = {0, 1, 2, 3, 4, 5, 6, 7};
 
-VOLMORPH_ALWAYS_INLINE inline v8f load(const float* p) { return *reinterpret_cast<const v8f*>(p); }
-VOLMORPH_ALWAYS_INLINE inline void store(float* p, v8f v) { *reinterpret_cast<v8f*>(p) = v; }
+VOLMORPH_ALWAYS_INLINE inline v8f load8(const float* p) { return *reinterpret_cast<const v8fu*>(p); }
+VOLMORPH_ALWAYS_INLINE inline void store8(float* p, v8f v) { *reinterpret_cast<v8fu*>(p) = v; }
+VOLMORPH_ALWAYS_INLINE inline v8f splat8(float v) { return v8f{v, v, v, v, v, v, v, v}; }
 VOLMORPH_ALWAYS_INLINE inline v8f vabs(v8f v) { return reinterpret_cast<v8f>(reinterpret_cast<v8i>(v) & 0x7fffffff); }
+VOLMORPH_ALWAYS_INLINE inline v8f vmax(v8f a, v8f b) { return a > b ? a : b; }
+VOLMORPH_ALWAYS_INLINE inline v8f vmin(v8f a, v8f b) { return a < b ? a : b; }
 VOLMORPH_ALWAYS_INLINE inline v8f vsqrt(v8f v)
 {
     v8f r;
@@ -144,33 +153,20 @@ VOLMORPH_ALWAYS_INLINE inline v8f vsqrt(v8f v)
     return r;
 }
 
-// The bound's per-pair loops take 4 pairs at a time in double precision (one AVX register, or
-// two SSE ones in the baseline build; the same IEEE operations per lane in both).
-typedef double v4d __attribute__((vector_size(32), __may_alias__));
-typedef long long v4l __attribute__((vector_size(32), __may_alias__));
-
-// std::vector's storage is only 16-byte aligned: unaligned loads and stores, through a type
-// that aliases doubles only (not the vectors' own pointers, as memcpy would).
-typedef double v4du __attribute__((vector_size(32), aligned(8)));
 VOLMORPH_ALWAYS_INLINE inline v4d load4(const double* p) { return *reinterpret_cast<const v4du*>(p); }
 VOLMORPH_ALWAYS_INLINE inline void store4(double* p, v4d v) { *reinterpret_cast<v4du*>(p) = v; }
+VOLMORPH_ALWAYS_INLINE inline v4d splat(double v) { return v4d{v, v, v, v}; }
 VOLMORPH_ALWAYS_INLINE inline v4d vabs(v4d v)
 {
     return reinterpret_cast<v4d>(reinterpret_cast<v4l>(v) & 0x7fffffffffffffffLL);
 }
+VOLMORPH_ALWAYS_INLINE inline v4d vmax(v4d a, v4d b) { return a > b ? a : b; }
 VOLMORPH_ALWAYS_INLINE inline v4d vsqrt(v4d v)
 {
     v4d r;
     for (int l = 0; l < 4; ++l) r[l] = __builtin_sqrt(v[l]);
     return r;
 }
-VOLMORPH_ALWAYS_INLINE inline v4d vmax(v4d a, v4d b) { return a > b ? a : b; }
-typedef float v8fu __attribute__((vector_size(32), aligned(4)));
-VOLMORPH_ALWAYS_INLINE inline v8f load8(const float* p) { return *reinterpret_cast<const v8fu*>(p); }
-VOLMORPH_ALWAYS_INLINE inline void store8(float* p, v8f v) { *reinterpret_cast<v8fu*>(p) = v; }
-VOLMORPH_ALWAYS_INLINE inline v8f vmax(v8f a, v8f b) { return a > b ? a : b; }
-VOLMORPH_ALWAYS_INLINE inline v8f vmin(v8f a, v8f b) { return a < b ? a : b; }
-VOLMORPH_ALWAYS_INLINE inline v8f splat8(float v) { return v8f{v, v, v, v, v, v, v, v}; }
 
 /// max(|q| - half, 0): how far a point lies beyond an element's half-extent along one of its axes.
 template <class V>
@@ -178,7 +174,6 @@ VOLMORPH_ALWAYS_INLINE inline V outside(V q, V half)
 {
     return vmax(vabs(q) - half, V{});
 }
-VOLMORPH_ALWAYS_INLINE inline v4d splat(double v) { return v4d{v, v, v, v}; }
 
 /// Distance in the element's frame at a row's 8 voxels, per type.
 template <FeatureType T>
@@ -202,7 +197,7 @@ VOLMORPH_ALWAYS_INLINE inline v8f frameDistance(v8f qx, v8f qy, v8f qz, float hx
 VOLMORPH_ALWAYS_INLINE inline void rowAffine(double a, double b, double c, float out[64])
 {
     const v8f step = kZ * float(c);
-    for (int i = 0; i < 8; ++i) store(out + 8 * i, float(a + b * i) + step);
+    for (int i = 0; i < 8; ++i) store8(out + 8 * i, float(a + b * i) + step);
 }
 
 /// One near pair's share of a leaf: its element, weight scale and residuals R = A - B at the
@@ -267,10 +262,13 @@ VOLMORPH_ALWAYS_INLINE inline void addNearRow(const LeafJob& job, size_t begin, 
 template <bool InverseSquare>
 VOLMORPH_ALWAYS_INLINE inline void fillLeafBody(LeafJob& job, WarpLeaf& leaf)
 {
-    // The far sums at the corners: the exact sums less each near pair's weight w and w R (R =
-    // A - B), in double, 4 corners at a time (z = 0, then z = 8).
+    // Per near pair: its weight w and w R (R = A - B) at the corners, taken off the exact sums
+    // there, in double, 4 corners at a time (z = 0, then z = 8): what remains are the far sums.
+    // Then its frame coordinates and residuals at each row's first voxel, and their steps.
     const v4d cx = {0, 8, 0, 8}, cy = {0, 0, 8, 8};
-    for (const NearTerm& t : job.near) {
+    job.rows.resize(job.near.size());
+    for (size_t p = 0; p < job.near.size(); ++p) {
+        const NearTerm& t = job.near[p];
         const Feature& e = *t.element;
         const Vec3d q0 = e.frameCoordinates(job.origin);
         const Vec3d* axes[3] = {&e.x, &e.y, &e.z};
@@ -301,29 +299,7 @@ VOLMORPH_ALWAYS_INLINE inline void fillLeafBody(LeafJob& job, WarpLeaf& leaf)
                 store4(ft, load4(ft) - w * rt);
             }
         }
-    }
-    // The far sums at each row's first voxel and their step along it, channels as acc below:
-    // bilinear in x (the row's i) in double, then in y (lanes j) in single precision.
-    alignas(32) float farStart[7][64], farStep[7][64];
-    const v8f J = kZ * 0.125f;
-    for (int c = 0; c < 7; ++c) {
-        const double* v = job.far[c];
-        for (int i = 0; i < 8; ++i) {
-            const double fx = i / 8.0;
-            const float a0 = float(v[0] + fx * (v[1] - v[0])), c0 = float(v[2] + fx * (v[3] - v[2]));
-            const float a1 = float(v[4] + fx * (v[5] - v[4])), c1 = float(v[6] + fx * (v[7] - v[6]));
-            const v8f z0 = a0 + J * (c0 - a0), z1 = a1 + J * (c1 - a1);
-            store(farStart[c] + 8 * i, z0);
-            store(farStep[c] + 8 * i, (z1 - z0) * 0.125f);
-        }
-    }
-    // The near pairs' frame coordinates and residuals at each row's first voxel.
-    job.rows.resize(job.near.size());
-    for (size_t p = 0; p < job.near.size(); ++p) {
-        const NearTerm& t = job.near[p];
-        const Feature& e = *t.element;
         NearRows& n = job.rows[p];
-        const Vec3d q0 = e.frameCoordinates(job.origin);
         // Steps of the frame coordinates along x, y and z: the frame's rows.
         const Vec3d dx(e.x.x(), e.y.x(), e.z.x()), dy(e.x.y(), e.y.y(), e.z.y()), dz(e.x.z(), e.y.z(), e.z.z());
         for (int c = 0; c < 3; ++c) {
@@ -336,6 +312,21 @@ VOLMORPH_ALWAYS_INLINE inline void fillLeafBody(LeafJob& job, WarpLeaf& leaf)
             n.half[c] = float(0.5 * e.scale[c]);
         }
         n.scale = float(t.scale);
+    }
+    // The far sums at each row's first voxel and their step along it, channels as acc below:
+    // bilinear in x (the row's i) in double, then in y (lanes j) in single precision.
+    alignas(32) float farStart[7][64], farStep[7][64];
+    const v8f J = kZ * 0.125f;
+    for (int c = 0; c < 7; ++c) {
+        const double* v = job.far[c];
+        for (int i = 0; i < 8; ++i) {
+            const double fx = i / 8.0;
+            const float a0 = float(v[0] + fx * (v[1] - v[0])), c0 = float(v[2] + fx * (v[3] - v[2]));
+            const float a1 = float(v[4] + fx * (v[5] - v[4])), c1 = float(v[6] + fx * (v[7] - v[6]));
+            const v8f z0 = a0 + J * (c0 - a0), z1 = a1 + J * (c1 - a1);
+            store8(farStart[c] + 8 * i, z0);
+            store8(farStep[c] + 8 * i, (z1 - z0) * 0.125f);
+        }
     }
     // B at each row's first voxel, each side.
     alignas(32) float bStart[6][64];
@@ -357,8 +348,8 @@ VOLMORPH_ALWAYS_INLINE inline void fillLeafBody(LeafJob& job, WarpLeaf& leaf)
         addNearRow<FeatureType::Box, InverseSquare>(job, job.typeEnd[2], job.typeEnd[3], r, acc);
         const v8f inv = 1.0f / acc[0];
         for (int c = 0; c < 3; ++c) {
-            store(leaf.s[c] + 8 * r, bStart[c][r] + (bStep[c] + acc[1 + c] * inv));
-            store(leaf.t[c] + 8 * r, bStart[3 + c][r] + (bStep[3 + c] + acc[4 + c] * inv));
+            store8(leaf.s[c] + 8 * r, bStart[c][r] + (bStep[c] + acc[1 + c] * inv));
+            store8(leaf.t[c] + 8 * r, bStart[3 + c][r] + (bStep[3 + c] + acc[4 + c] * inv));
         }
     }
 }
@@ -376,7 +367,14 @@ AdaptiveWarp::AdaptiveWarp(const InverseWarp& warp, double toleranceVoxels)
         mTarget.push_back(warp.targetAffine(i));
     }
     const std::vector<InverseWarp::Affine> maps[2] = {mSource, mTarget};
-    mColumns.reset(new Columns{PairColumns<double>(warp, maps), PairColumns<float>(warp, maps)});
+    auto columns = std::make_unique<Columns>(Columns{PairColumns<double>(warp, maps), PairColumns<float>(warp, maps), {}});
+    const size_t padded = columns->bound.padded;
+    columns->slope.assign(n * padded, 0.0f);
+    for (size_t j = 0; j < n; ++j)
+        for (size_t i = 0; i < n; ++i)
+            columns->slope[j * padded + i] =
+                float(std::max(linearDistance(mSource[i], mSource[j]), linearDistance(mTarget[i], mTarget[j])));
+    mColumns = std::move(columns);
 }
 
 namespace {
@@ -410,10 +408,6 @@ PairColumns<Real>::PairColumns(const InverseWarp& warp, const std::vector<Invers
             }
         }
     }
-    slope.assign(n * padded, 0);
-    for (size_t j = 0; j < n; ++j)
-        for (size_t i = 0; i < n; ++i)
-            slope[j * padded + i] = Real(std::max(linearDistance(maps[0][i], maps[0][j]), linearDistance(maps[1][i], maps[1][j])));
 }
 
 } // namespace
@@ -516,9 +510,9 @@ VOLMORPH_ALWAYS_INLINE inline void leafRangeBody(const WarpLeaf& leaf, Vec3f lo[
     for (int side = 0; side < 2; ++side)
         for (int c = 0; c < 3; ++c) {
             const float* v = side == 0 ? leaf.s[c] : leaf.t[c];
-            v8f l = load(v), u = l;
+            v8f l = load8(v), u = l;
             for (int m = 8; m < 512; m += 8) {
-                const v8f x = load(v + m);
+                const v8f x = load8(v + m);
                 l = x < l ? x : l;
                 u = x > u ? x : u;
             }
@@ -574,10 +568,7 @@ VOLMORPH_ALWAYS_INLINE inline void AdaptiveWarp::analyzeBody(Context& ctx, const
     PairBounds& pb = ctx.bounds;
     pb.resize(padded);
     using C = PairBounds::Column;
-    float* const __restrict dc = pb[C::DC];
-    float* const __restrict dMinC = pb[C::DMin];
     float* const __restrict rMinC = pb[C::RMin];
-    float* const __restrict rMaxC = pb[C::RMax];
     float* const __restrict wMaxC = pb[C::WMax];
     float* const __restrict wMinC = pb[C::WMin];
     float* const __restrict wcC = pb[C::WC];
@@ -617,10 +608,7 @@ VOLMORPH_ALWAYS_INLINE inline void AdaptiveWarp::analyzeBody(Context& ctx, const
         // centre: over the cube, d >= dc - h/2 |g|_1.
         const v8f dMin = positive ? vmax(zero, d - (0.5f * hf) * gL1) : zero;
         const v8f rMin = offset + dMin, rMax = offset + (inside ? zero : d + halfDiagonalF);
-        store8(dc + i, d);
-        store8(dMinC + i, dMin);
         store8(rMinC + i, rMin);
-        store8(rMaxC + i, rMax);
         store8(constantC + i, inside ? one : zero);
         // Weights at the smallest and largest distance and at the centre.
         v8f wMax, wMin, wc;
@@ -678,7 +666,7 @@ VOLMORPH_ALWAYS_INLINE inline void AdaptiveWarp::analyzeBody(Context& ctx, const
     }
     const InverseWarp::Affine& bS = mSource[dominant];
     const InverseWarp::Affine& bT = mTarget[dominant];
-    const float* slope = &col.slope[dominant * padded];
+    const float* slope = &mColumns->slope[dominant * padded];
 
     // R_i = A_i - B at the centre, |R_i| over the cube on either side (|M_i - M_B| the slope),
     // and |rho| = |p - B| <= sum w_i |R_i| / W.
@@ -769,7 +757,8 @@ VOLMORPH_ALWAYS_INLINE inline void AdaptiveWarp::analyzeBody(Context& ctx, const
     ctx.boundAllFar = std::min(ctx.boundAllFar, bound(ctx, terms, hess));
 }
 
-/// InverseWarp::sums over the pairs' columns, 4 pairs at a time.
+/// The exact warp's unnormalized sums W = sum w_i, S = sum w_i A_S,i, T = sum w_i A_T,i at x (so
+/// that S / W and T / W are InverseWarp::map's points), over the pairs' columns, 4 at a time.
 VOLMORPH_ALWAYS_INLINE inline bool AdaptiveWarp::exactSumsBody(const Vec3d& x, LatticePoint& out) const
 {
     const size_t n = mWarp.pairCount();

@@ -128,8 +128,8 @@ private:
     /// The bound's terms for the cube of `size` (4, 8 or 16) voxels at origin, from the exact
     /// sums at its corners (bit 0: +x, bit 1: +y, bit 2: +z), into ctx.
     void analyze(Context& ctx, const LatticePoint* const corners[8], const openvdb::Coord& origin, int size) const;
-    /// The exact sums W, S and T at x (InverseWarp::sums, by the pairs' columns); false where x
-    /// lies on an element with a zero offset.
+    /// The exact warp's unnormalized sums W, S and T at x (map() gives S / W and T / W), by the
+    /// pairs' columns; false where x lies on an element and the weight law has no offset.
     bool exactSums(const Vec3d& x, LatticePoint& out) const;
     bool exactSumsBody(const Vec3d& x, LatticePoint& out) const;
     bool exactSumsAvx2(const Vec3d& x, LatticePoint& out) const;

@@ -42,24 +42,6 @@ double InverseWarp::weightScale(size_t i) const
     return mWeighting == Weighting::InverseSquare ? 1.0 : std::pow(mPairs[i].lengthPow, mB);
 }
 
-bool InverseWarp::sums(const Vec3d& p, double& W, Vec3d& S, Vec3d& T) const
-{
-    W = 0.0;
-    S = T = Vec3d(0.0);
-    for (const Pair& pair : mPairs) {
-        const Vec3d q = pair.element.frameCoordinates(p);
-        const double d = pair.element.distanceInFrame(q);
-        if (d + weightOffset() < InverseWarp::kOnElement) return false;
-        const double w = weight(pair, d);
-        Vec3d ps, pt;
-        images(pair, q, ps, pt);
-        S += w * ps;
-        T += w * pt;
-        W += w;
-    }
-    return std::isfinite(W) && W > 0.0;
-}
-
 void InverseWarp::map(const Vec3d& p, Vec3d& source, Vec3d& target) const
 {
     if (mPairs.empty()) {
