@@ -16,6 +16,7 @@
 #include <openvdb/tools/Interpolation.h>
 #include <openvdb/tree/LeafManager.h>
 
+#include <cstring>
 #include <filesystem>
 #include <map>
 #include <mutex>
@@ -82,6 +83,25 @@ const Setup& setup(int across)
     return it->second;
 }
 
+/// Reads every coordinate of a leaf's points, cheaply: the bits are xor-ed, which vectorizes (a
+/// float sum would be a serial chain of 3072 additions, some 10% of the approximated warp's time,
+/// measured as if it were the warp's).
+uint32_t consume(const detail::WarpLeaf& leaf)
+{
+    uint32_t bits[8] = {};
+    for (int c = 0; c < 3; ++c)
+        for (int i = 0; i < 512; i += 8)
+            for (int l = 0; l < 8; ++l) {
+                uint32_t a, b;
+                std::memcpy(&a, &leaf.s[c][i + l], 4);
+                std::memcpy(&b, &leaf.t[c][i + l], 4);
+                bits[l] ^= a ^ b;
+            }
+    uint32_t all = 0;
+    for (uint32_t b : bits) all ^= b;
+    return all;
+}
+
 /// The warp alone over the frame's candidate domain: positions are computed and consumed.
 void warpOnly(benchmark::State& state, double tolerance)
 {
@@ -98,11 +118,7 @@ void warpOnly(benchmark::State& state, double tolerance)
     for (auto _ : state) {
         stats = {};
         adaptive.forEachLeaf(box, &occS, &occT,
-                             [&](const detail::WarpLeaf& leaf) {
-                                 float sum = 0.0f;
-                                 for (int i = 0; i < 512; ++i) sum += leaf.source(i).x() + leaf.target(i).y();
-                                 sink += uint64_t(sum != 0.0f);
-                             },
+                             [&](const detail::WarpLeaf& leaf) { sink += consume(leaf); },
                              &stats);
     }
     state.counters["leaves"] = double(stats.leaves);
