@@ -232,14 +232,17 @@ struct LeafJob {
     bool inverseSquare;
 };
 
-/// Adds the near pairs of type T, [begin, end), at row r: weight into acc[0], weighted residuals
-/// into acc[1..6] (source x, y, z, target x, y, z).
+/// Adds the near pairs of type T, [begin, end), at every row r: weight into sums[r][0], weighted
+/// residuals into sums[r][1..6] (source x, y, z, target x, y, z). Pair by pair, so that the rows'
+/// square roots and divisions are independent of each other and overlap.
 template <FeatureType T, bool InverseSquare>
-VOLMORPH_ALWAYS_INLINE inline void addNearRow(const LeafJob& job, size_t begin, size_t end, int r, v8f acc[7])
+VOLMORPH_ALWAYS_INLINE inline void addNearPairs(const LeafJob& job, size_t begin, size_t end, v8f sums[64][7])
 {
     const float off = float(job.offset);
     for (size_t p = begin; p < end; ++p) {
-        const NearRows& n = job.rows[p];
+      const NearRows& n = job.rows[p];
+      for (int r = 0; r < 64; ++r) {
+        v8f* acc = sums[r];
         const v8f qx = n.start[0][r] + n.step[0];
         const v8f qy = n.start[1][r] + n.step[1];
         const v8f qz = n.start[2][r] + n.step[2];
@@ -252,13 +255,14 @@ VOLMORPH_ALWAYS_INLINE inline void addNearRow(const LeafJob& job, size_t begin, 
         }
         acc[0] += w;
         for (int c = 0; c < 6; ++c) acc[1 + c] += w * (n.start[3 + c][r] + n.step[3 + c]);
+      }
     }
 }
 
-/// Fills a leaf row by row: the far sums interpolated (bilinear at each row's first voxel, linear
-/// along the row), the near pairs added, then p = B(x) + residual sum / weight sum, all in single
-/// precision as the points are stored (its rounding, some 1e-5 voxel at hundreds of voxels from
-/// the origin, is far below a tolerance). Each row stays in registers from the sums to the point.
+/// Fills a leaf by rows of 8 voxels along z: the far sums interpolated (bilinear at each row's
+/// first voxel, linear along the row), the near pairs added pair by pair over all rows, then
+/// p = B(x) + residual sum / weight sum, all in single precision as the points are stored (its
+/// rounding, some 1e-5 voxel at hundreds of voxels from the origin, is far below a tolerance).
 template <bool InverseSquare>
 VOLMORPH_ALWAYS_INLINE inline void fillLeafBody(LeafJob& job, WarpLeaf& leaf)
 {
@@ -339,13 +343,15 @@ VOLMORPH_ALWAYS_INLINE inline void fillLeafBody(LeafJob& job, WarpLeaf& leaf)
         bStep[3 + c] = kZ * float(job.bT.col[2][c]);
     }
 
+    alignas(32) v8f sums[64][7];
+    for (int r = 0; r < 64; ++r)
+        for (int c = 0; c < 7; ++c) sums[r][c] = farStart[c][r] + kZ * farStep[c][r];
+    addNearPairs<FeatureType::Point, InverseSquare>(job, 0, job.typeEnd[0], sums);
+    addNearPairs<FeatureType::Segment, InverseSquare>(job, job.typeEnd[0], job.typeEnd[1], sums);
+    addNearPairs<FeatureType::Rectangle, InverseSquare>(job, job.typeEnd[1], job.typeEnd[2], sums);
+    addNearPairs<FeatureType::Box, InverseSquare>(job, job.typeEnd[2], job.typeEnd[3], sums);
     for (int r = 0; r < 64; ++r) {
-        v8f acc[7];
-        for (int c = 0; c < 7; ++c) acc[c] = farStart[c][r] + kZ * farStep[c][r];
-        addNearRow<FeatureType::Point, InverseSquare>(job, 0, job.typeEnd[0], r, acc);
-        addNearRow<FeatureType::Segment, InverseSquare>(job, job.typeEnd[0], job.typeEnd[1], r, acc);
-        addNearRow<FeatureType::Rectangle, InverseSquare>(job, job.typeEnd[1], job.typeEnd[2], r, acc);
-        addNearRow<FeatureType::Box, InverseSquare>(job, job.typeEnd[2], job.typeEnd[3], r, acc);
+        const v8f* acc = sums[r];
         const v8f inv = 1.0f / acc[0];
         for (int c = 0; c < 3; ++c) {
             store8(leaf.s[c] + 8 * r, bStart[c][r] + (bStep[c] + acc[1 + c] * inv));

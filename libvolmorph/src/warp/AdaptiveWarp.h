@@ -39,9 +39,10 @@
 // 5. The arithmetic runs on 8-lane vectors (GCC's vector extension). The bound's per-pair terms
 //    take 8 pairs at a time in single precision (its rounding, about 1e-7 of each term, is far
 //    inside its slack; weights beyond single precision send the leaf to the exact path); the
-//    lattice's exact sums take 4 pairs at a time in double. Each leaf is filled by one kernel, row
-//    by row (a row of 8 voxels along z is one vector, kept in registers from the far sums through
-//    the near pairs to the point), in single precision as the points are stored. Each of these is
+//    lattice's exact sums take 4 pairs at a time in double. Each leaf is filled by one kernel on rows
+//    of 8 voxels along z (one vector each): the far sums of every row, then each near pair added
+//    over all rows (its rows' square roots and divisions independent, so they overlap), then the
+//    points, in single precision as they are stored. Each of these is
 //    compiled for AVX2 and for the baseline and picked by the CPU, with the same bits from both (no
 //    FMA contraction in this file).
 //
