@@ -2,6 +2,7 @@
 #include <volmorph/Morph.h>
 #include <volmorph/Warp.h>
 
+#include "Stretch.h"
 #include "warp/AdaptiveWarp.h"
 
 #include <volmorph/Diagnostics.h>
@@ -623,13 +624,7 @@ public:
         std::vector<float> stretch(count, 1.0f);
         if (mWarp.pairCount() > 0) {
             std::vector<float> own(count, 1.0f);
-            auto norm = [](const Vec3d& dx, const Vec3d& dy, const Vec3d& dz) {
-                const openvdb::math::Mat3d j(dx.x(), dy.x(), dz.x(), dx.y(), dy.y(), dz.y(), dx.z(), dy.z(), dz.z());
-                openvdb::math::Mat3d q;
-                Vec3d eigen;
-                openvdb::math::diagonalizeSymmetricMatrix(j.transpose() * j, q, eigen);
-                return std::sqrt(std::max({eigen.x(), eigen.y(), eigen.z(), 0.0})) / 8.0;
-            };
+            auto norm = [](const Vec3d& dx, const Vec3d& dy, const Vec3d& dz) { return detail::spectralNorm(dx, dy, dz) / 8.0; };
             auto diff = [&](const std::vector<Vec3d>& p, int x, int y, int z, int axis) {
                 Coord a(x, y, z), b(x, y, z);
                 if (b[axis] + 1 < n[axis]) b[axis] += 1;
@@ -637,23 +632,27 @@ public:
                 else return Vec3d(0.0);
                 return p[index(b.x(), b.y(), b.z())] - p[index(a.x(), a.y(), a.z())];
             };
-            for (int x = 0; x < n.x(); ++x)
-                for (int y = 0; y < n.y(); ++y)
-                    for (int z = 0; z < n.z(); ++z) {
-                        const double s = norm(diff(ps, x, y, z, 0), diff(ps, x, y, z, 1), diff(ps, x, y, z, 2));
-                        const double t = norm(diff(pt, x, y, z, 0), diff(pt, x, y, z, 1), diff(pt, x, y, z, 2));
-                        own[index(x, y, z)] = float((1.0 - mTau) * s + mTau * t);
-                    }
-            for (int x = 0; x < n.x(); ++x)
-                for (int y = 0; y < n.y(); ++y)
-                    for (int z = 0; z < n.z(); ++z) {
-                        float m = 0.0f;
-                        for (int i = std::max(0, x - 1); i <= std::min(n.x() - 1, x + 1); ++i)
-                            for (int j = std::max(0, y - 1); j <= std::min(n.y() - 1, y + 1); ++j)
-                                for (int k = std::max(0, z - 1); k <= std::min(n.z() - 1, z + 1); ++k)
-                                    m = std::max(m, own[index(i, j, k)]);
-                        stretch[index(x, y, z)] = std::max(1.0f, 1.25f * m);
-                    }
+            tbb::parallel_for(tbb::blocked_range<int>(0, n.x()), [&](const tbb::blocked_range<int>& r) {
+                for (int x = r.begin(); x != r.end(); ++x)
+                    for (int y = 0; y < n.y(); ++y)
+                        for (int z = 0; z < n.z(); ++z) {
+                            const double s = norm(diff(ps, x, y, z, 0), diff(ps, x, y, z, 1), diff(ps, x, y, z, 2));
+                            const double t = norm(diff(pt, x, y, z, 0), diff(pt, x, y, z, 1), diff(pt, x, y, z, 2));
+                            own[index(x, y, z)] = float((1.0 - mTau) * s + mTau * t);
+                        }
+            });
+            tbb::parallel_for(tbb::blocked_range<int>(0, n.x()), [&](const tbb::blocked_range<int>& r) {
+                for (int x = r.begin(); x != r.end(); ++x)
+                    for (int y = 0; y < n.y(); ++y)
+                        for (int z = 0; z < n.z(); ++z) {
+                            float m = 0.0f;
+                            for (int i = std::max(0, x - 1); i <= std::min(n.x() - 1, x + 1); ++i)
+                                for (int j = std::max(0, y - 1); j <= std::min(n.y() - 1, y + 1); ++j)
+                                    for (int k = std::max(0, z - 1); k <= std::min(n.z() - 1, z + 1); ++k)
+                                        m = std::max(m, own[index(i, j, k)]);
+                            stretch[index(x, y, z)] = std::max(1.0f, 1.25f * m);
+                        }
+            });
         }
         c.maxStretch = *std::max_element(stretch.begin(), stretch.end());
         // Values are computed within the compute band (the band and one voxel more, so that every

@@ -1,6 +1,7 @@
 #include "AdaptiveWarp.h"
 
 #include <tbb/blocked_range.h>
+#include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
@@ -54,6 +55,7 @@ struct PairBounds {
 struct AdaptiveWarp::LatticePoint {
     double w = 0.0;     ///< sum w_i
     Vec3d s, t;         ///< sum w_i A_i, source and target side
+    Vec3d ps, pt;       ///< the warped points s / w and t / w
     bool ok = false;    ///< false: on an element with a zero offset, or not evaluated
 };
 
@@ -731,7 +733,7 @@ VOLMORPH_ALWAYS_INLINE inline void AdaptiveWarp::analyzeBody(Context& ctx, const
         for (int c = 0; c < 8; ++c) {
             const LatticePoint& p = *corners[c];
             const Vec3d x = o + Vec3d((c & 1) * h, ((c >> 1) & 1) * h, ((c >> 2) & 1) * h);
-            rho[c] = (side == 0 ? p.s : p.t) * (1.0 / p.w) - bA.apply(x);
+            rho[c] = (side == 0 ? p.ps : p.pt) - bA.apply(x);
             lo = minComponent(lo, rho[c]);
             hi = maxComponent(hi, rho[c]);
         }
@@ -804,6 +806,8 @@ VOLMORPH_ALWAYS_INLINE inline bool AdaptiveWarp::exactSumsBody(const Vec3d& x, L
     out.w = total(W);
     out.s = Vec3d(total(S[0]), total(S[1]), total(S[2]));
     out.t = Vec3d(total(T[0]), total(T[1]), total(T[2]));
+    out.ps = out.s * (1.0 / out.w);
+    out.pt = out.t * (1.0 / out.w);
     const bool on = onElement[0] || onElement[1] || onElement[2] || onElement[3];
     return !on && std::isfinite(out.w) && out.w > 0.0;
 }
@@ -1073,6 +1077,15 @@ void AdaptiveWarp::forEachLeaf(const CoordBBox& box, const Occupancy* source, co
     if (candidates.empty()) return;
     if (interrupter && interrupter->wasInterrupted(0)) throw Interrupted();
 
+    // One scratch context per thread (its counters summed into stats at the end).
+    tbb::enumerable_thread_specific<Context> contexts([&] {
+        Context ctx;
+        ctx.source = source;
+        ctx.target = target;
+        ctx.fn = &fn;
+        return ctx;
+    });
+
     // 2. The exact sums at the corners of the candidate leaves, each lattice point once. With
     //    occupancies, cells of 2^3 leaves are culled first from their own corners (every other
     //    lattice point), so that the leaves of a cell whose image misses both sides cost nothing.
@@ -1132,9 +1145,7 @@ void AdaptiveWarp::forEachLeaf(const CoordBBox& box, const Occupancy* source, co
             evaluate(0);
             std::vector<char> keep(begin.size() - 1, 0);
             tbb::parallel_for(tbb::blocked_range<size_t>(0, keep.size(), 16), [&](const tbb::blocked_range<size_t>& r) {
-                auto ctx = std::make_unique<Context>();
-                ctx->source = source;
-                ctx->target = target;
+                Context* ctx = &contexts.local();
                 for (size_t c = r.begin(); c != r.end(); ++c) {
                     const Coord cell = cellOf(candidates[begin[c]]);
                     const Coord l(cell.x() >> 3, cell.y() >> 3, cell.z() >> 3);
@@ -1155,26 +1166,22 @@ void AdaptiveWarp::forEachLeaf(const CoordBBox& box, const Occupancy* source, co
     }
 
     // 3. Every candidate leaf: culled by the bound, filled, culled by its points, handed on.
-    std::mutex statsMutex;
     tbb::parallel_for(tbb::blocked_range<size_t>(0, candidates.size(), 16), [&](const tbb::blocked_range<size_t>& r) {
         if (stopped || (interrupter && interrupter->wasInterrupted(10 + int(90 * r.begin() / candidates.size())))) {
             stopped = true;
             return;
         }
-        auto ctx = std::make_unique<Context>();
-        ctx->source = source;
-        ctx->target = target;
-        ctx->fn = &fn;
-        for (size_t i = r.begin(); i != r.end(); ++i) leaf(*ctx, lattice, candidates[i]);
-        if (stats) {
-            std::lock_guard<std::mutex> lock(statsMutex);
-            stats->maxErrorVoxels = std::max(stats->maxErrorVoxels, ctx->maxError);
-            stats->exactEvaluations += ctx->evaluations;
-            stats->nearEvaluations += ctx->near;
-            stats->leaves += ctx->leaves;
-        }
+        Context& ctx = contexts.local();
+        for (size_t i = r.begin(); i != r.end(); ++i) leaf(ctx, lattice, candidates[i]);
     });
     if (stopped) throw Interrupted();
+    for (const Context& ctx : contexts) {
+        if (!stats) break;
+        stats->maxErrorVoxels = std::max(stats->maxErrorVoxels, ctx.maxError);
+        stats->exactEvaluations += ctx.evaluations;
+        stats->nearEvaluations += ctx.near;
+        stats->leaves += ctx.leaves;
+    }
     if (stats) stats->exactEvaluations += latticeEvaluations;
 }
 
