@@ -3,7 +3,9 @@
 //    at 256 voxels across, for 1, 4, 16 and 64 pairs (the scene's 3, plus hand-like random ones);
 //    counter max_error_voxels is measured against the exact warp on every 3rd voxel;
 //  - a whole frame (domain, warp, resample, blend) vs its lower bound: resampling source and target
-//    once per output voxel of the same frame with the identity warp;
+//    once per output voxel of the same frame with the identity warp; in density mode (issue 4's
+//    linear blend: morphFrameDensity, identityResampleDensity) and in the default scene's sdf mode
+//    (issue 5: morphFrame, identityResample);
 //  - frames at 128, 256 and 512 voxels across: time per active voxel.
 // Run: build-bench/tests/bench/volmorph_bench_warp --benchmark_repetitions=5 --benchmark_report_aggregates_only=true
 #include <volmorph/Morph.h>
@@ -146,11 +148,13 @@ void warpOnly(benchmark::State& state, double tolerance)
 void exactWarp(benchmark::State& state) { warpOnly(state, 0.0); }
 void approximatedWarp(benchmark::State& state) { warpOnly(state, 0.25); }
 
-/// One whole frame at t = 0.5 with the scene's pairs.
-void morphFrame(benchmark::State& state)
+/// One whole frame at t = 0.5 with the scene's pairs, in the given blend mode.
+void frame(benchmark::State& state, BlendMode mode)
 {
     const Setup& s = setup(int(state.range(0)));
-    const Morpher morpher(s.volumes.source, s.volumes.target, s.scene.pairs, s.scene.warp, s.scene.blend);
+    BlendSpec blend = s.scene.blend;
+    blend.mode = mode;
+    const Morpher morpher(s.volumes.source, s.volumes.target, s.scene.pairs, s.scene.warp, blend);
     MorphStats stats;
     for (auto _ : state) {
         VolumeSet v = morpher.frame(0.5, &stats);
@@ -162,12 +166,21 @@ void morphFrame(benchmark::State& state)
                                                                 benchmark::Counter::kInvert);
 }
 
-/// The lower bound of a frame: every output voxel of the same frame resampled from source and
-/// target at its own position (identity warp) and blended, in parallel over leaves.
-void identityResample(benchmark::State& state)
+/// The default scene's frame (sdf mode: the blend of extended distances, its islands dropped,
+/// redistanced; issue 5).
+void morphFrame(benchmark::State& state) { frame(state, BlendMode::Sdf); }
+/// The frame of issue 4: domain, warp, resample, and a linear blend of density and of
+/// density-weighted colour.
+void morphFrameDensity(benchmark::State& state) { frame(state, BlendMode::Density); }
+
+/// The lower bound of a frame: every output voxel of the same frame (in the given mode) resampled
+/// from source and target at its own position (identity warp) and blended, in parallel over leaves.
+void lowerBound(benchmark::State& state, BlendMode mode)
 {
     const Setup& s = setup(int(state.range(0)));
-    const Morpher morpher(s.volumes.source, s.volumes.target, s.scene.pairs, s.scene.warp, s.scene.blend);
+    BlendSpec blend = s.scene.blend;
+    blend.mode = mode;
+    const Morpher morpher(s.volumes.source, s.volumes.target, s.scene.pairs, s.scene.warp, blend);
     VolumeSet out = morpher.frame(0.5);
     // Every output voxel counts, also those the frame stored as tiles afterwards.
     out.density->tree().voxelizeActiveTiles();
@@ -195,9 +208,14 @@ void identityResample(benchmark::State& state)
     state.counters["active_voxels"] = double(out.density->activeVoxelCount());
 }
 
+void identityResample(benchmark::State& state) { lowerBound(state, BlendMode::Sdf); }
+void identityResampleDensity(benchmark::State& state) { lowerBound(state, BlendMode::Density); }
+
 } // namespace
 
 BENCHMARK(exactWarp)->Arg(1)->Arg(4)->Arg(16)->Arg(64)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(approximatedWarp)->Arg(1)->Arg(4)->Arg(16)->Arg(64)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(morphFrame)->Arg(128)->Arg(256)->Arg(512)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(morphFrameDensity)->Arg(128)->Arg(256)->Arg(512)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(identityResample)->Arg(128)->Arg(256)->Arg(512)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(identityResampleDensity)->Arg(128)->Arg(256)->Arg(512)->Unit(benchmark::kMillisecond)->UseRealTime();
