@@ -7,7 +7,6 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
-#include <mutex>
 #include <type_traits>
 
 namespace volmorph::detail {
@@ -55,7 +54,6 @@ struct PairBounds {
 struct AdaptiveWarp::LatticePoint {
     double w = 0.0;     ///< sum w_i
     Vec3d s, t;         ///< sum w_i A_i, source and target side
-    Vec3d ps, pt;       ///< the warped points s / w and t / w
     bool ok = false;    ///< false: on an element with a zero offset, or not evaluated
 };
 
@@ -242,22 +240,22 @@ VOLMORPH_ALWAYS_INLINE inline void addNearPairs(const LeafJob& job, size_t begin
 {
     const float off = float(job.offset);
     for (size_t p = begin; p < end; ++p) {
-      const NearRows& n = job.rows[p];
-      for (int r = 0; r < 64; ++r) {
-        v8f* acc = sums[r];
-        const v8f qx = n.start[0][r] + n.step[0];
-        const v8f qy = n.start[1][r] + n.step[1];
-        const v8f qz = n.start[2][r] + n.step[2];
-        const v8f d = off + frameDistance<T>(qx, qy, qz, n.half[0], n.half[1], n.half[2]);
-        v8f w;
-        if constexpr (InverseSquare) {
-            w = 1.0f / (d * d);
-        } else {
-            for (int l = 0; l < 8; ++l) w[l] = float(double(n.scale) * std::pow(double(d[l]), -job.exponent));
+        const NearRows& n = job.rows[p];
+        for (int r = 0; r < 64; ++r) {
+            v8f* acc = sums[r];
+            const v8f qx = n.start[0][r] + n.step[0];
+            const v8f qy = n.start[1][r] + n.step[1];
+            const v8f qz = n.start[2][r] + n.step[2];
+            const v8f d = off + frameDistance<T>(qx, qy, qz, n.half[0], n.half[1], n.half[2]);
+            v8f w;
+            if constexpr (InverseSquare) {
+                w = 1.0f / (d * d);
+            } else {
+                for (int l = 0; l < 8; ++l) w[l] = float(double(n.scale) * std::pow(double(d[l]), -job.exponent));
+            }
+            acc[0] += w;
+            for (int c = 0; c < 6; ++c) acc[1 + c] += w * (n.start[3 + c][r] + n.step[3 + c]);
         }
-        acc[0] += w;
-        for (int c = 0; c < 6; ++c) acc[1 + c] += w * (n.start[3 + c][r] + n.step[3 + c]);
-      }
     }
 }
 
@@ -733,7 +731,7 @@ VOLMORPH_ALWAYS_INLINE inline void AdaptiveWarp::analyzeBody(Context& ctx, const
         for (int c = 0; c < 8; ++c) {
             const LatticePoint& p = *corners[c];
             const Vec3d x = o + Vec3d((c & 1) * h, ((c >> 1) & 1) * h, ((c >> 2) & 1) * h);
-            rho[c] = (side == 0 ? p.ps : p.pt) - bA.apply(x);
+            rho[c] = (side == 0 ? p.s : p.t) * (1.0 / p.w) - bA.apply(x);
             lo = minComponent(lo, rho[c]);
             hi = maxComponent(hi, rho[c]);
         }
@@ -806,8 +804,6 @@ VOLMORPH_ALWAYS_INLINE inline bool AdaptiveWarp::exactSumsBody(const Vec3d& x, L
     out.w = total(W);
     out.s = Vec3d(total(S[0]), total(S[1]), total(S[2]));
     out.t = Vec3d(total(T[0]), total(T[1]), total(T[2]));
-    out.ps = out.s * (1.0 / out.w);
-    out.pt = out.t * (1.0 / out.w);
     const bool on = onElement[0] || onElement[1] || onElement[2] || onElement[3];
     return !on && std::isfinite(out.w) && out.w > 0.0;
 }
@@ -1175,14 +1171,14 @@ void AdaptiveWarp::forEachLeaf(const CoordBBox& box, const Occupancy* source, co
         for (size_t i = r.begin(); i != r.end(); ++i) leaf(ctx, lattice, candidates[i]);
     });
     if (stopped) throw Interrupted();
+    if (!stats) return;
     for (const Context& ctx : contexts) {
-        if (!stats) break;
         stats->maxErrorVoxels = std::max(stats->maxErrorVoxels, ctx.maxError);
         stats->exactEvaluations += ctx.evaluations;
         stats->nearEvaluations += ctx.near;
         stats->leaves += ctx.leaves;
     }
-    if (stats) stats->exactEvaluations += latticeEvaluations;
+    stats->exactEvaluations += latticeEvaluations;
 }
 
 } // namespace volmorph::detail
