@@ -1026,15 +1026,20 @@ void AdaptiveWarp::forEachLeaf(const CoordBBox& box, const Occupancy* source, co
     const size_t n = mWarp.pairCount();
     auto down = [](int v, int size) { return v >= 0 ? v / size * size : -((-v + size - 1) / size) * size; };
 
-    // 1. Candidate leaves, gathered per top cell: cells the filter refuses, or whose image under
-    //    every pair's affine map (the warp is a convex combination of them) misses both sides'
-    //    occupied blocks, are skipped whole.
+    // 1. Candidate cells of 2^3 leaves (16 voxels), each with the mask of its leaves that lie in
+    //    the box and are wanted, gathered per top cell: top cells the filter refuses, or whose
+    //    image under every pair's affine map (the warp is a convex combination of them) misses
+    //    both sides' occupied blocks, are skipped whole.
+    struct Cell {
+        Coord origin;
+        uint8_t leaves; ///< bit (x << 2 | y << 1 | z): the leaf at origin + 8 (x, y, z)
+    };
     const Coord lo(down(box.min().x(), kTopCell), down(box.min().y(), kTopCell), down(box.min().z(), kTopCell));
     std::vector<Coord> tops;
     for (int x = lo.x(); x <= box.max().x(); x += kTopCell)
         for (int y = lo.y(); y <= box.max().y(); y += kTopCell)
             for (int z = lo.z(); z <= box.max().z(); z += kTopCell) tops.emplace_back(x, y, z);
-    std::vector<std::vector<Coord>> perTop(tops.size());
+    std::vector<std::vector<Cell>> perTop(tops.size());
     tbb::parallel_for(tbb::blocked_range<size_t>(0, tops.size(), 1), [&](const tbb::blocked_range<size_t>& r) {
         for (size_t ti = r.begin(); ti != r.end(); ++ti) {
             const CoordBBox cube = CoordBBox::createCube(tops[ti], kTopCell);
@@ -1055,22 +1060,26 @@ void AdaptiveWarp::forEachLeaf(const CoordBBox& box, const Occupancy* source, co
             CoordBBox part = cube;
             part.intersect(box);
             if (part.empty()) continue;
-            // Leaves grouped by cells of 2^3 leaves (step 2 culls those cells).
+            const Coord first(down(part.min().x(), 8), down(part.min().y(), 8), down(part.min().z(), 8));
             for (int cx = down(part.min().x(), 16); cx <= part.max().x(); cx += 16)
                 for (int cy = down(part.min().y(), 16); cy <= part.max().y(); cy += 16)
-                    for (int cz = down(part.min().z(), 16); cz <= part.max().z(); cz += 16)
-                        for (int x = std::max(cx, down(part.min().x(), 8)); x <= std::min(cx + 8, part.max().x()); x += 8)
-                            for (int y = std::max(cy, down(part.min().y(), 8)); y <= std::min(cy + 8, part.max().y()); y += 8)
-                                for (int z = std::max(cz, down(part.min().z(), 8)); z <= std::min(cz + 8, part.max().z()); z += 8) {
-                                    const Coord c(x, y, z);
-                                    if (wanted && !(*wanted)(CoordBBox::createCube(c, 8))) continue;
-                                    perTop[ti].push_back(c);
-                                }
+                    for (int cz = down(part.min().z(), 16); cz <= part.max().z(); cz += 16) {
+                        Cell cell{Coord(cx, cy, cz), 0};
+                        for (int k = 0; k < 8; ++k) {
+                            const Coord c(cx + ((k >> 2) & 1) * 8, cy + ((k >> 1) & 1) * 8, cz + (k & 1) * 8);
+                            if (c.x() < first.x() || c.y() < first.y() || c.z() < first.z() || c.x() > part.max().x() ||
+                                c.y() > part.max().y() || c.z() > part.max().z())
+                                continue;
+                            if (wanted && !(*wanted)(CoordBBox::createCube(c, 8))) continue;
+                            cell.leaves |= uint8_t(1u << k);
+                        }
+                        if (cell.leaves) perTop[ti].push_back(cell);
+                    }
         }
     });
-    std::vector<Coord> candidates;
-    for (const auto& v : perTop) candidates.insert(candidates.end(), v.begin(), v.end());
-    if (candidates.empty()) return;
+    std::vector<Cell> cells;
+    for (const auto& v : perTop) cells.insert(cells.end(), v.begin(), v.end());
+    if (cells.empty()) return;
     if (interrupter && interrupter->wasInterrupted(0)) throw Interrupted();
 
     // One scratch context per thread (its counters summed into stats at the end).
@@ -1082,19 +1091,27 @@ void AdaptiveWarp::forEachLeaf(const CoordBBox& box, const Occupancy* source, co
         return ctx;
     });
 
+    // The candidate leaves, cell by cell.
+    std::vector<Coord> candidates;
+    auto expand = [&] {
+        for (const Cell& cell : cells)
+            for (int k = 0; k < 8; ++k)
+                if (cell.leaves & (1u << k))
+                    candidates.push_back(cell.origin.offsetBy(((k >> 2) & 1) * 8, ((k >> 1) & 1) * 8, (k & 1) * 8));
+    };
+
     // 2. The exact sums at the corners of the candidate leaves, each lattice point once. With
-    //    occupancies, cells of 2^3 leaves are culled first from their own corners (every other
-    //    lattice point), so that the leaves of a cell whose image misses both sides cost nothing.
+    //    occupancies, the cells are culled first from their own corners (every other lattice
+    //    point), so that the leaves of a cell whose image misses both sides cost nothing.
     Lattice lattice;
     uint64_t latticeEvaluations = 0;
     std::atomic<bool> stopped{false};
     if (n > 0) {
-        auto cellOf = [](const Coord& c) { return Coord(c.x() & ~15, c.y() & ~15, c.z() & ~15); };
         Coord llo(std::numeric_limits<int>::max()), lhi(std::numeric_limits<int>::min());
-        for (const Coord& c : candidates) {
-            const Coord l = cellOf(c);
-            llo = Coord::minComponent(llo, Coord(l.x() >> 3, l.y() >> 3, l.z() >> 3));
-            lhi = Coord::maxComponent(lhi, Coord(l.x() >> 3, l.y() >> 3, l.z() >> 3).offsetBy(2));
+        for (const Cell& c : cells) {
+            const Coord l(c.origin.x() >> 3, c.origin.y() >> 3, c.origin.z() >> 3);
+            llo = Coord::minComponent(llo, l);
+            lhi = Coord::maxComponent(lhi, l.offsetBy(2));
         }
         lattice.lo = llo;
         lattice.dim = lhi - llo + Coord(1);
@@ -1132,33 +1149,30 @@ void AdaptiveWarp::forEachLeaf(const CoordBBox& box, const Occupancy* source, co
             }
         };
         if (source || target) {
-            // The cells and, per cell, where its leaves begin in `candidates`.
-            std::vector<size_t> begin;
-            for (size_t i = 0; i < candidates.size(); ++i)
-                if (i == 0 || cellOf(candidates[i]) != cellOf(candidates[i - 1])) begin.push_back(i);
-            begin.push_back(candidates.size());
-            for (size_t c = 0; c + 1 < begin.size(); ++c) want(cellOf(candidates[begin[c]]), 2);
+            for (const Cell& c : cells) want(c.origin, 2);
             evaluate(0);
-            std::vector<char> keep(begin.size() - 1, 0);
-            tbb::parallel_for(tbb::blocked_range<size_t>(0, keep.size(), 16), [&](const tbb::blocked_range<size_t>& r) {
+            std::vector<char> keep(cells.size(), 0);
+            tbb::parallel_for(tbb::blocked_range<size_t>(0, cells.size(), 16), [&](const tbb::blocked_range<size_t>& r) {
                 Context* ctx = &contexts.local();
                 for (size_t c = r.begin(); c != r.end(); ++c) {
-                    const Coord cell = cellOf(candidates[begin[c]]);
-                    const Coord l(cell.x() >> 3, cell.y() >> 3, cell.z() >> 3);
+                    const Coord l(cells[c].origin.x() >> 3, cells[c].origin.y() >> 3, cells[c].origin.z() >> 3);
                     const LatticePoint* corners[8];
                     for (int k = 0; k < 8; ++k)
                         corners[k] = &lattice.points[lattice.index(l.offsetBy((k & 1) * 2, ((k >> 1) & 1) * 2, ((k >> 2) & 1) * 2))];
-                    analyze(*ctx, corners, cell, 16);
-                    keep[c] = mayTouch(*ctx, cell, 16);
+                    analyze(*ctx, corners, cells[c].origin, 16);
+                    keep[c] = mayTouch(*ctx, cells[c].origin, 16);
                 }
             });
-            std::vector<Coord> kept;
-            for (size_t c = 0; c < keep.size(); ++c)
-                if (keep[c]) kept.insert(kept.end(), candidates.begin() + begin[c], candidates.begin() + begin[c + 1]);
-            candidates.swap(kept);
+            size_t kept = 0;
+            for (size_t c = 0; c < cells.size(); ++c)
+                if (keep[c]) cells[kept++] = cells[c];
+            cells.resize(kept);
         }
+        expand();
         for (const Coord& c : candidates) want(c, 1);
         evaluate(5);
+    } else {
+        expand();
     }
 
     // 3. Every candidate leaf: culled by the bound, filled, culled by its points, handed on.
