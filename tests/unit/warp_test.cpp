@@ -15,6 +15,7 @@
 
 #include <array>
 #include <cmath>
+#include <cstdio>
 #include <cstring>
 #include <filesystem>
 #include <iostream>
@@ -130,7 +131,9 @@ std::vector<FeaturePairSpec> randomPairs(std::mt19937& random, int n, double ext
         FeatureElement& s = p.source;
         s.origin = vec() * extent;
         s.xAxis = direction();
-        s.yAxis = s.xAxis.cross(direction()).unit();
+        Vec3d across = s.xAxis.cross(direction());
+        while (across.length() < 0.1) across = s.xAxis.cross(direction()); // a frame, not a near-degenerate one
+        s.yAxis = across.unit();
         s.zAxis = s.xAxis.cross(s.yAxis);
         s.scale = (Vec3d(0.1) + vec()) * (extent / 4);
         FeatureElement& t = p.target;
@@ -215,6 +218,39 @@ TEST(Feature, SlerpTakesTheShorterArc)
     EXPECT_NEAR((h.x - Vec3d(std::sqrt(0.5), -std::sqrt(0.5), 0)).length(), 0.0, 1e-9);
     EXPECT_NEAR(interpolate(a, c, 0.0).x.x(), 1.0, 1e-12);
     EXPECT_NEAR((interpolate(a, c, 1.0).x - Vec3d(0, -1, 0)).length(), 0.0, 1e-12);
+}
+
+TEST(Feature, RotationQuaternionMatchesOpenVdbsAndAcceptsFramesAFewUlpsOff)
+{
+    std::mt19937 random(7);
+    std::uniform_real_distribution<double> u(-1.0, 1.0);
+    int refused = 0;
+    for (int i = 0; i < 20000; ++i) {
+        // Random frames, including ones near the half-turns where the trace is negative.
+        const Vec3d axis = Vec3d(u(random), u(random), u(random)).unit();
+        const double angle = i % 4 == 0 ? M_PI * (1.0 - 1e-3 * std::abs(u(random))) : M_PI * u(random);
+        const Vec3d x = rotate(Vec3d(1, 0, 0), axis, angle), y = rotate(Vec3d(0, 1, 0), axis, angle);
+        const Vec3d z = x.cross(y);
+        const openvdb::math::Quatd q = rotationQuaternion(x, y, z);
+        EXPECT_NEAR(std::sqrt(q.dot(q)), 1.0, 1e-14);
+        // The quaternion gives the frame back, in the convention rotation<Mat3> reads it.
+        const auto m = openvdb::math::rotation<openvdb::math::Mat3d>(q);
+        EXPECT_NEAR((m.row(0) - x).length() + (m.row(1) - y).length() + (m.row(2) - z).length(), 0.0, 1e-12);
+        try {
+            const openvdb::math::Quatd reference(openvdb::math::Mat3d(x, y, z, /*rows=*/true));
+            EXPECT_NEAR(std::abs(q.dot(reference)), 1.0, 1e-12); // q or -q: one rotation
+        } catch (const openvdb::ArithmeticError&) {
+            ++refused; // a few ulps off: OpenVDB refuses it, interpolate() must not
+        }
+    }
+    std::printf("frames OpenVDB's Quat refuses: %d of 20000\n", refused);
+    // A frame a few ulps off orthonormal, which OpenVDB's constructor refuses, still interpolates.
+    const Feature a = Feature::fromElement(element(Vec3d(0.0)), FeatureType::Box);
+    Feature b = a;
+    b.x = Vec3d(1.0 + 3e-15, 0, 0); // 13 ulps long
+    EXPECT_THROW(openvdb::math::Quatd(openvdb::math::Mat3d(b.x, b.y, b.z, true)), openvdb::ArithmeticError);
+    const Feature m = interpolate(a, b, 0.5);
+    EXPECT_NEAR((m.x - Vec3d(1, 0, 0)).length(), 0.0, 1e-12);
 }
 
 TEST(InverseWarp, NoPairsIsTheIdentity)
@@ -334,6 +370,53 @@ TEST(AdaptiveWarp, WithinToleranceOfTheExactWarpOnRandomConfigurations)
             EXPECT_LE(pairEvaluations, 1.01 * 96.0 * 96 * 96 * n);
         }
     }
+}
+
+TEST(AdaptiveWarp, ErrorBoundHoldsAtEveryVoxelOfEveryLeaf)
+{
+    // Each leaf's a-priori bound against the exact warp at its voxels, from tolerances that make
+    // most pairs near down to none but the kinks (a huge tolerance), for both weight laws: the
+    // bound must hold leaf by leaf, not only below the tolerance. Single-precision points allow
+    // 1e-3 voxel of rounding beyond it.
+    std::mt19937 random(1999);
+    double tightest = 0.0; // the largest error / bound seen (how tight the bound is)
+    size_t checked = 0;
+    for (int n : {1, 2, 4, 8, 16, 32, 64}) {
+        for (int trial = 0; trial < 2; ++trial) {
+            const auto pairs = randomPairs(random, n, 64.0);
+            WarpSpec spec;
+            spec.epsilon = trial == 0 ? 1.0 : 4.0;
+            if (trial == 1) {
+                spec.weighting = Weighting::BeierNeely;
+                spec.a = 3.0;
+                spec.b = 1.5;
+                spec.p = 0.5;
+            }
+            const InverseWarp warp(pairs, spec, 0.4 + 0.2 * trial);
+            for (double tolerance : {0.05, 0.5, 4.0, 1e6}) {
+                const detail::AdaptiveWarp adaptive(warp, tolerance);
+                std::mutex m;
+                adaptive.forEachLeaf(openvdb::CoordBBox(openvdb::Coord(0), openvdb::Coord(63)), nullptr, nullptr,
+                                     [&](const detail::WarpLeaf& leaf) {
+                                         double local = 0.0;
+                                         Vec3d s, d;
+                                         for (int i = 0; i < 512; i += n <= 16 ? 1 : 3) {
+                                             warp.map(leaf.origin.offsetBy(i >> 6, (i >> 3) & 7, i & 7).asVec3d(), s, d);
+                                             local = std::max({local, (Vec3d(leaf.source(i)) - s).length(),
+                                                               (Vec3d(leaf.target(i)) - d).length()});
+                                         }
+                                         std::lock_guard<std::mutex> lock(m);
+                                         ++checked;
+                                         EXPECT_LE(local, leaf.errorBound + 1e-3)
+                                             << n << " pairs, trial " << trial << ", tolerance " << tolerance
+                                             << ", leaf " << leaf.origin;
+                                         if (leaf.errorBound > 1e-3) tightest = std::max(tightest, local / leaf.errorBound);
+                                     });
+            }
+        }
+    }
+    EXPECT_EQ(checked, 7u * 2u * 4u * 512u);
+    std::printf("largest error / bound over the leaves: %.3f\n", tightest);
 }
 
 TEST(AdaptiveWarp, VectorAndBaselineKernelsGiveTheSameBits)

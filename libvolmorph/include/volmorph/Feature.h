@@ -3,6 +3,8 @@
 
 #include <volmorph/Scene.h>
 
+#include <openvdb/math/Quat.h>
+
 #include <array>
 #include <vector>
 
@@ -58,5 +60,10 @@ struct Feature {
 /// The element at time t in [0, 1]: origin and scales linear, orientation by quaternion slerp
 /// along the shorter arc.
 Feature interpolate(const Feature& a, const Feature& b, double t);
+
+/// The unit quaternion (as openvdb::math::Quat's constructor from a Mat3 gives it) of the
+/// rotation whose rows are the orthonormal frame x, y, z; also for frames a few ulps off, which
+/// that constructor refuses.
+openvdb::math::Quatd rotationQuaternion(const Vec3d& x, const Vec3d& y, const Vec3d& z);
 
 } // namespace volmorph

@@ -104,6 +104,43 @@ Feature Feature::scaled(double k) const
     return f;
 }
 
+namespace {
+
+/// The unit quaternion of a rotation matrix, in the convention of openvdb::math::Quat's
+/// constructor from a Mat3 (Shepperd's method: the largest of w, x, y, z first, from the trace or
+/// a diagonal entry). That constructor refuses matrices whose determinant is off 1 by more than
+/// 1e-15, which an orthonormal frame computed in double precision can be (a few ulps).
+openvdb::math::Quatd quaternionOf(const openvdb::math::Mat3d& m)
+{
+    const double trace = m(0, 0) + m(1, 1) + m(2, 2);
+    double q[4]; // x, y, z, w
+    if (trace > 0.0) {
+        const double w = 0.5 * std::sqrt(trace + 1.0), f = 0.25 / w;
+        q[0] = f * (m(1, 2) - m(2, 1));
+        q[1] = f * (m(2, 0) - m(0, 2));
+        q[2] = f * (m(0, 1) - m(1, 0));
+        q[3] = w;
+    } else {
+        // The largest diagonal entry i gives the component along axis i.
+        const int i = m(0, 0) > m(1, 1) && m(0, 0) > m(2, 2) ? 0 : m(1, 1) > m(2, 2) ? 1 : 2;
+        const int j = (i + 1) % 3, k = (i + 2) % 3;
+        const double v = 0.5 * std::sqrt(std::max(0.0, m(i, i) - m(j, j) - m(k, k) + 1.0)), f = 0.25 / v;
+        q[i] = v;
+        q[j] = f * (m(i, j) + m(j, i));
+        q[k] = f * (m(k, i) + m(i, k));
+        q[3] = f * (m(j, k) - m(k, j));
+    }
+    const double norm = std::sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3]);
+    return openvdb::math::Quatd(q[0] / norm, q[1] / norm, q[2] / norm, q[3] / norm);
+}
+
+} // namespace
+
+openvdb::math::Quatd rotationQuaternion(const Vec3d& x, const Vec3d& y, const Vec3d& z)
+{
+    return quaternionOf(openvdb::math::Mat3d(x, y, z, /*rows=*/true));
+}
+
 Feature interpolate(const Feature& a, const Feature& b, double t)
 {
     using Mat3 = openvdb::math::Mat3d;
@@ -122,8 +159,8 @@ Feature interpolate(const Feature& a, const Feature& b, double t)
     }
     // Rows are the axes. Whatever convention Quat reads a Mat3 in, rotation<Mat3>() writes it back
     // in the same one, and the geodesic between two frames is the same read either way.
-    const Quat qa(Mat3(a.x, a.y, a.z, /*rows=*/true));
-    Quat qb(Mat3(b.x, b.y, b.z, /*rows=*/true));
+    const Quat qa = rotationQuaternion(a.x, a.y, a.z);
+    Quat qb = rotationQuaternion(b.x, b.y, b.z);
     if (qa.dot(qb) < 0.0) qb = -qb; // q and -q are one rotation: take the shorter arc
     const Mat3 m = openvdb::math::rotation<Mat3>(openvdb::math::slerp(qa, qb, t));
     f.x = m.row(0).unit();

@@ -634,23 +634,28 @@ VOLMORPH_ALWAYS_INLINE inline void AdaptiveWarp::analyzeBody(Context& ctx, const
         store8(wMaxC + i, wMax);
         store8(wMinC + i, wMin);
         store8(wcC + i, wc);
-        // |grad w| and |Hess w| over the cube. Per axis a: |w_a| <= b w / r |d_a| and
-        // |w_aa| <= w (b (b + 1) / r^2 (d_a)^2 + b / r |d_aa|). grad d is the unit vector from
-        // the element's nearest point; over the cube it turns by at most |Hess d| halfDiagonal <=
-        // halfDiagonal / dMin, so sup |d_a| <= |g_a| + turn; and sum_a |d_aa| <= 3 / dMin.
-        // w1 bounds sqrt(sum_a sup (w_a)^2), w2 bounds sum_a sup |w_aa|; where the cube touches
-        // the element (dMin = 0) there is a kink: w2 is infinite.
+        // |grad w| and |Hess w| over the cube. Per axis a: |w_a| = b w / r |d_a| and
+        // w_aa = w (b (b + 1) / r^2 (d_a)^2 - b / r d_aa). Hess d is positive semidefinite (d is
+        // convex), has grad d as a null vector and eigenvalues at most 1 / d, so
+        // 0 <= d_aa <= (1 - (d_a)^2) / d, and the two terms of w_aa, of opposite signs, bound it by
+        // the larger. grad d is the unit vector from the element's nearest point; over the cube it
+        // turns by at most |Hess d| halfDiagonal <= halfDiagonal / dMin, so
+        // |g_a| - turn <= |d_a| <= |g_a| + turn. w1 bounds sqrt(sum_a sup (w_a)^2), w2 bounds
+        // sum_a sup |w_aa|; where the cube touches the element (dMin = 0) there is a kink: w2 is
+        // infinite.
         const v8i apart = dMin > zero;
         const v8f invD = one / (apart ? dMin : one), invR = one / rMin;
         const v8f turn = vmin(one, halfDiagonalF * invD);
-        v8f axial = zero;
+        const v8f bend = (b * (b + 1.0f)) * invR, curve = b * invD;
+        v8f axial = zero, curved = zero;
         for (int a = 0; a < 3; ++a) {
-            const v8f ga = vmin(one, vabs(g[a]) + turn);
-            axial += ga * ga;
+            const v8f hi = vmin(one, vabs(g[a]) + turn), lo = vmax(zero, vabs(g[a]) - turn);
+            axial += hi * hi;
+            curved += vmax(bend * (hi * hi), curve * (one - lo * lo));
         }
         const v8f slopeBound = b * wMax * invR;
         const v8f first = apart ? slopeBound * vsqrt(axial) : slopeBound;
-        const v8f second = apart ? wMax * invR * ((b * (b + 1.0f)) * invR * axial + (3.0f * b) * invD) : infinity;
+        const v8f second = apart ? wMax * invR * curved : infinity;
         store8(w1C + i, inside ? zero : first);
         store8(w2C + i, inside ? zero : second);
     }
@@ -984,6 +989,7 @@ void AdaptiveWarp::leaf(Context& ctx, const Lattice& lattice, const Coord& origi
                 return;
         }
         ++ctx.leaves;
+        ctx.leaf.errorBound = errorBound;
         (*ctx.fn)(ctx.leaf);
     };
 
@@ -992,6 +998,7 @@ void AdaptiveWarp::leaf(Context& ctx, const Lattice& lattice, const Coord& origi
             !touches(ctx.target, o, o + Vec3d(7.0), kSamplerReach))
             return;
         identityLeaf(ctx);
+        ctx.leaf.errorBound = 0.0;
         ++ctx.leaves;
         (*ctx.fn)(ctx.leaf);
         return;

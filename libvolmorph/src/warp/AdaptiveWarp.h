@@ -15,12 +15,15 @@
 // 3. Which pairs are near follows from an a-priori bound of the interpolation error, not from
 //    samples (samples between lattice points miss the kinks of d on the elements' boundaries and
 //    the bending on the scale of d + offset). For u in C^{1,1}, trilinear interpolation over a
-//    cube of side h errs by at most h^2/8 (|u_xx| + |u_yy| + |u_zz|) <= 3 h^2/8 |Hess u|. With
-//    |grad d| <= 1 and |Hess d| <= 1/d (the distance to a convex set), over the leaf
-//      |grad w_i| <= b w_i / r_i,  |Hess w_i| <= w_i (b (b + 1) / r_i^2 + b / (r_i d_i)),
-//    r_i = offset + d_i, each at the leaf's smallest distance to element i; and
-//      |p~ - p| <= (3 h^2/8) sum_F [(|R_i| + |rho|) |Hess w_i| + 2 |M_i - M_B| |grad w_i|]
-//                  / (W_min - (3 h^2/8) sum_F |Hess w_i|),
+//    cube of side h errs by at most h^2/8 (sup |u_xx| + sup |u_yy| + sup |u_zz|). With
+//    |grad d| = 1 and Hess d positive semidefinite with grad d as a null vector and eigenvalues
+//    at most 1/d (the distance to a convex set), along each axis a over the leaf
+//      |d_a w_i| <= b w_i / r_i |d_a d_i|,
+//      |d_aa w_i| <= w_i max(b (b + 1) / r_i^2 (d_a d_i)^2, b / r_i (1 - (d_a d_i)^2) / d_i)
+//    (the two terms of d_aa w_i have opposite signs), r_i = offset + d_i, each at the leaf's
+//    smallest distance to element i, with the range of d_a d_i from the turn of grad d; and
+//      |p~ - p| <= (h^2/8) sum_F [(|R_i| + |rho|) H_i + 2 |M_i - M_B| |grad w_i|]
+//                  / (W_min - (h^2/8) sum_F H_i),   H_i = sum_a sup |d_aa w_i|,
 //    rho = p - B (a convex combination of the R_i), |R_i| and W_min bounded over the leaf, both
 //    sides. Where this all-far bound is finite, a second pass tightens it: a far pair's share is
 //    (R_i(c) - rho) (I[w_i] - w_i) + (M_i - M_B)(I[w_i (x - c)] - w_i (x - c)), c the centre,
@@ -72,6 +75,8 @@ namespace volmorph::detail {
 /// channel-major (the warp's loops write whole channels).
 struct WarpLeaf {
     openvdb::Coord origin;
+    /// What the points may be off the exact warp's (voxels): the a-priori bound, 0 where exact.
+    double errorBound = 0.0;
     alignas(64) float s[3][512]; ///< source side: x, y, z of each voxel
     alignas(64) float t[3][512]; ///< target side
     Vec3f source(int n) const { return Vec3f(s[0][n], s[1][n], s[2][n]); }
