@@ -1068,20 +1068,27 @@ void AdaptiveWarp::forEachLeaf(const CoordBBox& box, const Occupancy* source, co
             part.intersect(box);
             if (part.empty()) continue;
             const Coord first(down(part.min().x(), 8), down(part.min().y(), 8), down(part.min().z(), 8));
-            for (int cx = down(part.min().x(), 16); cx <= part.max().x(); cx += 16)
-                for (int cy = down(part.min().y(), 16); cy <= part.max().y(); cy += 16)
-                    for (int cz = down(part.min().z(), 16); cz <= part.max().z(); cz += 16) {
-                        Cell cell{Coord(cx, cy, cz), 0};
-                        for (int k = 0; k < 8; ++k) {
-                            const Coord c(cx + ((k >> 2) & 1) * 8, cy + ((k >> 1) & 1) * 8, cz + (k & 1) * 8);
-                            if (c.x() < first.x() || c.y() < first.y() || c.z() < first.z() || c.x() > part.max().x() ||
-                                c.y() > part.max().y() || c.z() > part.max().z())
-                                continue;
-                            if (wanted && !(*wanted)(CoordBBox::createCube(c, 8))) continue;
-                            cell.leaves |= uint8_t(1u << k);
-                        }
-                        if (cell.leaves) perTop[ti].push_back(cell);
+            // Cells in the order of their blocks of 2^3 cells (step 2 culls blocks, then cells).
+            const CoordBBox cellRange(Coord(down(part.min().x(), 16), down(part.min().y(), 16), down(part.min().z(), 16)),
+                                      part.max());
+            for (int bx = down(part.min().x(), 32); bx <= part.max().x(); bx += 32)
+            for (int by = down(part.min().y(), 32); by <= part.max().y(); by += 32)
+            for (int bz = down(part.min().z(), 32); bz <= part.max().z(); bz += 32) {
+                for (int k = 0; k < 8; ++k) {
+                    const Coord o(bx + ((k >> 2) & 1) * 16, by + ((k >> 1) & 1) * 16, bz + (k & 1) * 16);
+                    if (!cellRange.isInside(o)) continue;
+                    Cell cell{o, 0};
+                    for (int m = 0; m < 8; ++m) {
+                        const Coord c = o.offsetBy(((m >> 2) & 1) * 8, ((m >> 1) & 1) * 8, (m & 1) * 8);
+                        if (c.x() < first.x() || c.y() < first.y() || c.z() < first.z() || c.x() > part.max().x() ||
+                            c.y() > part.max().y() || c.z() > part.max().z())
+                            continue;
+                        if (wanted && !(*wanted)(CoordBBox::createCube(c, 8))) continue;
+                        cell.leaves |= uint8_t(1u << m);
                     }
+                    if (cell.leaves) perTop[ti].push_back(cell);
+                }
+            }
         }
     });
     std::vector<Cell> cells;
@@ -1108,17 +1115,18 @@ void AdaptiveWarp::forEachLeaf(const CoordBBox& box, const Occupancy* source, co
     };
 
     // 2. The exact sums at the corners of the candidate leaves, each lattice point once. With
-    //    occupancies, the cells are culled first from their own corners (every other lattice
-    //    point), so that the leaves of a cell whose image misses both sides cost nothing.
+    //    occupancies, blocks of 2^3 cells and then cells are culled first from their own corners
+    //    (every 4th, then every other lattice point), so that the leaves of a cell whose image
+    //    misses both sides cost nothing.
     Lattice lattice;
     uint64_t latticeEvaluations = 0;
     std::atomic<bool> stopped{false};
     if (n > 0) {
         Coord llo(std::numeric_limits<int>::max()), lhi(std::numeric_limits<int>::min());
-        for (const Cell& c : cells) {
-            const Coord l(c.origin.x() >> 3, c.origin.y() >> 3, c.origin.z() >> 3);
+        for (const Cell& c : cells) { // the corners of their blocks of 32 voxels too
+            const Coord l(c.origin.x() >> 3 & -4, c.origin.y() >> 3 & -4, c.origin.z() >> 3 & -4);
             llo = Coord::minComponent(llo, l);
-            lhi = Coord::maxComponent(lhi, l.offsetBy(2));
+            lhi = Coord::maxComponent(lhi, l.offsetBy(4));
         }
         lattice.lo = llo;
         lattice.dim = lhi - llo + Coord(1);
@@ -1156,24 +1164,37 @@ void AdaptiveWarp::forEachLeaf(const CoordBBox& box, const Occupancy* source, co
             }
         };
         if (source || target) {
-            for (const Cell& c : cells) want(c.origin, 2);
-            evaluate(0);
-            std::vector<char> keep(cells.size(), 0);
-            tbb::parallel_for(tbb::blocked_range<size_t>(0, cells.size(), 16), [&](const tbb::blocked_range<size_t>& r) {
-                Context* ctx = &contexts.local();
-                for (size_t c = r.begin(); c != r.end(); ++c) {
-                    const Coord l(cells[c].origin.x() >> 3, cells[c].origin.y() >> 3, cells[c].origin.z() >> 3);
-                    const LatticePoint* corners[8];
-                    for (int k = 0; k < 8; ++k)
-                        corners[k] = &lattice.points[lattice.index(l.offsetBy((k & 1) * 2, ((k >> 1) & 1) * 2, ((k >> 2) & 1) * 2))];
-                    analyze(*ctx, corners, cells[c].origin, 16);
-                    keep[c] = mayTouch(*ctx, cells[c].origin, 16);
-                }
-            });
-            size_t kept = 0;
-            for (size_t c = 0; c < cells.size(); ++c)
-                if (keep[c]) cells[kept++] = cells[c];
-            cells.resize(kept);
+            // Blocks of 2^3 cells (32 voxels), then cells (16), each culled from its own corners.
+            auto cull = [&](int size) {
+                auto groupOf = [size](const Coord& c) { return Coord(c.x() & -size, c.y() & -size, c.z() & -size); };
+                std::vector<size_t> begin; // where each group's cells begin
+                for (size_t i = 0; i < cells.size(); ++i)
+                    if (i == 0 || groupOf(cells[i].origin) != groupOf(cells[i - 1].origin)) begin.push_back(i);
+                begin.push_back(cells.size());
+                const int step = size / 8;
+                for (size_t g = 0; g + 1 < begin.size(); ++g) want(groupOf(cells[begin[g]].origin), step);
+                evaluate(0);
+                std::vector<char> keep(begin.size() - 1, 0);
+                tbb::parallel_for(tbb::blocked_range<size_t>(0, keep.size(), 8), [&](const tbb::blocked_range<size_t>& r) {
+                    Context& ctx = contexts.local();
+                    for (size_t g = r.begin(); g != r.end(); ++g) {
+                        const Coord o = groupOf(cells[begin[g]].origin);
+                        const Coord l(o.x() >> 3, o.y() >> 3, o.z() >> 3);
+                        const LatticePoint* corners[8];
+                        for (int k = 0; k < 8; ++k)
+                            corners[k] = &lattice.points[lattice.index(l.offsetBy((k & 1) * step, ((k >> 1) & 1) * step, ((k >> 2) & 1) * step))];
+                        analyze(ctx, corners, o, size);
+                        keep[g] = mayTouch(ctx, o, size);
+                    }
+                });
+                size_t kept = 0;
+                for (size_t g = 0; g < keep.size(); ++g)
+                    if (keep[g])
+                        for (size_t c = begin[g]; c < begin[g + 1]; ++c) cells[kept++] = cells[c];
+                cells.resize(kept);
+            };
+            cull(32);
+            cull(16);
         }
         expand();
         for (const Coord& c : candidates) want(c, 1);

@@ -36,9 +36,9 @@
 //    interpolant is B + I[G] / I[W], and I[G] / I[W] is a convex combination of the corners'
 //    residuals, so the image lies within B(leaf) + their hull, widened by the bound; otherwise
 //    p = B + rho lies within B(leaf) widened by |rho|max. A leaf whose image misses every
-//    occupied block of both sides (widened by the sampler's reach) is skipped; blocks of 2^3
-//    leaves are judged first, from every other lattice point. A leaf kept only by the bound's
-//    margin is checked again on its filled points.
+//    occupied block of both sides (widened by the sampler's reach) is skipped; blocks of 4^3
+//    and then of 2^3 leaves are judged first, from every 4th and every other lattice point. A
+//    leaf kept only by the bound's margin is checked again on its filled points.
 // 5. The arithmetic runs on 8-lane vectors (GCC's vector extension). The bound's per-pair terms
 //    take 8 pairs at a time in single precision (its rounding, about 1e-7 of each term, is far
 //    inside its slack; weights beyond single precision send the leaf to the exact path); the
