@@ -647,11 +647,22 @@ VOLMORPH_ALWAYS_INLINE inline void AdaptiveWarp::analyzeBody(Context& ctx, const
         const v8f invD = one / (apart ? dMin : one), invR = one / rMin;
         const v8f turn = vmin(one, halfDiagonalF * invD);
         const v8f bend = (b * (b + 1.0f)) * invR, curve = b * invD;
+        // Along axis a, the half of the cube away from the element is (h/2) |g_a| farther (d lies
+        // above its tangent plane at the centre), so with w ~ r^-b both sups there are at most
+        // rho = (rMin / (rMin + h/2 |g_a|))^(b + 1) times those over the cube. Linear
+        // interpolation's error with sup |u''| <= M on one half and rho M on the other is at most
+        // h^2/8 M ((3 + rho) / 4)^2 (its Peano kernel's integral over each half, at the worst x):
+        // each axis's share carries that factor (1 where rho is not computed: Beier-Neely's law).
         v8f axial = zero, curved = zero;
         for (int a = 0; a < 3; ++a) {
             const v8f hi = vmin(one, vabs(g[a]) + turn), lo = vmax(zero, vabs(g[a]) - turn);
-            axial += hi * hi;
-            curved += vmax(bend * (hi * hi), curve * (one - lo * lo));
+            v8f share = one;
+            if (inverseSquare) {
+                const v8f near = rMin / (rMin + (0.5f * hf) * vabs(g[a])), rho = near * near * near;
+                share = (0.75f + 0.25f * rho) * (0.75f + 0.25f * rho);
+            }
+            axial += (share * hi) * (share * hi);
+            curved += share * vmax(bend * (hi * hi), curve * (one - lo * lo));
         }
         const v8f slopeBound = b * wMax * invR;
         const v8f first = apart ? slopeBound * vsqrt(axial) : slopeBound;

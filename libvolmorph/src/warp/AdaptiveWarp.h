@@ -21,7 +21,9 @@
 //      |d_a w_i| <= b w_i / r_i |d_a d_i|,
 //      |d_aa w_i| <= w_i max(b (b + 1) / r_i^2 (d_a d_i)^2, b / r_i (1 - (d_a d_i)^2) / d_i)
 //    (the two terms of d_aa w_i have opposite signs), r_i = offset + d_i, each at the leaf's
-//    smallest distance to element i, with the range of d_a d_i from the turn of grad d; and
+//    smallest distance to element i, with the range of d_a d_i from the turn of grad d. Along
+//    each axis, the half of the leaf away from the element is farther from it, its sups smaller
+//    by a factor rho; axis a's share of the h^2/8 then shrinks by ((3 + rho) / 4)^2. And
 //      |p~ - p| <= (h^2/8) sum_F [(|R_i| + |rho|) H_i + 2 |M_i - M_B| |grad w_i|]
 //                  / (W_min - (h^2/8) sum_F H_i),   H_i = sum_a sup |d_aa w_i|,
 //    rho = p - B (a convex combination of the R_i), |R_i| and W_min bounded over the leaf, both
