@@ -51,17 +51,21 @@ struct PairBounds {
 
 /// The exact sums at the corners of the candidate leaves: a lattice 8 voxels apart over the
 /// leaves' bounding box (index space / 8), evaluated only where a candidate leaf needs it.
+/// Left uninitialized until evaluated (only the wanted points are, and only they are read): the
+/// whole lattice is allocated per call, and zeroing it cost about 1 ms, serially.
 struct AdaptiveWarp::LatticePoint {
-    double w = 0.0;     ///< sum w_i
+    double w;           ///< sum w_i
     Vec3d s, t;         ///< sum w_i A_i, source and target side
-    bool ok = false;    ///< false: on an element with a zero offset, or not evaluated
+    bool ok;            ///< false: on an element with a zero offset
 };
 
 struct AdaptiveWarp::Lattice {
     using Point = LatticePoint;
+    static_assert(std::is_trivially_default_constructible_v<Point>, "allocated uninitialized");
     Coord lo;               ///< lattice coordinates of point 0 (leaf coordinates)
     Coord dim;              ///< points along each axis
-    std::vector<Point> points;
+    std::unique_ptr<Point[]> points;
+    size_t count = 0;
     size_t index(const Coord& leafCoord) const
     {
         const Coord c = leafCoord - lo;
@@ -1141,8 +1145,9 @@ void AdaptiveWarp::forEachLeaf(const CoordBBox& box, const Occupancy* source, co
         }
         lattice.lo = llo;
         lattice.dim = lhi - llo + Coord(1);
-        lattice.points.resize(size_t(lattice.dim.x()) * lattice.dim.y() * lattice.dim.z());
-        std::vector<char> state(lattice.points.size(), 0); // 1 wanted, 2 evaluated
+        lattice.count = size_t(lattice.dim.x()) * lattice.dim.y() * lattice.dim.z();
+        lattice.points.reset(new LatticePoint[lattice.count]);
+        std::vector<char> state(lattice.count, 0); // 1 wanted, 2 evaluated
         auto evaluate = [&](int progressFrom) {
             std::vector<size_t> todo;
             for (size_t i = 0; i < state.size(); ++i)
