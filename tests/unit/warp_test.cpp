@@ -150,8 +150,20 @@ std::vector<FeaturePairSpec> randomPairs(std::mt19937& random, int n, double ext
     return pairs;
 }
 
-/// The largest distance between the approximated and the exact warp's points, on either side,
-/// over every `stride`-th voxel of every leaf of the box [0, last]^3 (index space).
+/// The largest distance between a leaf's approximated points and the exact warp's, on either side,
+/// over every `stride`-th voxel.
+double leafError(const InverseWarp& warp, const detail::WarpLeaf& leaf, int stride)
+{
+    double local = 0.0;
+    Vec3d s, d;
+    for (int i = 0; i < 512; i += stride) {
+        warp.map(leaf.origin.offsetBy(i >> 6, (i >> 3) & 7, i & 7).asVec3d(), s, d);
+        local = std::max({local, (Vec3d(leaf.source(i)) - s).length(), (Vec3d(leaf.target(i)) - d).length()});
+    }
+    return local;
+}
+
+/// The largest leafError over every leaf of the box [0, last]^3 (index space).
 double largestError(const InverseWarp& warp, const detail::AdaptiveWarp& adaptive, int last, int stride,
                     detail::AdaptiveWarpStats& stats)
 {
@@ -159,13 +171,7 @@ double largestError(const InverseWarp& warp, const detail::AdaptiveWarp& adaptiv
     double worst = 0.0;
     adaptive.forEachLeaf(openvdb::CoordBBox(openvdb::Coord(0), openvdb::Coord(last)), nullptr, nullptr,
                          [&](const detail::WarpLeaf& leaf) {
-                             double local = 0.0;
-                             Vec3d s, d;
-                             for (int i = 0; i < 512; i += stride) {
-                                 warp.map(leaf.origin.offsetBy(i >> 6, (i >> 3) & 7, i & 7).asVec3d(), s, d);
-                                 local = std::max({local, (Vec3d(leaf.source(i)) - s).length(),
-                                                   (Vec3d(leaf.target(i)) - d).length()});
-                             }
+                             const double local = leafError(warp, leaf, stride);
                              std::lock_guard<std::mutex> lock(m);
                              worst = std::max(worst, local);
                          },
@@ -398,13 +404,7 @@ TEST(AdaptiveWarp, ErrorBoundHoldsAtEveryVoxelOfEveryLeaf)
                 std::mutex m;
                 adaptive.forEachLeaf(openvdb::CoordBBox(openvdb::Coord(0), openvdb::Coord(63)), nullptr, nullptr,
                                      [&](const detail::WarpLeaf& leaf) {
-                                         double local = 0.0;
-                                         Vec3d s, d;
-                                         for (int i = 0; i < 512; i += n <= 16 ? 1 : 3) {
-                                             warp.map(leaf.origin.offsetBy(i >> 6, (i >> 3) & 7, i & 7).asVec3d(), s, d);
-                                             local = std::max({local, (Vec3d(leaf.source(i)) - s).length(),
-                                                               (Vec3d(leaf.target(i)) - d).length()});
-                                         }
+                                         const double local = leafError(warp, leaf, n <= 16 ? 1 : 3);
                                          std::lock_guard<std::mutex> lock(m);
                                          ++checked;
                                          EXPECT_LE(local, leaf.errorBound + 1e-3)

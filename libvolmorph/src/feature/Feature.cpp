@@ -104,14 +104,13 @@ Feature Feature::scaled(double k) const
     return f;
 }
 
-namespace {
-
-/// The unit quaternion of a rotation matrix, in the convention of openvdb::math::Quat's
-/// constructor from a Mat3 (Shepperd's method: the largest of w, x, y, z first, from the trace or
-/// a diagonal entry). That constructor refuses matrices whose determinant is off 1 by more than
-/// 1e-15, which an orthonormal frame computed in double precision can be (a few ulps).
-openvdb::math::Quatd quaternionOf(const openvdb::math::Mat3d& m)
+/// Shepperd's method, in the convention of openvdb::math::Quat's constructor from a Mat3: the
+/// largest of w, x, y, z first, from the trace or a diagonal entry. That constructor refuses
+/// matrices whose determinant is off 1 by more than 1e-15, which an orthonormal frame computed in
+/// double precision can be (a few ulps).
+openvdb::math::Quatd rotationQuaternion(const Vec3d& x, const Vec3d& y, const Vec3d& z)
 {
+    const openvdb::math::Mat3d m(x, y, z, /*rows=*/true);
     const double trace = m(0, 0) + m(1, 1) + m(2, 2);
     double q[4]; // x, y, z, w
     if (trace > 0.0) {
@@ -132,13 +131,6 @@ openvdb::math::Quatd quaternionOf(const openvdb::math::Mat3d& m)
     }
     const double norm = std::sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3]);
     return openvdb::math::Quatd(q[0] / norm, q[1] / norm, q[2] / norm, q[3] / norm);
-}
-
-} // namespace
-
-openvdb::math::Quatd rotationQuaternion(const Vec3d& x, const Vec3d& y, const Vec3d& z)
-{
-    return quaternionOf(openvdb::math::Mat3d(x, y, z, /*rows=*/true));
 }
 
 Feature interpolate(const Feature& a, const Feature& b, double t)

@@ -1082,7 +1082,8 @@ void AdaptiveWarp::forEachLeaf(const CoordBBox& box, const Occupancy* source, co
             CoordBBox part = cube;
             part.intersect(box);
             if (part.empty()) continue;
-            const Coord first(down(part.min().x(), 8), down(part.min().y(), 8), down(part.min().z(), 8));
+            const CoordBBox leafRange(Coord(down(part.min().x(), 8), down(part.min().y(), 8), down(part.min().z(), 8)),
+                                      part.max()); // the leaves' origins
             // Cells in the order of their blocks of 2^3 cells (step 2 culls blocks, then cells).
             const CoordBBox cellRange(Coord(down(part.min().x(), 16), down(part.min().y(), 16), down(part.min().z(), 16)),
                                       part.max());
@@ -1095,9 +1096,7 @@ void AdaptiveWarp::forEachLeaf(const CoordBBox& box, const Occupancy* source, co
                     Cell cell{o, 0};
                     for (int m = 0; m < 8; ++m) {
                         const Coord c = o.offsetBy(((m >> 2) & 1) * 8, ((m >> 1) & 1) * 8, (m & 1) * 8);
-                        if (c.x() < first.x() || c.y() < first.y() || c.z() < first.z() || c.x() > part.max().x() ||
-                            c.y() > part.max().y() || c.z() > part.max().z())
-                            continue;
+                        if (!leafRange.isInside(c)) continue;
                         if (wanted && !(*wanted)(CoordBBox::createCube(c, 8))) continue;
                         cell.leaves |= uint8_t(1u << m);
                     }
