@@ -196,13 +196,21 @@ VOLMORPH_ALWAYS_INLINE inline v8f frameDistance(v8f qx, v8f qy, v8f qz, float hx
     return vsqrt(a * a + b * b + c * c);
 }
 
-/// a + b i + c j at every row r = i * 8 + j of a leaf: a + b i in double, then the 8 rows of
-/// each i as one vector in single precision.
-VOLMORPH_ALWAYS_INLINE inline void rowAffine(double a, double b, double c, float out[64])
-{
-    const v8f step = kZ * float(c);
-    for (int i = 0; i < 8; ++i) store8(out + 8 * i, float(a + b * i) + step);
-}
+/// An affine function of the voxel (i, j, k), a + b i + c j + d k, as the rows walk it: a + b i at
+/// each slice i in double (then single precision), c and d in single precision.
+struct RowAffine {
+    float start[8]; ///< at the first voxel of each slice (j = k = 0)
+    float dy;       ///< step along y: from one row to the next
+    float dz;       ///< step along z: from one voxel of a row to the next
+    void set(double a, double b, double c, double d)
+    {
+        for (int i = 0; i < 8; ++i) start[i] = float(a + b * i);
+        dy = float(c);
+        dz = float(d);
+    }
+    /// At the first row of slice i; each next row of the slice adds dy.
+    VOLMORPH_ALWAYS_INLINE v8f first(int i) const { return start[i] + kZ * dz; }
+};
 
 /// One near pair's share of a leaf: its element, weight scale and residuals R = A - B at the
 /// leaf's origin, whose steps along the axes are the columns of M_A - M_B.
@@ -213,11 +221,9 @@ struct NearTerm {
     Vec3d rs, drs[3], rt, drt[3];
 };
 
-/// A near pair ready for the rows: its frame coordinates and residuals at each row's first voxel
-/// and their steps along the row.
+/// A near pair ready for the rows: its frame coordinates and residuals over the leaf.
 struct NearRows {
-    alignas(32) float start[9][64]; ///< frame coordinates q, source residual, target residual
-    v8f step[9];                    ///< their steps at each voxel of a row (0, 1, ..., 7 steps)
+    RowAffine f[9]; ///< frame coordinates q, source residual, target residual
     float half[3];
     float scale;
 };
@@ -245,20 +251,22 @@ VOLMORPH_ALWAYS_INLINE inline void addNearPairs(const LeafJob& job, size_t begin
     const float off = float(job.offset);
     for (size_t p = begin; p < end; ++p) {
         const NearRows& n = job.rows[p];
-        for (int r = 0; r < 64; ++r) {
-            v8f* acc = sums[r];
-            const v8f qx = n.start[0][r] + n.step[0];
-            const v8f qy = n.start[1][r] + n.step[1];
-            const v8f qz = n.start[2][r] + n.step[2];
-            const v8f d = off + frameDistance<T>(qx, qy, qz, n.half[0], n.half[1], n.half[2]);
-            v8f w;
-            if constexpr (InverseSquare) {
-                w = 1.0f / (d * d);
-            } else {
-                for (int l = 0; l < 8; ++l) w[l] = float(double(n.scale) * std::pow(double(d[l]), -job.exponent));
+        for (int i = 0; i < 8; ++i) {
+            v8f v[9];
+            for (int c = 0; c < 9; ++c) v[c] = n.f[c].first(i);
+            for (int j = 0; j < 8; ++j) {
+                v8f* acc = sums[8 * i + j];
+                const v8f d = off + frameDistance<T>(v[0], v[1], v[2], n.half[0], n.half[1], n.half[2]);
+                v8f w;
+                if constexpr (InverseSquare) {
+                    w = 1.0f / (d * d);
+                } else {
+                    for (int l = 0; l < 8; ++l) w[l] = float(double(n.scale) * std::pow(double(d[l]), -job.exponent));
+                }
+                acc[0] += w;
+                for (int c = 0; c < 6; ++c) acc[1 + c] += w * v[3 + c];
+                for (int c = 0; c < 9; ++c) v[c] += n.f[c].dy;
             }
-            acc[0] += w;
-            for (int c = 0; c < 6; ++c) acc[1 + c] += w * (n.start[3 + c][r] + n.step[3 + c]);
         }
     }
 }
@@ -311,55 +319,59 @@ VOLMORPH_ALWAYS_INLINE inline void fillLeafBody(LeafJob& job, WarpLeaf& leaf)
         // Steps of the frame coordinates along x, y and z: the frame's rows.
         const Vec3d dx(e.x.x(), e.y.x(), e.z.x()), dy(e.x.y(), e.y.y(), e.z.y()), dz(e.x.z(), e.y.z(), e.z.z());
         for (int c = 0; c < 3; ++c) {
-            rowAffine(q0[c], dx[c], dy[c], n.start[c]);
-            rowAffine(t.rs[c], t.drs[0][c], t.drs[1][c], n.start[3 + c]);
-            rowAffine(t.rt[c], t.drt[0][c], t.drt[1][c], n.start[6 + c]);
-            n.step[c] = kZ * float(dz[c]);
-            n.step[3 + c] = kZ * float(t.drs[2][c]);
-            n.step[6 + c] = kZ * float(t.drt[2][c]);
+            n.f[c].set(q0[c], dx[c], dy[c], dz[c]);
+            n.f[3 + c].set(t.rs[c], t.drs[0][c], t.drs[1][c], t.drs[2][c]);
+            n.f[6 + c].set(t.rt[c], t.drt[0][c], t.drt[1][c], t.drt[2][c]);
             n.half[c] = float(0.5 * e.scale[c]);
         }
         n.scale = float(t.scale);
     }
-    // The far sums at each row's first voxel and their step along it, channels as acc below:
-    // bilinear in x (the row's i) in double, then in y (lanes j) in single precision.
-    alignas(32) float farStart[7][64], farStep[7][64];
-    const v8f J = kZ * 0.125f;
+    // The far sums at every voxel, channels as acc below, interpolated in single precision: along
+    // x on the leaf's four edges (lanes i), then per slice i its first and last rows (y = 0 and
+    // y = 8) along z, and the rows between one step along y apart.
+    alignas(32) v8f sums[64][7];
+    const v8f fraction = kZ * 0.125f; // i / 8 or k / 8
     for (int c = 0; c < 7; ++c) {
         const double* v = job.far[c];
+        alignas(32) float edge[4][8]; // (y, z) = (0, 0), (8, 0), (0, 8), (8, 8)
+        for (int m = 0; m < 4; ++m) {
+            const float a = float(v[2 * m]), b = float(v[2 * m + 1]);
+            store8(edge[m], a + fraction * (b - a));
+        }
         for (int i = 0; i < 8; ++i) {
-            const double fx = i / 8.0;
-            const float a0 = float(v[0] + fx * (v[1] - v[0])), c0 = float(v[2] + fx * (v[3] - v[2]));
-            const float a1 = float(v[4] + fx * (v[5] - v[4])), c1 = float(v[6] + fx * (v[7] - v[6]));
-            const v8f z0 = a0 + J * (c0 - a0), z1 = a1 + J * (c1 - a1);
-            store8(farStart[c] + 8 * i, z0);
-            store8(farStep[c] + 8 * i, (z1 - z0) * 0.125f);
+            const v8f row0 = edge[0][i] + fraction * (edge[2][i] - edge[0][i]);
+            const v8f row8 = edge[1][i] + fraction * (edge[3][i] - edge[1][i]);
+            const v8f dy = (row8 - row0) * 0.125f;
+            v8f row = row0;
+            for (int j = 0; j < 8; ++j) {
+                sums[8 * i + j][c] = row;
+                row += dy;
+            }
         }
     }
-    // B at each row's first voxel, each side.
-    alignas(32) float bStart[6][64];
-    v8f bStep[6]; // B's steps at each voxel of a row
-    const Vec3d bs0 = job.bS.apply(job.origin), bt0 = job.bT.apply(job.origin);
-    for (int c = 0; c < 3; ++c) {
-        rowAffine(bs0[c], job.bS.col[0][c], job.bS.col[1][c], bStart[c]);
-        rowAffine(bt0[c], job.bT.col[0][c], job.bT.col[1][c], bStart[3 + c]);
-        bStep[c] = kZ * float(job.bS.col[2][c]);
-        bStep[3 + c] = kZ * float(job.bT.col[2][c]);
-    }
-
-    alignas(32) v8f sums[64][7];
-    for (int r = 0; r < 64; ++r)
-        for (int c = 0; c < 7; ++c) sums[r][c] = farStart[c][r] + kZ * farStep[c][r];
     addNearPairs<FeatureType::Point, InverseSquare>(job, 0, job.typeEnd[0], sums);
     addNearPairs<FeatureType::Segment, InverseSquare>(job, job.typeEnd[0], job.typeEnd[1], sums);
     addNearPairs<FeatureType::Rectangle, InverseSquare>(job, job.typeEnd[1], job.typeEnd[2], sums);
     addNearPairs<FeatureType::Box, InverseSquare>(job, job.typeEnd[2], job.typeEnd[3], sums);
-    for (int r = 0; r < 64; ++r) {
-        const v8f* acc = sums[r];
-        const v8f inv = 1.0f / acc[0];
-        for (int c = 0; c < 3; ++c) {
-            store8(leaf.s[c] + 8 * r, bStart[c][r] + (bStep[c] + acc[1 + c] * inv));
-            store8(leaf.t[c] + 8 * r, bStart[3 + c][r] + (bStep[3 + c] + acc[4 + c] * inv));
+    // p = B + residual sum / weight sum, B walked like the near pairs' functions.
+    RowAffine b[6];
+    const Vec3d bs0 = job.bS.apply(job.origin), bt0 = job.bT.apply(job.origin);
+    for (int c = 0; c < 3; ++c) {
+        b[c].set(bs0[c], job.bS.col[0][c], job.bS.col[1][c], job.bS.col[2][c]);
+        b[3 + c].set(bt0[c], job.bT.col[0][c], job.bT.col[1][c], job.bT.col[2][c]);
+    }
+    for (int i = 0; i < 8; ++i) {
+        v8f base[6];
+        for (int c = 0; c < 6; ++c) base[c] = b[c].first(i);
+        for (int j = 0; j < 8; ++j) {
+            const int r = 8 * i + j;
+            const v8f* acc = sums[r];
+            const v8f inv = 1.0f / acc[0];
+            for (int c = 0; c < 3; ++c) {
+                store8(leaf.s[c] + 8 * r, base[c] + acc[1 + c] * inv);
+                store8(leaf.t[c] + 8 * r, base[3 + c] + acc[4 + c] * inv);
+            }
+            for (int c = 0; c < 6; ++c) base[c] += b[c].dy;
         }
     }
 }
