@@ -271,8 +271,8 @@ VOLMORPH_ALWAYS_INLINE inline void addNearPairs(const LeafJob& job, size_t begin
     }
 }
 
-/// Fills a leaf by rows of 8 voxels along z: the far sums interpolated (bilinear at each row's
-/// first voxel, linear along the row), the near pairs added pair by pair over all rows, then
+/// Fills a leaf by rows of 8 voxels along z: the far sums interpolated trilinearly (slice by
+/// slice, row by row), the near pairs added pair by pair over all rows, then
 /// p = B(x) + residual sum / weight sum, all in single precision as the points are stored (its
 /// rounding, some 1e-5 voxel at hundreds of voxels from the origin, is far below a tolerance).
 template <bool InverseSquare>
