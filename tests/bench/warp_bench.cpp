@@ -161,6 +161,9 @@ void frame(benchmark::State& state, BlendMode mode)
         benchmark::DoNotOptimize(v);
     }
     state.counters["active_voxels"] = double(stats.activeVoxels);
+    state.counters["candidate_leaves"] = double(stats.candidateLeaves);
+    state.counters["output_leaves"] = double(stats.outputLeaves);
+    if (mode == BlendMode::Sdf) state.counters["blend_samples"] = double(stats.blendSamples);
     state.counters["ns_per_active_voxel"] =
         benchmark::Counter(double(stats.activeVoxels) * 1e-9, benchmark::Counter::kIsIterationInvariantRate |
                                                                 benchmark::Counter::kInvert);

@@ -547,6 +547,7 @@ struct BlockClasses {
     CoordBBox leaves;           ///< in leaf coordinates (index >> 3)
     std::vector<int8_t> kind;   ///< per leaf: 0 evaluate, +1 outside, -1 inside
     std::vector<float> stretch; ///< per leaf: G there
+    std::vector<float> band;    ///< per leaf: the compute band there (world units; SdfFrame::classify)
     double maxStretch = 1.0;    ///< G over the box
 
     size_t index(const Coord& leaf) const
@@ -568,6 +569,27 @@ struct BlockClasses {
         return false;
     }
 };
+
+/// The largest of `values` over each leaf's 3^3 neighbourhood within the box (`dim` leaves on a
+/// side, indexed as BlockClasses::index does).
+std::vector<float> neighbourhoodMax(const std::vector<float>& values, const Coord& dim)
+{
+    auto index = [&dim](int x, int y, int z) { return (size_t(x) * dim.y() + y) * dim.z() + z; };
+    std::vector<float> out(values.size());
+    tbb::parallel_for(tbb::blocked_range<int>(0, dim.x()), [&](const tbb::blocked_range<int>& r) {
+        for (int x = r.begin(); x != r.end(); ++x)
+            for (int y = 0; y < dim.y(); ++y)
+                for (int z = 0; z < dim.z(); ++z) {
+                    float m = -std::numeric_limits<float>::max();
+                    for (int i = std::max(0, x - 1); i <= std::min(dim.x() - 1, x + 1); ++i)
+                        for (int j = std::max(0, y - 1); j <= std::min(dim.y() - 1, y + 1); ++j)
+                            for (int k = std::max(0, z - 1); k <= std::min(dim.z() - 1, z + 1); ++k)
+                                m = std::max(m, values[index(i, j, k)]);
+                    out[index(x, y, z)] = m;
+                }
+    });
+    return out;
+}
 
 /// One sdf-mode frame: the blend of the two extended distances through their warps, evaluated
 /// only in the blocks that can hold its narrow band, redistanced there, with colour on the band.
@@ -641,40 +663,38 @@ public:
                             own[index(x, y, z)] = float((1.0 - mTau) * s + mTau * t);
                         }
             });
-            tbb::parallel_for(tbb::blocked_range<int>(0, n.x()), [&](const tbb::blocked_range<int>& r) {
-                for (int x = r.begin(); x != r.end(); ++x)
-                    for (int y = 0; y < n.y(); ++y)
-                        for (int z = 0; z < n.z(); ++z) {
-                            float m = 0.0f;
-                            for (int i = std::max(0, x - 1); i <= std::min(n.x() - 1, x + 1); ++i)
-                                for (int j = std::max(0, y - 1); j <= std::min(n.y() - 1, y + 1); ++j)
-                                    for (int k = std::max(0, z - 1); k <= std::min(n.z() - 1, z + 1); ++k)
-                                        m = std::max(m, own[index(i, j, k)]);
-                            stretch[index(x, y, z)] = std::max(1.0f, 1.25f * m);
-                        }
-            });
+            stretch = neighbourhoodMax(own, n);
+            for (float& g : stretch) g = std::max(1.0f, 1.25f * g);
         }
         c.maxStretch = *std::max_element(stretch.begin(), stretch.end());
-        // Values are computed within the compute band (the band and one voxel more, so that every
-        // band voxel's neighbours are known); a leaf can be skipped when its centre is farther than
-        // its corners' reach plus that, plus a voxel for the extended fields' transition.
+        // Values are computed within the compute band of each leaf: the band and one voxel more,
+        // so that every band voxel's neighbours are known. A voxel of leaf L is in the band that
+        // is kept when its value is within G_L width voxels of zero (G_L the leaf's stretch), and
+        // its neighbours, in L or a face neighbour L', are then within G_L (width + 1) voxels, so
+        // each leaf's compute band is (width + 1) voxels times the largest G of the leaf and its
+        // 26 neighbours. (One band for the whole box, from the largest G anywhere, costs some two
+        // times the samples where the warp stretches only some leaves.) A leaf can be skipped
+        // when its centre is farther than its corners' reach plus that, plus a voxel for the
+        // extended fields' transition.
+        c.band = neighbourhoodMax(stretch, n);
+        for (float& g : c.band) g *= (mWidth + 1.0f) * mVoxel;
         mComputeBand = float(c.maxStretch) * (mWidth + 1.0f) * mVoxel;
-        mKeepBand = float(c.maxStretch) * mWidth * mVoxel;
         c.kind.assign(count, 0);
         c.stretch = std::move(stretch);
         mPrune = prune;
         if (!prune) return;
         for (size_t i = 0; i < count; ++i)
-            if (!(std::abs(blend[i]) < limit(c.stretch[i], 3.5f * kSqrt3))) c.kind[i] = blend[i] < 0.0f ? -1 : 1;
+            if (!(std::abs(blend[i]) < limit(c.stretch[i], 3.5f * kSqrt3, c.band[i]))) c.kind[i] = blend[i] < 0.0f ? -1 : 1;
     }
 
     /// Beyond this blend (world units) at a point, no voxel within `reach` voxels of it is in the
-    /// compute band: G reach, plus the slack of the extended fields' transition (where they
+    /// compute band `band` (of the leaf that holds them): G reach, plus the slack of the extended fields' transition (where they
     /// pass from the band to the coarse field, they may change by up to the coarse error more
     /// than a distance does).
-    float limit(float stretch, float reach) const { return (stretch * reach + mSlack) * mVoxel + mComputeBand; }
+    float limit(float stretch, float reach, float band) const { return (stretch * reach + mSlack) * mVoxel + band; }
 
     const BlockClasses& classes() const { return mClasses; }
+    /// The widest compute band of the box (world units): beyond it, a value is outside every one.
     float computeBand() const { return mComputeBand; }
     float width() const { return mWidth * mVoxel; }
     uint64_t samples() const { return mSamples + mClasses.kind.size(); }
@@ -689,22 +709,32 @@ public:
         int whole() const { return on ? 0 : (inside && !outside ? -1 : (outside && !inside ? 1 : 0)); }
     };
 
+    /// The leaf's bands (world units): its compute band, and the band that is kept.
+    struct Bands {
+        float compute, keep;
+    };
+    Bands bandsAt(const Coord& origin) const
+    {
+        const size_t i = mClasses.index(origin >> size_t(3));
+        return {mClasses.band[i], mClasses.stretch[i] * mWidth * mVoxel};
+    }
+
     /// Blends voxel n from its two distances: active within the compute band, +/- the band
     /// (inactive) beyond it; its colour, colorAt(), within the band that is kept.
     template <typename ColorAt>
-    void blendVoxel(openvdb::Index n, float da, float db, FloatTree::LeafNodeType& value,
+    void blendVoxel(openvdb::Index n, float da, float db, const Bands& bands, FloatTree::LeafNodeType& value,
                     Vec3STree::LeafNodeType& color, Seen& seen, const ColorAt& colorAt) const
     {
         const float d = (1.0f - mTau) * da + mTau * db;
         seen.inside = seen.inside || d < 0.0f;
         seen.outside = seen.outside || !(d < 0.0f);
-        if (!(std::abs(d) < mComputeBand)) {
-            value.setValueOff(n, d < 0.0f ? -mComputeBand : mComputeBand);
+        if (!(std::abs(d) < bands.compute)) {
+            value.setValueOff(n, d < 0.0f ? -bands.compute : bands.compute);
             return;
         }
         value.setValueOn(n, d);
         seen.on = true;
-        if (std::abs(d) < mKeepBand) color.setValueOn(n, colorAt());
+        if (std::abs(d) < bands.keep) color.setValueOn(n, colorAt());
     }
 
     /// Fills one leaf: the blend within the compute band (active), +/- the compute band beyond
@@ -725,10 +755,11 @@ public:
         // sqrt(3)) / 8 of that mean. Beyond the limit a quarter or block is inside or outside as a
         // whole.
         const float stretch = mClasses.stretch[mClasses.index(w.origin >> size_t(3))];
-        const float quarterLimit = limit(stretch, 2.0f * kSqrt3);
-        const float blockLimit = limit(stretch, kBlockReach);
+        const Bands bands = bandsAt(w.origin);
+        const float quarterLimit = limit(stretch, 2.0f * kSqrt3, bands.compute);
+        const float blockLimit = limit(stretch, kBlockReach, bands.compute);
         auto fill = [&](int x0, int y0, int z0, int size, float d) {
-            const float v = d < 0.0f ? -mComputeBand : mComputeBand;
+            const float v = d < 0.0f ? -bands.compute : bands.compute;
             for (int i = x0; i < x0 + size; ++i)
                 for (int j = y0; j < y0 + size; ++j)
                     for (int k = z0; k < z0 + size; ++k) value.setValueOff(openvdb::Index((i * 8 + j) * 8 + k), v);
@@ -768,7 +799,7 @@ public:
                             const openvdb::Vec3R ps(w.source(n)), pt(w.target(n));
                             const float da = a(ps), db = b(pt);
                             ++samples;
-                            blendVoxel(n, da, db, value, color, seen, [&] {
+                            blendVoxel(n, da, db, bands, value, color, seen, [&] {
                                 return colors(ps, pt, fogRamp(da, ramp), fogRamp(db, ramp));
                             });
                         }
@@ -788,9 +819,10 @@ public:
         ColorBlend<Sampler> colors(mSource, mTarget, mTauColor, mBackground);
         const float ramp = kSdfRampVoxels * mVoxel;
         Seen seen;
+        const Bands bands = bandsAt(origin);
         for (openvdb::Index n = 0; n < 512; ++n) {
             const float da = distances.source[n], db = distances.target[n];
-            blendVoxel(n, da, db, value, color, seen, [&] {
+            blendVoxel(n, da, db, bands, value, color, seen, [&] {
                 return colors.atVoxel(origin + value.offsetToLocalCoord(n), fogRamp(da, ramp), fogRamp(db, ramp));
             });
         }
@@ -810,7 +842,7 @@ public:
     {
         using Leaf = FloatTree::LeafNodeType;
         openvdb::tree::LeafManager<FloatTree> leaves(values.tree(), 1);
-        const float keep = mKeepBand, width = mWidth * mVoxel;
+        const float width = mWidth * mVoxel;
         std::vector<Leaf::NodeMaskType> bands(leaves.leafCount());
         std::vector<std::unique_ptr<Leaf>> fogs(leaves.leafCount());
         // Central differences as math::GradStencil takes them. The six neighbours are read from
@@ -832,6 +864,9 @@ public:
                 const Leaf* next = acc.probeConstLeaf(o);
                 across[f] = next ? next->buffer().data() : nullptr;
             }
+            // Only voxels within the leaf's kept band can come within the width of the zero set.
+            const float keep = mClasses.leaves.isInside(origin >> size_t(3)) ? bandsAt(origin).keep
+                                                                             : float(mClasses.maxStretch) * width;
             const float* in = leaf.buffer().data();
             float* out = leaves.getBuffer(index, 1).data();
             auto fog = std::make_unique<Leaf>(origin, 0.0f, false);
@@ -915,7 +950,7 @@ private:
     float mVoxel;  ///< world units
     float mWidth;  ///< the output band's half width, voxels
     float mSlack;  ///< voxels
-    float mComputeBand = 0.0f, mKeepBand = 0.0f; ///< world units
+    float mComputeBand = 0.0f; ///< the widest compute band (world units)
     bool mPrune = true;
     BlockClasses mClasses;
     mutable std::atomic<uint64_t> mSamples{0};
