@@ -999,7 +999,10 @@ Morpher::Morpher(VolumeSet source, VolumeSet target, std::vector<FeaturePairSpec
 
 CoordBBox Morpher::candidateBounds(double t) const
 {
-    const CoordBBox s = mSourceBlocks->bounds(), d = mTargetBlocks->bounds();
+    // The occupied blocks' bounds and a block more on each side.
+    CoordBBox s = mSourceBlocks->bounds(), d = mTargetBlocks->bounds();
+    if (!s.empty()) s.expand(8);
+    if (!d.empty()) d.expand(8);
     CoordBBox box;
     if (!s.empty()) box.expand(s);
     if (!d.empty()) box.expand(d);

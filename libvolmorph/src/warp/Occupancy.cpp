@@ -1,7 +1,5 @@
 #include "Occupancy.h"
 
-#include <openvdb/tools/Morphology.h>
-
 namespace volmorph::detail {
 namespace {
 
@@ -27,8 +25,6 @@ Occupancy::Occupancy(const openvdb::FloatTree& tree)
                                Coord(block(b.max().x()), block(b.max().y()), block(b.max().z()))),
                      true, true);
     }
-    openvdb::tools::dilateActiveValues(mBlocks, 1, openvdb::tools::NN_FACE_EDGE_VERTEX,
-                                       openvdb::tools::PRESERVE_TILES);
 
     CoordBBox b;
     if (!mBlocks.evalActiveVoxelBoundingBox(b)) return;

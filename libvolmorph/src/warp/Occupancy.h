@@ -9,8 +9,9 @@
 
 namespace volmorph::detail {
 
-/// "Might a trilinear sample here be non-zero?" at the resolution of 8^3 blocks: the blocks holding
-/// active voxels or tiles of a grid, dilated by one block.
+/// "Might a sample here be non-zero?" at the resolution of 8^3 blocks: the blocks holding active
+/// voxels or tiles of a grid (whose inactive values are zero). A sampler reads beyond the point:
+/// callers widen their boxes by its reach.
 class Occupancy {
 public:
     explicit Occupancy(const openvdb::FloatTree& tree);
