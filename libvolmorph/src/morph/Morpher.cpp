@@ -688,9 +688,9 @@ public:
     }
 
     /// Beyond this blend (world units) at a point, no voxel within `reach` voxels of it is in the
-    /// compute band `band` (of the leaf that holds them): G reach, plus the slack of the extended fields' transition (where they
-    /// pass from the band to the coarse field, they may change by up to the coarse error more
-    /// than a distance does).
+    /// compute band `band` (of the leaf that holds them): G reach, plus the slack of the extended
+    /// fields' transition (where they pass from the band to the coarse field, they may change by
+    /// up to the coarse error more than a distance does).
     float limit(float stretch, float reach, float band) const { return (stretch * reach + mSlack) * mVoxel + band; }
 
     const BlockClasses& classes() const { return mClasses; }
