@@ -53,7 +53,7 @@ struct PairBounds {
 /// leaves' bounding box (index space / 8), evaluated only where a candidate leaf needs it.
 /// Left uninitialized until evaluated (only the wanted points are, and only they are read): the
 /// whole lattice is allocated per call, and zeroing it cost about 1 ms, serially.
-struct AdaptiveWarp::LatticePoint {
+struct alignas(64) AdaptiveWarp::LatticePoint { // one cache line each
     double w;           ///< sum w_i
     Vec3d s, t;         ///< sum w_i A_i, source and target side
     bool ok;            ///< false: on an element with a zero offset
@@ -117,6 +117,7 @@ struct AdaptiveWarp::Context {
     size_t dominant = 0;
     double wMinSum = 0.0, rhoMax = 0.0, boundAllFar = 0.0;
     Vec3d rhoLo[2], rhoHi[2], rhoMid[2]; ///< the box of the corners' rho_k, source and target side
+    double cornerB[2][3][8]; ///< B at the corners: [side][axis][corner] (where cornersOk)
 };
 
 namespace {
@@ -165,6 +166,7 @@ VOLMORPH_ALWAYS_INLINE inline v4d vabs(v4d v)
     return reinterpret_cast<v4d>(reinterpret_cast<v4l>(v) & 0x7fffffffffffffffLL);
 }
 VOLMORPH_ALWAYS_INLINE inline v4d vmax(v4d a, v4d b) { return a > b ? a : b; }
+VOLMORPH_ALWAYS_INLINE inline v4d vmin(v4d a, v4d b) { return a < b ? a : b; }
 VOLMORPH_ALWAYS_INLINE inline v4d vsqrt(v4d v)
 {
     v4d r;
@@ -756,23 +758,44 @@ VOLMORPH_ALWAYS_INLINE inline void AdaptiveWarp::analyzeBody(Context& ctx, const
     // The corners' residuals rho_k = p_k - B(x_k): their box on each side (the domain test uses
     // it too), its centre rho_0 and largest distance r.
     if (!ctx.cornersOk) return;
+    // Corners 0-3 (z = 0) and 4-7 (z = h), 4 lanes each; B(x) as Affine::apply computes it.
+    const v4d cornerX = o.x() + v4d{0, h, 0, h}, cornerY = o.y() + v4d{0, 0, h, h};
+    const v4d cornerZ[2] = {splat(o.z()), splat(o.z() + h)};
+    v4d inverseW[2]; // 1 / w at the corners
+    for (int m = 0; m < 2; ++m) {
+        for (int l = 0; l < 4; ++l) inverseW[m][l] = corners[4 * m + l]->w;
+        inverseW[m] = 1.0 / inverseW[m];
+    }
     double radius[2];
     for (int side = 0; side < 2; ++side) {
         const InverseWarp::Affine& bA = side == 0 ? bS : bT;
-        Vec3d rho[8], lo(std::numeric_limits<double>::max()), hi(-lo);
-        for (int c = 0; c < 8; ++c) {
-            const LatticePoint& p = *corners[c];
-            const Vec3d x = o + Vec3d((c & 1) * h, ((c >> 1) & 1) * h, ((c >> 2) & 1) * h);
-            rho[c] = (side == 0 ? p.s : p.t) * (1.0 / p.w) - bA.apply(x);
-            lo = minComponent(lo, rho[c]);
-            hi = maxComponent(hi, rho[c]);
+        v4d rho[3][2];
+        for (int a = 0; a < 3; ++a)
+            for (int m = 0; m < 2; ++m) {
+                const v4d bx = ((bA.col[0][a] * cornerX + bA.col[1][a] * cornerY) + bA.col[2][a] * cornerZ[m]) + bA.offset[a];
+                store4(&ctx.cornerB[side][a][4 * m], bx);
+                v4d sum; // S or T
+                for (int l = 0; l < 4; ++l) {
+                    const LatticePoint& q = *corners[4 * m + l];
+                    sum[l] = (side == 0 ? q.s : q.t)[a];
+                }
+                rho[a][m] = sum * inverseW[m] - bx; // the exact point S / W less B
+            }
+        Vec3d lo, hi;
+        for (int a = 0; a < 3; ++a) {
+            const v4d l = vmin(rho[a][0], rho[a][1]), u = vmax(rho[a][0], rho[a][1]);
+            lo[a] = std::min(std::min(l[0], l[1]), std::min(l[2], l[3]));
+            hi[a] = std::max(std::max(u[0], u[1]), std::max(u[2], u[3]));
         }
         ctx.rhoLo[side] = lo;
         ctx.rhoHi[side] = hi;
-        ctx.rhoMid[side] = 0.5 * (lo + hi);
-        double r2 = 0.0;
-        for (int c = 0; c < 8; ++c) r2 = std::max(r2, (rho[c] - ctx.rhoMid[side]).lengthSqr());
-        radius[side] = std::sqrt(r2);
+        const Vec3d mid = ctx.rhoMid[side] = 0.5 * (lo + hi);
+        v4d r2 = splat(0.0);
+        for (int m = 0; m < 2; ++m) {
+            const v4d dx = rho[0][m] - mid.x(), dy = rho[1][m] - mid.y(), dz = rho[2][m] - mid.z();
+            r2 = vmax(r2, (dx * dx + dy * dy) + dz * dz);
+        }
+        radius[side] = std::sqrt(std::max(std::max(r2[0], r2[1]), std::max(r2[2], r2[3])));
     }
     if (!std::isfinite(ctx.boundAllFar) || n == 1) return;
     const Vec3f mid[2] = {Vec3f(ctx.rhoMid[0]), Vec3f(ctx.rhoMid[1])};
@@ -949,24 +972,21 @@ double AdaptiveWarp::selectNear(Context& ctx, size_t& nearCount) const
 
 void AdaptiveWarp::fill(Context& ctx, const Coord& origin) const
 {
-    constexpr int Size = 8;
     const size_t n = mWarp.pairCount();
-    const double h = Size;
     const Vec3d o = origin.asVec3d();
     const InverseWarp::Affine& bS = mSource[ctx.dominant];
     const InverseWarp::Affine& bT = mTarget[ctx.dominant];
 
-    // The exact sums at the corners, as W, S - W B and T - W B; the kernel takes the near pairs
+    // The exact sums at the corners, as W, S - W B and T - W B (B at the corners from analyze());
+    // the kernel takes the near pairs
     // off them (G = N - W B - sum_E w_i R_i, W_F = W - sum_E w_i).
     LeafJob& job = *ctx.job;
     for (int c = 0; c < 8; ++c) {
-        const Vec3d x = o + Vec3d((c & 1) * h, ((c >> 1) & 1) * h, ((c >> 2) & 1) * h);
         const LatticePoint& p = *ctx.corner[c];
-        const Vec3d s = p.s - p.w * bS.apply(x), t = p.t - p.w * bT.apply(x);
         job.far[0][c] = p.w;
         for (int k = 0; k < 3; ++k) {
-            job.far[1 + k][c] = s[k];
-            job.far[4 + k][c] = t[k];
+            job.far[1 + k][c] = p.s[k] - p.w * ctx.cornerB[0][k][c];
+            job.far[4 + k][c] = p.t[k] - p.w * ctx.cornerB[1][k][c];
         }
     }
     bool anyNear = false;
@@ -1179,6 +1199,7 @@ void AdaptiveWarp::forEachLeaf(const CoordBBox& box, const Occupancy* source, co
                                   lattice.lo.z() + int(idx % lattice.dim.z()));
                     Lattice::Point& p = lattice.points[idx];
                     p.ok = exactSums(Vec3d(l.x() * 8.0, l.y() * 8.0, l.z() * 8.0), p);
+
                 }
             });
             if (stopped) throw Interrupted();

@@ -49,22 +49,9 @@ Occupancy::Occupancy(const openvdb::FloatTree& tree)
             }
 }
 
-bool Occupancy::anyIn(const CoordBBox& box) const
+bool Occupancy::scan(const Coord& lo, const Coord& hi) const
 {
-    const Coord lo(block(box.min().x()), block(box.min().y()), block(box.min().z()));
-    const Coord hi(block(box.max().x()), block(box.max().y()), block(box.max().z()));
-    const CoordBBox blocks(lo, hi);
-    if (!mPrefix.empty()) {
-        // Inclusion-exclusion over the summed-volume table, the box clamped to its bounds.
-        const Coord a = Coord::maxComponent(lo, mLo) - mLo, c = Coord::minComponent(hi, mLo + mDim - Coord(1)) - mLo;
-        if (a.x() > c.x() || a.y() > c.y() || a.z() > c.z()) return false;
-        const size_t sy = size_t(mDim.z() + 1), sx = sy * size_t(mDim.y() + 1);
-        auto at = [&](int x, int y, int z) { return int64_t(mPrefix[size_t(x) * sx + size_t(y) * sy + size_t(z)]); };
-        const int x0 = a.x(), y0 = a.y(), z0 = a.z(), x1 = c.x() + 1, y1 = c.y() + 1, z1 = c.z() + 1;
-        return at(x1, y1, z1) - at(x0, y1, z1) - at(x1, y0, z1) - at(x1, y1, z0) + at(x0, y0, z1) + at(x0, y1, z0) +
-                   at(x1, y0, z0) - at(x0, y0, z0) > 0;
-    }
-    if (blocks.volume() > (1u << 16)) return true; // too large to be worth asking
+    if (CoordBBox(lo, hi).volume() > (1u << 16)) return true; // too large to be worth asking
     openvdb::tree::ValueAccessor<const openvdb::MaskTree> acc(mBlocks);
     for (int x = lo.x(); x <= hi.x(); ++x)
         for (int y = lo.y(); y <= hi.y(); ++y)
