@@ -174,6 +174,23 @@ VOLMORPH_ALWAYS_INLINE inline v4d vsqrt(v4d v)
     return r;
 }
 
+/// Sums over pairs, 8 lanes of single precision accumulated in double (two 4-lane halves).
+VOLMORPH_ALWAYS_INLINE inline v4d lowHalf(v8f v) { return __builtin_convertvector(__builtin_shufflevector(v, v, 0, 1, 2, 3), v4d); }
+VOLMORPH_ALWAYS_INLINE inline v4d highHalf(v8f v) { return __builtin_convertvector(__builtin_shufflevector(v, v, 4, 5, 6, 7), v4d); }
+struct WideSum {
+    v4d lo{}, hi{};
+    VOLMORPH_ALWAYS_INLINE void add(v8f v)
+    {
+        lo += lowHalf(v);
+        hi += highHalf(v);
+    }
+    VOLMORPH_ALWAYS_INLINE double total() const
+    {
+        const v4d s = lo + hi;
+        return (s[0] + s[1]) + (s[2] + s[3]);
+    }
+};
+
 /// max(|q| - half, 0): how far a point lies beyond an element's half-extent along one of its axes.
 template <class V>
 VOLMORPH_ALWAYS_INLINE inline V outside(V q, V half)
@@ -609,7 +626,15 @@ VOLMORPH_ALWAYS_INLINE inline void AdaptiveWarp::analyzeBody(Context& ctx, const
     // Per pair: frame coordinates q of the centre, the distance dc = |max(|q| - half, 0)| (half 0
     // on the axes a type does not extend along), its gradient g in index axes, the smallest
     // distance over the cube, and whether a box contains the whole cube (d = 0, w constant).
+    // Over the pairs: the smallest total weight, whether any weight is too steep (below
+    // kTinyRadius or beyond single precision: the leaf is then evaluated exactly), and the
+    // dominant pair (the largest weight at the centre; the first such pair), per lane.
+    WideSum wMinTotal;
+    v8i steep{}, bestIndex{};
+    v8f best = splat8(-1.0f);
+    const v8i laneIndex = {0, 1, 2, 3, 4, 5, 6, 7};
     for (size_t i = 0; i < padded; i += 8) {
+        const v8i live = load8(&col.live[i]) != zero;
         const v8f p[3] = {cf.x() - load8(&col.origin[0][i]), cf.y() - load8(&col.origin[1][i]), cf.z() - load8(&col.origin[2][i])};
         v8f q[3], v[3], out2 = zero;
         v8i inside = load8(&col.box[i]) != zero;
@@ -652,6 +677,12 @@ VOLMORPH_ALWAYS_INLINE inline void AdaptiveWarp::analyzeBody(Context& ctx, const
         store8(wMaxC + i, wMax);
         store8(wMinC + i, wMin);
         store8(wcC + i, wc);
+        wMinTotal.add(live ? wMin : zero);
+        steep |= live & ((rMin < float(kTinyRadius)) | ~(wMax <= std::numeric_limits<float>::max()));
+        const v8f centreWeight = live ? wc : splat8(-1.0f);
+        const v8i better = centreWeight > best;
+        best = better ? centreWeight : best;
+        bestIndex = better ? int(i) + laneIndex : bestIndex;
         // |grad w| and |Hess w| over the cube. Per axis a: |w_a| = b w / r |d_a| and
         // w_aa = w (b (b + 1) / r^2 (d_a)^2 - b / r d_aa). Hess d is positive semidefinite (d is
         // convex), has grad d as a null vector and eigenvalues at most 1 / d, so
@@ -688,22 +719,18 @@ VOLMORPH_ALWAYS_INLINE inline void AdaptiveWarp::analyzeBody(Context& ctx, const
         store8(w1C + i, inside ? zero : first);
         store8(w2C + i, inside ? zero : second);
     }
-    double& wMinSum = ctx.wMinSum;
-    size_t& dominant = ctx.dominant;
-    bool& tiny = ctx.tiny;
-    wMinSum = 0.0;
-    dominant = 0;
-    tiny = false;
+    const double wMinSum = ctx.wMinSum = wMinTotal.total();
+    ctx.tiny = false;
+    size_t dominant = 0;
     float wCentreMax = -1.0f;
-    for (size_t i = 0; i < n; ++i) {
-        wMinSum += wMinC[i];
-        // Below kTinyRadius (or weights beyond single precision) the leaf is evaluated exactly.
-        tiny = tiny || rMinC[i] < float(kTinyRadius) || !std::isfinite(wMaxC[i]);
-        if (wcC[i] > wCentreMax) {
-            wCentreMax = wcC[i];
-            dominant = i;
+    for (int l = 0; l < 8; ++l) {
+        ctx.tiny = ctx.tiny || steep[l];
+        if (best[l] > wCentreMax || (best[l] == wCentreMax && size_t(bestIndex[l]) < dominant)) {
+            wCentreMax = best[l];
+            dominant = size_t(bestIndex[l]);
         }
     }
+    ctx.dominant = dominant;
     const InverseWarp::Affine& bS = mSource[dominant];
     const InverseWarp::Affine& bT = mTarget[dominant];
     const float* slope = &mColumns->slope[dominant * padded];
@@ -711,7 +738,10 @@ VOLMORPH_ALWAYS_INLINE inline void AdaptiveWarp::analyzeBody(Context& ctx, const
     // R_i = A_i - B at the centre, |R_i| over the cube on either side (|M_i - M_B| the slope),
     // and |rho| = |p - B| <= sum w_i |R_i| / W.
     const Vec3f bc[2] = {Vec3f(bS.apply(centre)), Vec3f(bT.apply(centre))};
+    WideSum rhoTotal;
+    v8f residLargest = zero;
     for (size_t i = 0; i < padded; i += 8) {
+        const v8i live = load8(&col.live[i]) != zero;
         v8f length2[2];
         for (int side = 0; side < 2; ++side) {
             const auto& m = col.affine[side];
@@ -723,31 +753,34 @@ VOLMORPH_ALWAYS_INLINE inline void AdaptiveWarp::analyzeBody(Context& ctx, const
                 length2[side] += r * r;
             }
         }
-        store8(residC + i, vsqrt(vmax(length2[0], length2[1])) + load8(&slope[i]) * halfDiagonalF);
+        const v8f resid = vsqrt(vmax(length2[0], length2[1])) + load8(&slope[i]) * halfDiagonalF;
+        store8(residC + i, resid);
+        const v8f wMax = live ? load8(wMaxC + i) : zero, residLive = live ? resid : zero;
+        rhoTotal.lo += lowHalf(wMax) * lowHalf(residLive); // products of floats, exact in double
+        rhoTotal.hi += highHalf(wMax) * highHalf(residLive);
+        residLargest = vmax(residLargest, residLive);
     }
-    double rhoSum = 0.0, residMax = 0.0;
-    for (size_t i = 0; i < n; ++i) {
-        rhoSum += double(wMaxC[i]) * residC[i];
-        residMax = std::max(residMax, double(residC[i]));
-    }
+    const double rhoSum = rhoTotal.total();
+    double residMax = 0.0;
+    for (int l = 0; l < 8; ++l) residMax = std::max(residMax, double(residLargest[l]));
     const double rhoMax = ctx.rhoMax = std::min(residMax, rhoSum / wMinSum);
 
     // Each far pair's share of the bound; one pair is its own affine map (R = 0, rho = 0).
     const float k = float(kBoundScale * h * h / 8.0), rhoMaxF = float(rhoMax);
     const v8f none = n == 1 ? one : zero;
+    WideSum termTotal, hessTotal;
     for (size_t i = 0; i < padded; i += 8) {
         const v8f w1 = load8(w1C + i), w2 = load8(w2C + i);
-        const v8i skip = (load8(constantC + i) != zero) | (none != zero);
-        const v8f term = k * ((load8(residC + i) + rhoMaxF) * w2 + 2.0f * load8(&slope[i]) * w1);
-        store8(hessC + i, skip ? zero : k * w2);
-        store8(termC + i, skip ? zero : w2 == infinity ? infinity : term);
+        const v8i skip = (load8(constantC + i) != zero) | (none != zero) | (load8(&col.live[i]) == zero);
+        const v8f term = skip ? zero : w2 == infinity ? infinity : k * ((load8(residC + i) + rhoMaxF) * w2 + 2.0f * load8(&slope[i]) * w1);
+        const v8f hess = skip ? zero : k * w2;
+        store8(hessC + i, hess);
+        store8(termC + i, term);
+        termTotal.add(term);
+        hessTotal.add(hess);
     }
-    double terms = 0.0, hess = 0.0;
-    for (size_t i = 0; i < n; ++i) {
-        terms += termC[i];
-        hess += hessC[i];
-    }
-    ctx.boundAllFar = bound(ctx, terms, hess);
+    const double hess = hessTotal.total();
+    ctx.boundAllFar = bound(ctx, termTotal.total(), hess);
 
     // A second, tighter pass where that bound is finite. A far pair's share of the error is
     // (R_i(c) - rho(x)) (I[w_i] - w_i) + D_i (I[w_i (x - c)] - w_i (x - c)), c the centre and
@@ -800,6 +833,7 @@ VOLMORPH_ALWAYS_INLINE inline void AdaptiveWarp::analyzeBody(Context& ctx, const
     if (!std::isfinite(ctx.boundAllFar) || n == 1) return;
     const Vec3f mid[2] = {Vec3f(ctx.rhoMid[0]), Vec3f(ctx.rhoMid[1])};
     const float boundAllFar = float(ctx.boundAllFar), radiusS = float(radius[0]), radiusT = float(radius[1]);
+    WideSum tightTotal;
     for (size_t i = 0; i < padded; i += 8) {
         v8f length2[2] = {zero, zero};
         for (int a = 0; a < 3; ++a) {
@@ -811,11 +845,11 @@ VOLMORPH_ALWAYS_INLINE inline void AdaptiveWarp::analyzeBody(Context& ctx, const
         const v8f apart = vmax(vsqrt(length2[0]) + radiusS, vsqrt(length2[1]) + radiusT) +
                           load8(&slope[i]) * halfDiagonalF + boundAllFar;
         const v8i tighter = (term != infinity) & (load8(constantC + i) == zero) & (apart < load8(residC + i) + rhoMaxF);
-        store8(termC + i, tighter ? k * (apart * w2 + 2.0f * load8(&slope[i]) * w1) : term);
+        const v8f tightTerm = tighter ? k * (apart * w2 + 2.0f * load8(&slope[i]) * w1) : term;
+        store8(termC + i, tightTerm);
+        tightTotal.add(tightTerm);
     }
-    terms = 0.0;
-    for (size_t i = 0; i < n; ++i) terms += termC[i];
-    ctx.boundAllFar = std::min(ctx.boundAllFar, bound(ctx, terms, hess));
+    ctx.boundAllFar = std::min(ctx.boundAllFar, bound(ctx, tightTotal.total(), hess));
 }
 
 /// The exact warp's unnormalized sums W = sum w_i, S = sum w_i A_S,i, T = sum w_i A_T,i at x (so
