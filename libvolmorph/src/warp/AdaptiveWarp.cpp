@@ -111,6 +111,7 @@ struct AdaptiveWarp::Context {
     std::unique_ptr<LeafJob> job = std::make_unique<LeafJob>();
     PairBounds bounds;
     std::vector<char> isNear;
+    std::vector<size_t> nearList; ///< the near pairs, by type, then by index
     // What analyze() found of the last cell.
     const LatticePoint* corner[8];
     bool cornersOk = false, tiny = false, coreTouches = false;
@@ -1001,19 +1002,24 @@ double AdaptiveWarp::selectNear(Context& ctx, size_t& nearCount) const
         }
         b = kinks > 0 ? std::numeric_limits<double>::infinity() : bound(ctx, terms, hessSum);
     }
+    // The near pairs by type (the kernel's order), then by index.
+    ctx.nearList.clear();
+    for (size_t i = 0; nearCount > 0 && i < n; ++i)
+        if (ctx.isNear[i]) ctx.nearList.push_back(i);
+    std::sort(ctx.nearList.begin(), ctx.nearList.end(), [this](size_t a, size_t c) {
+        return std::make_pair(int(mWarp.interpolated(a).type), a) < std::make_pair(int(mWarp.interpolated(c).type), c);
+    });
     return nearCount == n ? 0.0 : b; // every pair near: exact at every voxel but for rounding
 }
 
 void AdaptiveWarp::fill(Context& ctx, const Coord& origin) const
 {
-    const size_t n = mWarp.pairCount();
     const Vec3d o = origin.asVec3d();
     const InverseWarp::Affine& bS = mSource[ctx.dominant];
     const InverseWarp::Affine& bT = mTarget[ctx.dominant];
 
     // The exact sums at the corners, as W, S - W B and T - W B (B at the corners from analyze());
-    // the kernel takes the near pairs
-    // off them (G = N - W B - sum_E w_i R_i, W_F = W - sum_E w_i).
+    // the kernel takes the near pairs off them (G = N - W B - sum_E w_i R_i, W_F = W - sum_E w_i).
     LeafJob& job = *ctx.job;
     for (int c = 0; c < 8; ++c) {
         const LatticePoint& p = *ctx.corner[c];
@@ -1023,9 +1029,6 @@ void AdaptiveWarp::fill(Context& ctx, const Coord& origin) const
             job.far[4 + k][c] = p.t[k] - p.w * ctx.cornerB[1][k][c];
         }
     }
-    bool anyNear = false;
-    for (size_t i = 0; i < n; ++i) anyNear = anyNear || ctx.isNear[i];
-
     job.origin = o;
     job.bS = bS;
     job.bT = bT;
@@ -1033,23 +1036,23 @@ void AdaptiveWarp::fill(Context& ctx, const Coord& origin) const
     job.exponent = mWarp.weightExponent();
     job.inverseSquare = mWarp.weighting() == Weighting::InverseSquare;
     job.near.clear();
-    for (int type = 0; type < 4; ++type) {
-        for (size_t p = 0; anyNear && p < n; ++p) {
-            if (!ctx.isNear[p] || int(mWarp.interpolated(p).type) != type) continue;
-            NearTerm t;
-            t.element = &mWarp.interpolated(p);
-            t.scale = mWarp.weightScale(p);
-            for (int k = 0; k < 3; ++k) t.half[k] = mColumns->exact.half[k][p];
-            t.rs = mSource[p].apply(o) - bS.apply(o);
-            t.rt = mTarget[p].apply(o) - bT.apply(o);
-            for (int k = 0; k < 3; ++k) {
-                t.drs[k] = mSource[p].col[k] - bS.col[k];
-                t.drt[k] = mTarget[p].col[k] - bT.col[k];
-            }
-            job.near.push_back(t);
+    const Vec3d bso = bS.apply(o), bto = bT.apply(o);
+    for (int type = 0; type < 4; ++type) job.typeEnd[type] = 0;
+    for (const size_t p : ctx.nearList) { // by type, then by index
+        NearTerm t;
+        t.element = &mWarp.interpolated(p);
+        t.scale = mWarp.weightScale(p);
+        for (int k = 0; k < 3; ++k) t.half[k] = mColumns->exact.half[k][p];
+        t.rs = mSource[p].apply(o) - bso;
+        t.rt = mTarget[p].apply(o) - bto;
+        for (int k = 0; k < 3; ++k) {
+            t.drs[k] = mSource[p].col[k] - bS.col[k];
+            t.drt[k] = mTarget[p].col[k] - bT.col[k];
         }
-        job.typeEnd[type] = job.near.size();
+        job.near.push_back(t);
+        ++job.typeEnd[int(mWarp.interpolated(p).type)];
     }
+    for (int type = 1; type < 4; ++type) job.typeEnd[type] += job.typeEnd[type - 1]; // counts to ends
     fillLeaf(job, ctx.leaf);
 }
 
@@ -1212,14 +1215,13 @@ void AdaptiveWarp::forEachLeaf(const CoordBBox& box, const Occupancy* source, co
         lattice.dim = lhi - llo + Coord(1);
         lattice.count = size_t(lattice.dim.x()) * lattice.dim.y() * lattice.dim.z();
         lattice.points.reset(new LatticePoint[lattice.count]);
-        std::vector<char> state(lattice.count, 0); // 1 wanted, 2 evaluated
+        // Each point is listed once, when first wanted, and evaluated by the next evaluate() (the
+        // lists are not scanned for: the lattice's box is mostly unwanted).
+        std::vector<char> wanted(lattice.count, 0);
+        std::vector<size_t> pending;
         auto evaluate = [&](int progressFrom) {
             std::vector<size_t> todo;
-            for (size_t i = 0; i < state.size(); ++i)
-                if (state[i] == 1) {
-                    todo.push_back(i);
-                    state[i] = 2;
-                }
+            todo.swap(pending);
             latticeEvaluations += todo.size();
             tbb::parallel_for(tbb::blocked_range<size_t>(0, todo.size(), 64), [&](const tbb::blocked_range<size_t>& r) {
                 if (stopped || (interrupter && interrupter->wasInterrupted(progressFrom + int(5 * r.begin() / todo.size())))) {
@@ -1233,16 +1235,17 @@ void AdaptiveWarp::forEachLeaf(const CoordBBox& box, const Occupancy* source, co
                                   lattice.lo.z() + int(idx % lattice.dim.z()));
                     Lattice::Point& p = lattice.points[idx];
                     p.ok = exactSums(Vec3d(l.x() * 8.0, l.y() * 8.0, l.z() * 8.0), p);
-
                 }
             });
             if (stopped) throw Interrupted();
         };
-        auto want = [&](const Coord& origin, int step) {
+        // Wants the corners of the cube of `step` lattice cells at origin; new ones go to `list`.
+        // Safe from several threads at once (each point is claimed by one atomic exchange).
+        auto want = [&](const Coord& origin, int step, std::vector<size_t>& list) {
             const Coord l(origin.x() >> 3, origin.y() >> 3, origin.z() >> 3);
             for (int k = 0; k < 8; ++k) {
-                char& st = state[lattice.index(l.offsetBy((k & 1) * step, ((k >> 1) & 1) * step, ((k >> 2) & 1) * step))];
-                if (st == 0) st = 1;
+                const size_t i = lattice.index(l.offsetBy((k & 1) * step, ((k >> 1) & 1) * step, ((k >> 2) & 1) * step));
+                if (!wanted[i] && __atomic_exchange_n(&wanted[i], char(1), __ATOMIC_RELAXED) == 0) list.push_back(i);
             }
         };
         if (source || target) {
@@ -1254,7 +1257,7 @@ void AdaptiveWarp::forEachLeaf(const CoordBBox& box, const Occupancy* source, co
                     if (i == 0 || groupOf(cells[i].origin) != groupOf(cells[i - 1].origin)) begin.push_back(i);
                 begin.push_back(cells.size());
                 const int step = size / 8;
-                for (size_t g = 0; g + 1 < begin.size(); ++g) want(groupOf(cells[begin[g]].origin), step);
+                for (size_t g = 0; g + 1 < begin.size(); ++g) want(groupOf(cells[begin[g]].origin), step, pending);
                 evaluate(0);
                 std::vector<char> keep(begin.size() - 1, 0);
                 tbb::parallel_for(tbb::blocked_range<size_t>(0, keep.size(), 8), [&](const tbb::blocked_range<size_t>& r) {
@@ -1279,7 +1282,14 @@ void AdaptiveWarp::forEachLeaf(const CoordBBox& box, const Occupancy* source, co
             cull(16);
         }
         expand();
-        for (const Coord& c : candidates) want(c, 1);
+        // The candidates' corners, found in parallel, listed in the threads' order (the points do
+        // not depend on the order they are evaluated in).
+        tbb::enumerable_thread_specific<std::vector<size_t>> found;
+        tbb::parallel_for(tbb::blocked_range<size_t>(0, candidates.size(), 512), [&](const tbb::blocked_range<size_t>& r) {
+            std::vector<size_t>& list = found.local();
+            for (size_t i = r.begin(); i != r.end(); ++i) want(candidates[i], 1, list);
+        });
+        for (const std::vector<size_t>& list : found) pending.insert(pending.end(), list.begin(), list.end());
         evaluate(5);
     } else {
         expand();
