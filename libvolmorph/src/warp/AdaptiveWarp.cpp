@@ -848,7 +848,7 @@ VOLMORPH_ALWAYS_INLINE inline void AdaptiveWarp::analyzeBody(Context& ctx, const
         const v8i tighter = (term != infinity) & (load8(constantC + i) == zero) & (apart < load8(residC + i) + rhoMaxF);
         const v8f tightTerm = tighter ? k * (apart * w2 + 2.0f * load8(&slope[i]) * w1) : term;
         store8(termC + i, tightTerm);
-        tightTotal.add(tightTerm);
+        tightTotal.add(load8(&col.live[i]) != zero ? tightTerm : zero); // padding lanes hold no pair
     }
     ctx.boundAllFar = std::min(ctx.boundAllFar, bound(ctx, tightTotal.total(), hess));
 }
