@@ -43,8 +43,9 @@
 //    leaf kept only by the bound's margin is checked again on its filled points.
 // 5. The arithmetic runs on 8-lane vectors (GCC's vector extension). The bound's per-pair terms
 //    take 8 pairs at a time in single precision (its rounding, about 1e-7 of each term, is far
-//    inside its slack; weights beyond single precision send the leaf to the exact path); the
-//    lattice's exact sums take 4 pairs at a time in double. Each leaf is filled by one kernel on rows
+//    inside its slack; weights beyond single precision send the leaf to the exact path), their
+//    sums over pairs kept per lane in double (padding lanes masked) and the corners' residuals 4
+//    corners at a time in double; the lattice's exact sums take 4 pairs at a time in double. Each leaf is filled by one kernel on rows
 //    of 8 voxels along z (one vector each): the far sums of every row (along x on the leaf's
 //    edges, then each slice's first and last rows, the rows between one step along y apart),
 //    then each near pair added over all rows (its frame coordinates and residuals walked the
