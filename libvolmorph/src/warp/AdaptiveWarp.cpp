@@ -417,6 +417,10 @@ AdaptiveWarp::AdaptiveWarp(const InverseWarp& warp, double toleranceVoxels)
             columns->slope[j * padded + i] =
                 float(std::max(linearDistance(mSource[i], mSource[j]), linearDistance(mTarget[i], mTarget[j])));
     mColumns = std::move(columns);
+    // The kernel's order of near pairs: by type, then by index.
+    for (size_t i = 0; i < n; ++i) mByType.push_back(i);
+    std::stable_sort(mByType.begin(), mByType.end(),
+                     [&warp](size_t a, size_t b) { return warp.interpolated(a).type < warp.interpolated(b).type; });
 }
 
 namespace {
@@ -1002,13 +1006,9 @@ double AdaptiveWarp::selectNear(Context& ctx, size_t& nearCount) const
         }
         b = kinks > 0 ? std::numeric_limits<double>::infinity() : bound(ctx, terms, hessSum);
     }
-    // The near pairs by type (the kernel's order), then by index.
     ctx.nearList.clear();
-    for (size_t i = 0; nearCount > 0 && i < n; ++i)
-        if (ctx.isNear[i]) ctx.nearList.push_back(i);
-    std::sort(ctx.nearList.begin(), ctx.nearList.end(), [this](size_t a, size_t c) {
-        return std::make_pair(int(mWarp.interpolated(a).type), a) < std::make_pair(int(mWarp.interpolated(c).type), c);
-    });
+    for (size_t k = 0; nearCount > 0 && k < n; ++k)
+        if (ctx.isNear[mByType[k]]) ctx.nearList.push_back(mByType[k]);
     return nearCount == n ? 0.0 : b; // every pair near: exact at every voxel but for rounding
 }
 

@@ -163,6 +163,7 @@ private:
     double mTolerance;
     std::vector<InverseWarp::Affine> mSource, mTarget; ///< each pair's affine map on each side
     std::unique_ptr<const Columns> mColumns; ///< the interpolated elements, by column
+    std::vector<size_t> mByType;             ///< the pairs by type, then by index (the kernel's order)
 };
 
 } // namespace volmorph::detail
