@@ -117,6 +117,7 @@ struct AdaptiveWarp::Context {
     bool cornersOk = false, tiny = false, coreTouches = false;
     size_t dominant = 0;
     double wMinSum = 0.0, rhoMax = 0.0, boundAllFar = 0.0;
+    double wCornerMin = 0.0; ///< the smallest W at the corners (where cornersOk, else 0)
     Vec3d rhoLo[2], rhoHi[2], rhoMid[2]; ///< the box of the corners' rho_k, source and target side
     double cornerB[2][3][8]; ///< B at the corners: [side][axis][corner] (where cornersOk)
 };
@@ -600,10 +601,14 @@ VOLMORPH_ALWAYS_INLINE inline void AdaptiveWarp::analyzeBody(Context& ctx, const
     const PairColumns<float>& col = mColumns->bound;
     const size_t padded = col.padded;
     ctx.cornersOk = true;
+    ctx.wCornerMin = std::numeric_limits<double>::infinity();
     for (int k = 0; k < 8; ++k) {
         ctx.corner[k] = corners[k];
         ctx.cornersOk = ctx.cornersOk && corners[k]->ok;
+        if (ctx.cornersOk) ctx.wCornerMin = std::min(ctx.wCornerMin, corners[k]->w);
     }
+    // Less a margin for the rounding of W to single precision in the kernel.
+    ctx.wCornerMin = ctx.cornersOk ? ctx.wCornerMin * (1.0 - 1e-6) : 0.0;
     const Vec3d o = origin.asVec3d();
     const double h = size, halfDiagonal = 0.5 * h * std::sqrt(3.0);
     const Vec3d centre = o + Vec3d(0.5 * h);
@@ -661,7 +666,11 @@ VOLMORPH_ALWAYS_INLINE inline void AdaptiveWarp::analyzeBody(Context& ctx, const
         // d is convex (the distance to a convex set), so it lies above its tangent plane at the
         // centre: over the cube, d >= dc - h/2 |g|_1.
         const v8f dMin = positive ? vmax(zero, d - (0.5f * hf) * gL1) : zero;
-        const v8f rMin = offset + dMin, rMax = offset + (inside ? zero : d + halfDiagonalF);
+        // And it lies below the distance to the centre's nearest point on the element, c - d g:
+        // |x - c + d g|^2 = |x - c|^2 + 2 d g.(x - c) + d^2 <= 3 h^2/4 + h d |g|_1 + d^2 over the
+        // cube (d + halfDiagonal only where g is along a diagonal).
+        const v8f dMax = vmin(d + halfDiagonalF, vsqrt((d * d + (hf * d) * gL1) + (0.75f * hf * hf)));
+        const v8f rMin = offset + dMin, rMax = offset + (inside ? zero : dMax);
         store8(rMinC + i, rMin);
         store8(constantC + i, inside ? one : zero);
         // Weights at the smallest and largest distance and at the centre.
@@ -701,19 +710,21 @@ VOLMORPH_ALWAYS_INLINE inline void AdaptiveWarp::analyzeBody(Context& ctx, const
         const v8f invD = one / (apart ? dMin : one), invR = one / rMin;
         const v8f turn = vmin(one, halfDiagonalF * invD);
         const v8f bend = (b * (b + 1.0f)) * invR, curve = b * invD;
-        // Along axis a, the half of the cube away from the element is (h/2) |g_a| farther (d lies
-        // above its tangent plane at the centre), so with w ~ r^-b both sups there are at most
-        // rho = (rMin / (rMin + h/2 |g_a|))^(b + 1) times those over the cube. Linear
-        // interpolation's error with sup |u''| <= M on one half and rho M on the other is at most
-        // h^2/8 M ((3 + rho) / 4)^2 (its Peano kernel's integral over each half, at the worst x):
-        // each axis's share carries that factor (1 where rho is not computed: Beier-Neely's law).
+        // Along axis a, the slice s voxels from the cube's face nearest the element is s |g_a|
+        // farther (d lies above its tangent plane at the centre), so with w ~ r^-b both sups over
+        // it are at most (1 + kappa s)^-(b + 1) times those over the cube, kappa = |g_a| / rMin
+        // (d / dMin grows at least as fast as r / rMin). Linear interpolation's error at x is
+        // the integral of its Peano kernel G(x, s) against u''; with |u''(s)| <= M (1 + kappa s)^-3
+        // its largest value over x is, in closed form, h^2/8 M (2 / (q (q + 1)))^2 with
+        // q = sqrt(1 + kappa h) (1 where kappa = 0): each axis's share carries that factor (1 for
+        // Beier-Neely's law, whose exponent may be below 2).
         v8f axial = zero, curved = zero;
         for (int a = 0; a < 3; ++a) {
             const v8f hi = vmin(one, vabs(g[a]) + turn), lo = vmax(zero, vabs(g[a]) - turn);
             v8f share = one;
             if (inverseSquare) {
-                const v8f near = rMin / (rMin + (0.5f * hf) * vabs(g[a])), rho = near * near * near;
-                share = (0.75f + 0.25f * rho) * (0.75f + 0.25f * rho);
+                const v8f kh = (hf * vabs(g[a])) * invR, f = 2.0f / ((one + kh) + vsqrt(one + kh)); // q (q + 1) = q^2 + q
+                share = f * f;
             }
             axial += (share * hi) * (share * hi);
             curved += share * vmax(bend * (hi * hi), curve * (one - lo * lo));
@@ -785,7 +796,8 @@ VOLMORPH_ALWAYS_INLINE inline void AdaptiveWarp::analyzeBody(Context& ctx, const
         hessTotal.add(hess);
     }
     const double hess = hessTotal.total();
-    ctx.boundAllFar = bound(ctx, termTotal.total(), hess);
+    // With every pair far, the interpolated W is a convex combination of the corners' W.
+    ctx.boundAllFar = bound(ctx, termTotal.total(), hess, ctx.wCornerMin);
 
     // A second, tighter pass where that bound is finite. A far pair's share of the error is
     // (R_i(c) - rho(x)) (I[w_i] - w_i) + D_i (I[w_i (x - c)] - w_i (x - c)), c the centre and
@@ -854,7 +866,7 @@ VOLMORPH_ALWAYS_INLINE inline void AdaptiveWarp::analyzeBody(Context& ctx, const
         store8(termC + i, tightTerm);
         tightTotal.add(load8(&col.live[i]) != zero ? tightTerm : zero); // padding lanes hold no pair
     }
-    ctx.boundAllFar = std::min(ctx.boundAllFar, bound(ctx, tightTotal.total(), hess));
+    ctx.boundAllFar = std::min(ctx.boundAllFar, bound(ctx, tightTotal.total(), hess, ctx.wCornerMin));
 }
 
 /// The exact warp's unnormalized sums W = sum w_i, S = sum w_i A_S,i, T = sum w_i A_T,i at x (so
@@ -965,10 +977,12 @@ bool AdaptiveWarp::mayTouch(Context& ctx, const Coord& origin, int size) const
     return touches(ctx.source, sLo, sHi, margin) || touches(ctx.target, tLo, tHi, margin);
 }
 
-double AdaptiveWarp::bound(const Context& ctx, double terms, double hess) const
+double AdaptiveWarp::bound(const Context& ctx, double terms, double hess, double floor) const
 {
-    // The far pairs' terms over the smallest total weight, less what interpolating it may take.
-    const double denominator = ctx.wMinSum - hess;
+    // The far pairs' terms over the smallest interpolated total weight W_E + I[W_F]: at least
+    // the smallest total weight less what interpolating W_F may take, and at least `floor`
+    // (with every pair far, I[W] is a convex combination of the corners' W: their smallest).
+    const double denominator = std::max(ctx.wMinSum - hess, floor);
     return std::isfinite(terms) && denominator > 0.0 ? terms / denominator : std::numeric_limits<double>::infinity();
 }
 
@@ -1004,7 +1018,7 @@ double AdaptiveWarp::selectNear(Context& ctx, size_t& nearCount) const
         } else {
             --kinks;
         }
-        b = kinks > 0 ? std::numeric_limits<double>::infinity() : bound(ctx, terms, hessSum);
+        b = kinks > 0 ? std::numeric_limits<double>::infinity() : bound(ctx, terms, hessSum, 0.0);
     }
     ctx.nearList.clear();
     for (size_t k = 0; nearCount > 0 && k < n; ++k)

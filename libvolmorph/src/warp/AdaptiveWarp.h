@@ -22,12 +22,16 @@
 //      |d_aa w_i| <= w_i max(b (b + 1) / r_i^2 (d_a d_i)^2, b / r_i (1 - (d_a d_i)^2) / d_i)
 //    (the two terms of d_aa w_i have opposite signs), r_i = offset + d_i, each at the leaf's
 //    smallest distance to element i, with the range of d_a d_i from the turn of grad d. Along
-//    each axis, the half of the leaf away from the element is farther from it, its sups smaller
-//    by a factor rho; axis a's share of the h^2/8 then shrinks by ((3 + rho) / 4)^2. And
+//    each axis the sups fall off away from the element, at least as (1 + kappa s)^-(b + 1) at
+//    s voxels from the nearest face (kappa = |d_a d_i| / r_i there, by the tangent plane of d);
+//    integrating the linear interpolant's Peano kernel against that profile, in closed form,
+//    shrinks axis a's share of the h^2/8 by (2 / (q (q + 1)))^2, q = sqrt(1 + kappa h). And
 //      |p~ - p| <= (h^2/8) sum_F [(|R_i| + |rho|) H_i + 2 |M_i - M_B| |grad w_i|]
-//                  / (W_min - (h^2/8) sum_F H_i),   H_i = sum_a sup |d_aa w_i|,
+//                  / max(W_min - (h^2/8) sum_F H_i, W_floor),   H_i = sum_a sup |d_aa w_i|,
 //    rho = p - B (a convex combination of the R_i), |R_i| and W_min bounded over the leaf, both
-//    sides. Where this all-far bound is finite, a second pass tightens it: a far pair's share is
+//    sides (w_i at least at d_i <= |x - (c - d_c grad d_c)|, the centre's nearest point on the
+//    element); with every pair far, the interpolated W is at least W_floor, the corners'
+//    smallest W. Where this all-far bound is finite, a second pass tightens it: a far pair's share is
 //    (R_i(c) - rho) (I[w_i] - w_i) + (M_i - M_B)(I[w_i (x - c)] - w_i (x - c)), c the centre,
 //    and the all-far interpolant's rho lies in the hull of the corners' rho_k, within the bound
 //    of the true rho, so |R_i| + |rho| becomes |R_i(c) - rho_0| + (hull radius) + bound.
@@ -149,8 +153,9 @@ private:
     void analyzeAvx2(Context& ctx, const LatticePoint* const corners[8], const openvdb::Coord& origin, int size) const;
     /// False when the analysed cube's image misses both sides' occupied blocks.
     bool mayTouch(Context& ctx, const openvdb::Coord& origin, int size) const;
-    /// The error bound of the analysed cube from its far pairs' summed terms and Hessian bounds.
-    double bound(const Context& ctx, double terms, double hess) const;
+    /// The error bound of the analysed cube from its far pairs' summed terms and Hessian bounds,
+    /// and `floor`, a lower bound of the interpolated total weight (0: none).
+    double bound(const Context& ctx, double terms, double hess, double floor) const;
     /// Marks the analysed cube's near pairs; returns its bound.
     double selectNear(Context& ctx, size_t& nearCount) const;
     /// Fills the analysed leaf at origin: far sums interpolated, near pairs evaluated.
