@@ -49,14 +49,14 @@
 //    take 8 pairs at a time in single precision (its rounding, about 1e-7 of each term, is far
 //    inside its slack; weights beyond single precision send the leaf to the exact path), their
 //    sums over pairs kept per lane in double (padding lanes masked) and the corners' residuals 4
-//    corners at a time in double; the lattice's exact sums take 4 pairs at a time in double. Each leaf is filled by one kernel on rows
-//    of 8 voxels along z (one vector each): the far sums of every row (along x on the leaf's
-//    edges, then each slice's first and last rows, the rows between one step along y apart),
-//    then each near pair added over all rows (its frame coordinates and residuals walked the
-//    same way, affine in the voxel; its rows' square roots and divisions independent, so they
-//    overlap), then the points, in single precision as they are stored. Each of these is
-//    compiled for AVX2 and for the baseline and picked by the CPU, with the same bits from both (no
-//    FMA contraction in this file).
+//    corners at a time in double; the lattice's exact sums take 4 pairs at a time in double.
+//    Each leaf is filled by one kernel on rows of 8 voxels along z (one vector each): the far
+//    sums of every row (along x on the leaf's edges, then each slice's first and last rows, the
+//    rows between one step along y apart), then each near pair added over all rows (its frame
+//    coordinates and residuals walked the same way, affine in the voxel; its rows' square roots
+//    and divisions independent, so they overlap), then the points, in single precision as they
+//    are stored. Each of these is compiled for AVX2 and for the baseline and picked by the CPU,
+//    with the same bits from both (no FMA contraction in this file).
 //
 // Lerios et al. (1995) interpolated the warp over an adaptive grid checked at the next finer
 // lattice; here no sample decides the error, and the exact warp is evaluated at about one point
