@@ -263,6 +263,16 @@ struct LeafJob {
     bool inverseSquare;
 };
 
+/// The far sums of channel c along the rows of slice i: the first row's (y = 0) and the step to
+/// the next row, from the leaf's x edges (per channel, (y, z) = (0, 0), (8, 0), (0, 8), (8, 8)).
+VOLMORPH_ALWAYS_INLINE inline void farRows(const float edge[4][8], int i, v8f& row0, v8f& dy)
+{
+    const v8f fraction = kZ * 0.125f; // k / 8
+    row0 = edge[0][i] + fraction * (edge[2][i] - edge[0][i]);
+    const v8f row8 = edge[1][i] + fraction * (edge[3][i] - edge[1][i]);
+    dy = (row8 - row0) * 0.125f;
+}
+
 /// Adds the near pairs of type T, [begin, end), at every row r: weight into sums[r][0], weighted
 /// residuals into sums[r][1..6] (source x, y, z, target x, y, z). Pair by pair, so that the rows'
 /// square roots and divisions are independent of each other and overlap.
@@ -348,32 +358,17 @@ VOLMORPH_ALWAYS_INLINE inline void fillLeafBody(LeafJob& job, WarpLeaf& leaf)
         n.scale = float(t.scale);
     }
     // The far sums at every voxel, channels as acc below, interpolated in single precision: along
-    // x on the leaf's four edges (lanes i), then per slice i its first and last rows (y = 0 and
-    // y = 8) along z, and the rows between one step along y apart.
-    alignas(32) v8f sums[64][7];
+    // x on the leaf's four edges (lanes i) here, then per slice i its first and last rows (y = 0
+    // and y = 8) along z, and the rows between one step along y apart (farRows).
     const v8f fraction = kZ * 0.125f; // i / 8 or k / 8
+    alignas(32) float edge[7][4][8];  // per channel, (y, z) = (0, 0), (8, 0), (0, 8), (8, 8)
     for (int c = 0; c < 7; ++c) {
         const double* v = job.far[c];
-        alignas(32) float edge[4][8]; // (y, z) = (0, 0), (8, 0), (0, 8), (8, 8)
         for (int m = 0; m < 4; ++m) {
             const float a = float(v[2 * m]), b = float(v[2 * m + 1]);
-            store8(edge[m], a + fraction * (b - a));
-        }
-        for (int i = 0; i < 8; ++i) {
-            const v8f row0 = edge[0][i] + fraction * (edge[2][i] - edge[0][i]);
-            const v8f row8 = edge[1][i] + fraction * (edge[3][i] - edge[1][i]);
-            const v8f dy = (row8 - row0) * 0.125f;
-            v8f row = row0;
-            for (int j = 0; j < 8; ++j) {
-                sums[8 * i + j][c] = row;
-                row += dy;
-            }
+            store8(edge[c][m], a + fraction * (b - a));
         }
     }
-    addNearPairs<FeatureType::Point, InverseSquare>(job, 0, job.typeEnd[0], sums);
-    addNearPairs<FeatureType::Segment, InverseSquare>(job, job.typeEnd[0], job.typeEnd[1], sums);
-    addNearPairs<FeatureType::Rectangle, InverseSquare>(job, job.typeEnd[1], job.typeEnd[2], sums);
-    addNearPairs<FeatureType::Box, InverseSquare>(job, job.typeEnd[2], job.typeEnd[3], sums);
     // p = B + residual sum / weight sum, B walked like the near pairs' functions.
     RowAffine b[6];
     const Vec3d bs0 = job.bS.apply(job.origin), bt0 = job.bT.apply(job.origin);
@@ -381,6 +376,40 @@ VOLMORPH_ALWAYS_INLINE inline void fillLeafBody(LeafJob& job, WarpLeaf& leaf)
         b[c].set(bs0[c], job.bS.col[0][c], job.bS.col[1][c], job.bS.col[2][c]);
         b[3 + c].set(bt0[c], job.bT.col[0][c], job.bT.col[1][c], job.bT.col[2][c]);
     }
+    if (job.near.empty()) {
+        // Every pair far: the rows' sums go straight into the points (the same operations as
+        // below, without storing them).
+        for (int i = 0; i < 8; ++i) {
+            v8f row[7], dy[7], base[6];
+            for (int c = 0; c < 7; ++c) farRows(edge[c], i, row[c], dy[c]);
+            for (int c = 0; c < 6; ++c) base[c] = b[c].first(i);
+            for (int j = 0; j < 8; ++j) {
+                const int r = 8 * i + j;
+                const v8f inv = 1.0f / row[0];
+                for (int c = 0; c < 3; ++c) {
+                    store8(leaf.s[c] + 8 * r, base[c] + row[1 + c] * inv);
+                    store8(leaf.t[c] + 8 * r, base[3 + c] + row[4 + c] * inv);
+                }
+                for (int c = 0; c < 7; ++c) row[c] += dy[c];
+                for (int c = 0; c < 6; ++c) base[c] += b[c].dy;
+            }
+        }
+        return;
+    }
+    alignas(32) v8f sums[64][7];
+    for (int c = 0; c < 7; ++c)
+        for (int i = 0; i < 8; ++i) {
+            v8f row, dy;
+            farRows(edge[c], i, row, dy);
+            for (int j = 0; j < 8; ++j) {
+                sums[8 * i + j][c] = row;
+                row += dy;
+            }
+        }
+    addNearPairs<FeatureType::Point, InverseSquare>(job, 0, job.typeEnd[0], sums);
+    addNearPairs<FeatureType::Segment, InverseSquare>(job, job.typeEnd[0], job.typeEnd[1], sums);
+    addNearPairs<FeatureType::Rectangle, InverseSquare>(job, job.typeEnd[1], job.typeEnd[2], sums);
+    addNearPairs<FeatureType::Box, InverseSquare>(job, job.typeEnd[2], job.typeEnd[3], sums);
     for (int i = 0; i < 8; ++i) {
         v8f base[6];
         for (int c = 0; c < 6; ++c) base[c] = b[c].first(i);
