@@ -273,6 +273,16 @@ VOLMORPH_ALWAYS_INLINE inline void farRows(const float edge[4][8], int i, v8f& r
     dy = (row8 - row0) * 0.125f;
 }
 
+/// Row r's points from its sums (weight, then source and target residuals): p = B + sum / weight.
+VOLMORPH_ALWAYS_INLINE inline void storeRow(WarpLeaf& leaf, int r, const v8f base[6], const v8f acc[7])
+{
+    const v8f inv = 1.0f / acc[0];
+    for (int c = 0; c < 3; ++c) {
+        store8(leaf.s[c] + 8 * r, base[c] + acc[1 + c] * inv);
+        store8(leaf.t[c] + 8 * r, base[3 + c] + acc[4 + c] * inv);
+    }
+}
+
 /// Adds the near pairs of type T, [begin, end), at every row r: weight into sums[r][0], weighted
 /// residuals into sums[r][1..6] (source x, y, z, target x, y, z). Pair by pair, so that the rows'
 /// square roots and divisions are independent of each other and overlap.
@@ -377,19 +387,14 @@ VOLMORPH_ALWAYS_INLINE inline void fillLeafBody(LeafJob& job, WarpLeaf& leaf)
         b[3 + c].set(bt0[c], job.bT.col[0][c], job.bT.col[1][c], job.bT.col[2][c]);
     }
     if (job.near.empty()) {
-        // Every pair far: the rows' sums go straight into the points (the same operations as
-        // below, without storing them).
+        // Every pair far: the rows' sums go straight into the points (storeRow, as below, without
+        // storing the sums first).
         for (int i = 0; i < 8; ++i) {
             v8f row[7], dy[7], base[6];
             for (int c = 0; c < 7; ++c) farRows(edge[c], i, row[c], dy[c]);
             for (int c = 0; c < 6; ++c) base[c] = b[c].first(i);
             for (int j = 0; j < 8; ++j) {
-                const int r = 8 * i + j;
-                const v8f inv = 1.0f / row[0];
-                for (int c = 0; c < 3; ++c) {
-                    store8(leaf.s[c] + 8 * r, base[c] + row[1 + c] * inv);
-                    store8(leaf.t[c] + 8 * r, base[3 + c] + row[4 + c] * inv);
-                }
+                storeRow(leaf, 8 * i + j, base, row);
                 for (int c = 0; c < 7; ++c) row[c] += dy[c];
                 for (int c = 0; c < 6; ++c) base[c] += b[c].dy;
             }
@@ -414,13 +419,7 @@ VOLMORPH_ALWAYS_INLINE inline void fillLeafBody(LeafJob& job, WarpLeaf& leaf)
         v8f base[6];
         for (int c = 0; c < 6; ++c) base[c] = b[c].first(i);
         for (int j = 0; j < 8; ++j) {
-            const int r = 8 * i + j;
-            const v8f* acc = sums[r];
-            const v8f inv = 1.0f / acc[0];
-            for (int c = 0; c < 3; ++c) {
-                store8(leaf.s[c] + 8 * r, base[c] + acc[1 + c] * inv);
-                store8(leaf.t[c] + 8 * r, base[3 + c] + acc[4 + c] * inv);
-            }
+            storeRow(leaf, 8 * i + j, base, sums[8 * i + j]);
             for (int c = 0; c < 6; ++c) base[c] += b[c].dy;
         }
     }
