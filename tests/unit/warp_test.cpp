@@ -439,37 +439,44 @@ TEST(AdaptiveWarp, VectorAndBaselineKernelsGiveTheSameBits)
             spec.p = 0.5;
         }
         const InverseWarp warp(pairs, spec, 0.4);
-        const detail::AdaptiveWarp adaptive(warp, 0.25);
-        auto run = [&](bool baseline) {
-            detail::useBaselineKernel(baseline);
-            std::mutex m;
-            std::map<std::tuple<int, int, int>, std::vector<float>> leaves;
-            detail::AdaptiveWarpStats stats;
-            const detail::Occupancy* occ = trial == 2 ? &occupancy : nullptr;
-            adaptive.forEachLeaf(openvdb::CoordBBox(openvdb::Coord(0), openvdb::Coord(95)), occ, occ,
-                                 [&](const detail::WarpLeaf& leaf) {
-                                     std::vector<float> v(&leaf.s[0][0], &leaf.s[0][0] + 3 * 512);
-                                     v.insert(v.end(), &leaf.t[0][0], &leaf.t[0][0] + 3 * 512);
-                                     std::lock_guard<std::mutex> lock(m);
-                                     leaves[{leaf.origin.x(), leaf.origin.y(), leaf.origin.z()}] = std::move(v);
-                                 },
-                                 &stats);
-            detail::useBaselineKernel(false);
-            EXPECT_GT(stats.nearEvaluations, 0u); // the near-pair loops ran
-            return leaves;
-        };
-        const auto vector = run(false), baseline = run(true);
-        if (trial < 2) {
-            ASSERT_EQ(vector.size(), 12u * 12u * 12u);
-        } else {
-            ASSERT_GT(vector.size(), 0u);
-            ASSERT_LT(vector.size(), 12u * 12u * 12u); // the domain test culled leaves
+        // 0.25: most leaves have near pairs; 1e6: only the kinks are near, and the other leaves
+        // take the kernel's path with no near pair.
+        for (const double tolerance : {0.25, 1e6}) {
+            const detail::AdaptiveWarp adaptive(warp, tolerance);
+            auto run = [&](bool baseline) {
+                detail::useBaselineKernel(baseline);
+                std::mutex m;
+                std::map<std::tuple<int, int, int>, std::vector<float>> leaves;
+                detail::AdaptiveWarpStats stats;
+                const detail::Occupancy* occ = trial == 2 ? &occupancy : nullptr;
+                adaptive.forEachLeaf(openvdb::CoordBBox(openvdb::Coord(0), openvdb::Coord(95)), occ, occ,
+                                     [&](const detail::WarpLeaf& leaf) {
+                                         std::vector<float> v(&leaf.s[0][0], &leaf.s[0][0] + 3 * 512);
+                                         v.insert(v.end(), &leaf.t[0][0], &leaf.t[0][0] + 3 * 512);
+                                         std::lock_guard<std::mutex> lock(m);
+                                         leaves[{leaf.origin.x(), leaf.origin.y(), leaf.origin.z()}] = std::move(v);
+                                     },
+                                     &stats);
+                detail::useBaselineKernel(false);
+                EXPECT_GT(stats.nearEvaluations, 0u); // the near-pair loops ran
+                if (tolerance > 1.0) {
+                    EXPECT_GT(stats.allFarLeaves, 0u); // and the path without them
+                }
+                return leaves;
+            };
+            const auto vector = run(false), baseline = run(true);
+            if (trial < 2) {
+                ASSERT_EQ(vector.size(), 12u * 12u * 12u);
+            } else {
+                ASSERT_GT(vector.size(), 0u);
+                ASSERT_LT(vector.size(), 12u * 12u * 12u); // the domain test culled leaves
+            }
+            ASSERT_EQ(vector.size(), baseline.size());
+            size_t differing = 0;
+            for (const auto& [origin, v] : vector)
+                differing += std::memcmp(v.data(), baseline.at(origin).data(), v.size() * sizeof(float)) != 0;
+            EXPECT_EQ(differing, 0u) << "trial " << trial << ", tolerance " << tolerance;
         }
-        ASSERT_EQ(vector.size(), baseline.size());
-        size_t differing = 0;
-        for (const auto& [origin, v] : vector)
-            differing += std::memcmp(v.data(), baseline.at(origin).data(), v.size() * sizeof(float)) != 0;
-        EXPECT_EQ(differing, 0u) << "trial " << trial;
     }
 }
 

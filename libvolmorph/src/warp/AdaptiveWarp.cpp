@@ -106,7 +106,7 @@ struct AdaptiveWarp::Context {
     const LeafFunction* fn;
     WarpLeaf leaf;
     double maxError = 0.0;
-    uint64_t evaluations = 0, near = 0, leaves = 0;
+    uint64_t evaluations = 0, near = 0, allFar = 0, leaves = 0;
     // Per pair, per leaf (scratch).
     std::unique_ptr<LeafJob> job = std::make_unique<LeafJob>();
     PairBounds bounds;
@@ -1147,6 +1147,7 @@ void AdaptiveWarp::leaf(Context& ctx, const Lattice& lattice, const Coord& origi
     const uint64_t near = uint64_t(nearCount) * 512;
     fill(ctx, origin);
     ctx.near += near;
+    ctx.allFar += nearCount == 0;
     ctx.maxError = std::max(ctx.maxError, bound);
     visit(bound, !ctx.coreTouches);
 }
@@ -1352,6 +1353,7 @@ void AdaptiveWarp::forEachLeaf(const CoordBBox& box, const Occupancy* source, co
         stats->maxErrorVoxels = std::max(stats->maxErrorVoxels, ctx.maxError);
         stats->exactEvaluations += ctx.evaluations;
         stats->nearEvaluations += ctx.near;
+        stats->allFarLeaves += ctx.allFar;
         stats->leaves += ctx.leaves;
     }
     stats->exactEvaluations += latticeEvaluations;

@@ -105,6 +105,7 @@ struct AdaptiveWarpStats {
     double maxErrorVoxels = 0.0;     ///< the largest error bound of an interpolated leaf (voxels)
     uint64_t exactEvaluations = 0;   ///< exact warp evaluations (lattice points, exact leaves' voxels)
     uint64_t nearEvaluations = 0;    ///< near pairs evaluated at single voxels (one pair each)
+    uint64_t allFarLeaves = 0;       ///< interpolated leaves with no near pair
     uint64_t leaves = 0;             ///< leaves visited (the candidate domain)
 };
 
