@@ -34,17 +34,16 @@ struct LeafJob;
 
 /// Everything the error bound needs of each pair over a cube, one column per quantity (single
 /// precision: its rounding, some 1e-7 of each term, is far inside the bound's slack).
+/// Stored in groups of 8 pairs, all columns of a group together (one base address for a loop's
+/// loads and stores: the columns' own pointers no longer compete for registers).
 struct PairBounds {
-    enum Column { RMin, WMax, WMin, WC, W1, W2, Constant, Resid, RS0, RS1, RS2, RT0, RT1, RT2, Term, Hess, Count };
-    std::vector<float> storage;
-    size_t stride = 0;
-    void resize(size_t n)
-    {
-        stride = n;
-        storage.resize(n * Count);
-    }
-    float* operator[](Column c) { return storage.data() + c * stride; }
-    const float* operator[](Column c) const { return storage.data() + c * stride; }
+    enum Column { WMax, W1, W2, Constant, Resid, RS0, RS1, RS2, RT0, RT1, RT2, Term, Hess, Count };
+    struct Group {
+        float v[Count][8];
+    };
+    std::vector<Group> groups;
+    void resize(size_t padded) { groups.resize(padded / 8); }
+    float get(Column c, size_t i) const { return groups[i / 8].v[c][i % 8]; }
 };
 
 } // namespace
@@ -77,17 +76,27 @@ namespace {
 
 /// The pairs, one column per quantity, padded to a multiple of 8 (the bound's loops take 8 pairs
 /// at a time in single precision, the exact sums 4 at a time in double; padding lanes compute
-/// harmless values that are never read, or are masked by `live`).
+/// harmless values that are never read, or are masked by `live`). Stored in groups of one
+/// vector's lanes, all columns of a group together (see PairBounds).
 template <class Real>
 struct PairColumns {
+    static constexpr size_t kLanes = 32 / sizeof(Real);
+    enum Column {
+        Origin = 0,  ///< + k: the element's origin, index axes
+        Axis = 3,    ///< + 3 k + a: component a of the frame's axis k
+        Half = 12,   ///< + k: half the scale along axis k, 0 where the type does not extend
+        Reach = 15,  ///< + k: half the extent along axis k of a unit axis-aligned cube
+        Box = 18,    ///< 1 for boxes
+        Live = 19,   ///< 1 for the pairs, 0 for the padding
+        Affine = 20, ///< + 12 side + 3 column + a: the affine maps (column 3: offset)
+        Count = 44
+    };
+    struct Group {
+        Real v[Count][kLanes];
+    };
     size_t padded = 0;
-    std::vector<Real> origin[3];       ///< the element's origin, index axes
-    std::vector<Real> axis[3][3];      ///< [k][a]: component a of the frame's axis k
-    std::vector<Real> half[3];         ///< half the scale along axis k, 0 where the type does not extend
-    std::vector<Real> reach[3];        ///< half the extent along axis k of a unit axis-aligned cube
-    std::vector<Real> box;             ///< 1 for boxes
-    std::vector<Real> live;            ///< 1 for the pairs, 0 for the padding
-    std::vector<Real> affine[2][4][3]; ///< [side][column][a]: the affine maps (column 3: offset)
+    std::vector<Group> groups;
+    Real get(int c, size_t i) const { return groups[i / kLanes].v[c][i % kLanes]; }
 
     PairColumns(const InverseWarp& warp, const std::vector<InverseWarp::Affine> maps[2]);
 };
@@ -112,6 +121,7 @@ struct AdaptiveWarp::Context {
     PairBounds bounds;
     std::vector<char> isNear;
     std::vector<size_t> nearList; ///< the near pairs, by type, then by index
+    std::vector<float> termList, hessList; ///< selectNear's copies of the bound's columns
     // What analyze() found of the last cell.
     const LatticePoint* corner[8];
     bool cornersOk = false, tiny = false, coreTouches = false;
@@ -459,6 +469,7 @@ PairColumns<Real>::PairColumns(const InverseWarp& warp, const std::vector<Invers
 {
     const size_t n = warp.pairCount();
     padded = (n + 7) / 8 * 8;
+    groups.resize(padded / kLanes);
     InverseWarp::Affine zero;
     zero.col[0] = zero.col[1] = zero.col[2] = zero.offset = Vec3d(0.0);
     for (size_t i = 0; i < padded; ++i) {
@@ -466,20 +477,21 @@ PairColumns<Real>::PairColumns(const InverseWarp& warp, const std::vector<Invers
         const Feature e = i < n ? warp.interpolated(i) : Feature();
         const int extent = e.type == FeatureType::Point ? 0 : e.type == FeatureType::Segment ? 1 : e.type == FeatureType::Rectangle ? 2 : 3;
         const Vec3d* axes[3] = {&e.x, &e.y, &e.z};
+        auto set = [&](int c, double v) { groups[i / kLanes].v[c][i % kLanes] = Real(v); };
         for (int k = 0; k < 3; ++k) {
-            origin[k].push_back(Real(e.origin[k]));
-            for (int a = 0; a < 3; ++a) axis[k][a].push_back(Real((*axes[k])[a]));
-            half[k].push_back(Real(k < extent ? 0.5 * e.scale[k] : 0.0));
+            set(Origin + k, e.origin[k]);
+            for (int a = 0; a < 3; ++a) set(Axis + 3 * k + a, (*axes[k])[a]);
+            set(Half + k, k < extent ? 0.5 * e.scale[k] : 0.0);
             const Vec3d& ax = *axes[k];
-            reach[k].push_back(Real(0.5 * (std::abs(ax.x()) + std::abs(ax.y()) + std::abs(ax.z()))));
+            set(Reach + k, 0.5 * (std::abs(ax.x()) + std::abs(ax.y()) + std::abs(ax.z())));
         }
-        box.push_back(e.type == FeatureType::Box ? 1 : 0);
-        live.push_back(i < n ? 1 : 0);
+        set(Box, e.type == FeatureType::Box ? 1 : 0);
+        set(Live, i < n ? 1 : 0);
         for (int side = 0; side < 2; ++side) {
             const InverseWarp::Affine& m = i < n ? maps[side][i] : zero;
             for (int a = 0; a < 3; ++a) {
-                for (int k = 0; k < 3; ++k) affine[side][k][a].push_back(Real(m.col[k][a]));
-                affine[side][3][a].push_back(Real(m.offset[a]));
+                for (int k = 0; k < 3; ++k) set(Affine + 12 * side + 3 * k + a, m.col[k][a]);
+                set(Affine + 12 * side + 9 + a, m.offset[a]);
             }
         }
     }
@@ -647,18 +659,7 @@ VOLMORPH_ALWAYS_INLINE inline void AdaptiveWarp::analyzeBody(Context& ctx, const
     PairBounds& pb = ctx.bounds;
     pb.resize(padded);
     using C = PairBounds::Column;
-    float* const __restrict rMinC = pb[C::RMin];
-    float* const __restrict wMaxC = pb[C::WMax];
-    float* const __restrict wMinC = pb[C::WMin];
-    float* const __restrict wcC = pb[C::WC];
-    float* const __restrict w1C = pb[C::W1];
-    float* const __restrict w2C = pb[C::W2];
-    float* const __restrict constantC = pb[C::Constant];
-    float* const __restrict residC = pb[C::Resid];
-    float* const __restrict termC = pb[C::Term];
-    float* const __restrict hessC = pb[C::Hess];
-    float* const rs[3] = {pb[C::RS0], pb[C::RS1], pb[C::RS2]};
-    float* const rt[3] = {pb[C::RT0], pb[C::RT1], pb[C::RT2]};
+    using PC = PairColumns<float>;
     const v8f zero = splat8(0.0f), one = splat8(1.0f), infinity = splat8(std::numeric_limits<float>::infinity());
 
     // Per pair: frame coordinates q of the centre, the distance dc = |max(|q| - half, 0)| (half 0
@@ -672,23 +673,25 @@ VOLMORPH_ALWAYS_INLINE inline void AdaptiveWarp::analyzeBody(Context& ctx, const
     v8f best = splat8(-1.0f);
     const v8i laneIndex = {0, 1, 2, 3, 4, 5, 6, 7};
     for (size_t i = 0; i < padded; i += 8) {
-        const v8i live = load8(&col.live[i]) != zero;
-        const v8f p[3] = {cf.x() - load8(&col.origin[0][i]), cf.y() - load8(&col.origin[1][i]), cf.z() - load8(&col.origin[2][i])};
+        const PC::Group& cg = col.groups[i / 8];
+        PairBounds::Group& pg = pb.groups[i / 8];
+        const v8i live = load8(cg.v[PC::Live]) != zero;
+        const v8f p[3] = {cf.x() - load8(cg.v[PC::Origin + 0]), cf.y() - load8(cg.v[PC::Origin + 1]), cf.z() - load8(cg.v[PC::Origin + 2])};
         v8f q[3], v[3], out2 = zero;
-        v8i inside = load8(&col.box[i]) != zero;
+        v8i inside = load8(cg.v[PC::Box]) != zero;
         for (int k = 0; k < 3; ++k) {
-            q[k] = load8(&col.axis[k][0][i]) * p[0] + load8(&col.axis[k][1][i]) * p[1] + load8(&col.axis[k][2][i]) * p[2];
-            const v8f d = outside(q[k], load8(&col.half[k][i]));
+            q[k] = load8(cg.v[PC::Axis + 3 * k + 0]) * p[0] + load8(cg.v[PC::Axis + 3 * k + 1]) * p[1] + load8(cg.v[PC::Axis + 3 * k + 2]) * p[2];
+            const v8f d = outside(q[k], load8(cg.v[PC::Half + k]));
             out2 += d * d;
             v[k] = q[k] < zero ? -d : d;
-            inside &= vabs(q[k]) + hf * load8(&col.reach[k][i]) <= load8(&col.half[k][i]);
+            inside &= vabs(q[k]) + hf * load8(cg.v[PC::Reach + k]) <= load8(cg.v[PC::Half + k]);
         }
         const v8f d = vsqrt(out2);
         const v8i positive = d > zero;
         const v8f inv = positive ? one / d : zero;
         v8f gL1 = zero, g[3];
         for (int a = 0; a < 3; ++a) {
-            g[a] = (load8(&col.axis[0][a][i]) * v[0] + load8(&col.axis[1][a][i]) * v[1] + load8(&col.axis[2][a][i]) * v[2]) * inv;
+            g[a] = (load8(cg.v[PC::Axis + 3 * 0 + a]) * v[0] + load8(cg.v[PC::Axis + 3 * 1 + a]) * v[1] + load8(cg.v[PC::Axis + 3 * 2 + a]) * v[2]) * inv;
             gL1 += vabs(g[a]);
         }
         // d is convex (the distance to a convex set), so it lies above its tangent plane at the
@@ -699,8 +702,7 @@ VOLMORPH_ALWAYS_INLINE inline void AdaptiveWarp::analyzeBody(Context& ctx, const
         // cube (d + halfDiagonal only where g is along a diagonal).
         const v8f dMax = vmin(d + halfDiagonalF, vsqrt((d * d + (hf * d) * gL1) + (0.75f * hf * hf)));
         const v8f rMin = offset + dMin, rMax = offset + (inside ? zero : dMax);
-        store8(rMinC + i, rMin);
-        store8(constantC + i, inside ? one : zero);
+        store8(pg.v[C::Constant], inside ? one : zero);
         // Weights at the smallest and largest distance and at the centre.
         v8f wMax, wMin, wc;
         if (inverseSquare) {
@@ -716,9 +718,7 @@ VOLMORPH_ALWAYS_INLINE inline void AdaptiveWarp::analyzeBody(Context& ctx, const
                 wc[l] = float(mWarp.weightAt(j, d[l]));
             }
         }
-        store8(wMaxC + i, wMax);
-        store8(wMinC + i, wMin);
-        store8(wcC + i, wc);
+        store8(pg.v[C::WMax], wMax);
         wMinTotal.add(live ? wMin : zero);
         steep |= live & ((rMin < float(kTinyRadius)) | ~(wMax <= std::numeric_limits<float>::max()));
         const v8f centreWeight = live ? wc : splat8(-1.0f);
@@ -760,8 +760,8 @@ VOLMORPH_ALWAYS_INLINE inline void AdaptiveWarp::analyzeBody(Context& ctx, const
         const v8f slopeBound = b * wMax * invR;
         const v8f first = apart ? slopeBound * vsqrt(axial) : slopeBound;
         const v8f second = apart ? wMax * invR * curved : infinity;
-        store8(w1C + i, inside ? zero : first);
-        store8(w2C + i, inside ? zero : second);
+        store8(pg.v[C::W1], inside ? zero : first);
+        store8(pg.v[C::W2], inside ? zero : second);
     }
     const double wMinSum = ctx.wMinSum = wMinTotal.total();
     ctx.tiny = false;
@@ -785,21 +785,22 @@ VOLMORPH_ALWAYS_INLINE inline void AdaptiveWarp::analyzeBody(Context& ctx, const
     WideSum rhoTotal;
     v8f residLargest = zero;
     for (size_t i = 0; i < padded; i += 8) {
-        const v8i live = load8(&col.live[i]) != zero;
+        const PC::Group& cg = col.groups[i / 8];
+        PairBounds::Group& pg = pb.groups[i / 8];
+        const v8i live = load8(cg.v[PC::Live]) != zero;
         v8f length2[2];
         for (int side = 0; side < 2; ++side) {
-            const auto& m = col.affine[side];
             length2[side] = zero;
             for (int a = 0; a < 3; ++a) {
-                const v8f r = load8(&m[0][a][i]) * cf.x() + load8(&m[1][a][i]) * cf.y() +
-                              load8(&m[2][a][i]) * cf.z() + load8(&m[3][a][i]) - bc[side][a];
-                store8((side == 0 ? rs[a] : rt[a]) + i, r);
+                const v8f r = load8(cg.v[PC::Affine + 12 * side + 3 * 0 + a]) * cf.x() + load8(cg.v[PC::Affine + 12 * side + 3 * 1 + a]) * cf.y() +
+                              load8(cg.v[PC::Affine + 12 * side + 3 * 2 + a]) * cf.z() + load8(cg.v[PC::Affine + 12 * side + 3 * 3 + a]) - bc[side][a];
+                store8(pg.v[(side == 0 ? C::RS0 : C::RT0) + a], r);
                 length2[side] += r * r;
             }
         }
         const v8f resid = vsqrt(vmax(length2[0], length2[1])) + load8(&slope[i]) * halfDiagonalF;
-        store8(residC + i, resid);
-        const v8f wMax = live ? load8(wMaxC + i) : zero, residLive = live ? resid : zero;
+        store8(pg.v[C::Resid], resid);
+        const v8f wMax = live ? load8(pg.v[C::WMax]) : zero, residLive = live ? resid : zero;
         rhoTotal.lo += lowHalf(wMax) * lowHalf(residLive); // products of floats, exact in double
         rhoTotal.hi += highHalf(wMax) * highHalf(residLive);
         residLargest = vmax(residLargest, residLive);
@@ -814,12 +815,14 @@ VOLMORPH_ALWAYS_INLINE inline void AdaptiveWarp::analyzeBody(Context& ctx, const
     const v8f none = n == 1 ? one : zero;
     WideSum termTotal, hessTotal;
     for (size_t i = 0; i < padded; i += 8) {
-        const v8f w1 = load8(w1C + i), w2 = load8(w2C + i);
-        const v8i skip = (load8(constantC + i) != zero) | (none != zero) | (load8(&col.live[i]) == zero);
-        const v8f term = skip ? zero : w2 == infinity ? infinity : k * ((load8(residC + i) + rhoMaxF) * w2 + 2.0f * load8(&slope[i]) * w1);
+        const PC::Group& cg = col.groups[i / 8];
+        PairBounds::Group& pg = pb.groups[i / 8];
+        const v8f w1 = load8(pg.v[C::W1]), w2 = load8(pg.v[C::W2]);
+        const v8i skip = (load8(pg.v[C::Constant]) != zero) | (none != zero) | (load8(cg.v[PC::Live]) == zero);
+        const v8f term = skip ? zero : w2 == infinity ? infinity : k * ((load8(pg.v[C::Resid]) + rhoMaxF) * w2 + 2.0f * load8(&slope[i]) * w1);
         const v8f hess = skip ? zero : k * w2;
-        store8(hessC + i, hess);
-        store8(termC + i, term);
+        store8(pg.v[C::Hess], hess);
+        store8(pg.v[C::Term], term);
         termTotal.add(term);
         hessTotal.add(hess);
     }
@@ -880,19 +883,21 @@ VOLMORPH_ALWAYS_INLINE inline void AdaptiveWarp::analyzeBody(Context& ctx, const
     const float boundAllFar = float(ctx.boundAllFar), radiusS = float(radius[0]), radiusT = float(radius[1]);
     WideSum tightTotal;
     for (size_t i = 0; i < padded; i += 8) {
+        const PC::Group& cg = col.groups[i / 8];
+        PairBounds::Group& pg = pb.groups[i / 8];
         v8f length2[2] = {zero, zero};
         for (int a = 0; a < 3; ++a) {
-            const v8f ds = load8(rs[a] + i) - mid[0][a], dt = load8(rt[a] + i) - mid[1][a];
+            const v8f ds = load8(pg.v[C::RS0 + a]) - mid[0][a], dt = load8(pg.v[C::RT0 + a]) - mid[1][a];
             length2[0] += ds * ds;
             length2[1] += dt * dt;
         }
-        const v8f w1 = load8(w1C + i), w2 = load8(w2C + i), term = load8(termC + i);
+        const v8f w1 = load8(pg.v[C::W1]), w2 = load8(pg.v[C::W2]), term = load8(pg.v[C::Term]);
         const v8f apart = vmax(vsqrt(length2[0]) + radiusS, vsqrt(length2[1]) + radiusT) +
                           load8(&slope[i]) * halfDiagonalF + boundAllFar;
-        const v8i tighter = (term != infinity) & (load8(constantC + i) == zero) & (apart < load8(residC + i) + rhoMaxF);
+        const v8i tighter = (term != infinity) & (load8(pg.v[C::Constant]) == zero) & (apart < load8(pg.v[C::Resid]) + rhoMaxF);
         const v8f tightTerm = tighter ? k * (apart * w2 + 2.0f * load8(&slope[i]) * w1) : term;
-        store8(termC + i, tightTerm);
-        tightTotal.add(load8(&col.live[i]) != zero ? tightTerm : zero); // padding lanes hold no pair
+        store8(pg.v[C::Term], tightTerm);
+        tightTotal.add(load8(cg.v[PC::Live]) != zero ? tightTerm : zero); // padding lanes hold no pair
     }
     ctx.boundAllFar = std::min(ctx.boundAllFar, bound(ctx, tightTotal.total(), hess, ctx.wCornerMin));
 }
@@ -908,16 +913,18 @@ VOLMORPH_ALWAYS_INLINE inline bool AdaptiveWarp::exactSumsBody(const Vec3d& x, L
     const v4d zero = splat(0.0), one = splat(1.0);
     v4d W = zero, S[3] = {zero, zero, zero}, T[3] = {zero, zero, zero};
     v4l onElement = v4l{0, 0, 0, 0};
+    using PC = PairColumns<double>;
     for (size_t i = 0; i < col.padded; i += 4) {
-        const v4d p[3] = {x.x() - load4(&col.origin[0][i]), x.y() - load4(&col.origin[1][i]), x.z() - load4(&col.origin[2][i])};
+        const PC::Group& cg = col.groups[i / 4];
+        const v4d p[3] = {x.x() - load4(cg.v[PC::Origin + 0]), x.y() - load4(cg.v[PC::Origin + 1]), x.z() - load4(cg.v[PC::Origin + 2])};
         v4d out2 = zero;
         for (int k = 0; k < 3; ++k) {
-            const v4d q = load4(&col.axis[k][0][i]) * p[0] + load4(&col.axis[k][1][i]) * p[1] + load4(&col.axis[k][2][i]) * p[2];
-            const v4d d = outside(q, load4(&col.half[k][i]));
+            const v4d q = load4(cg.v[PC::Axis + 3 * k + 0]) * p[0] + load4(cg.v[PC::Axis + 3 * k + 1]) * p[1] + load4(cg.v[PC::Axis + 3 * k + 2]) * p[2];
+            const v4d d = outside(q, load4(cg.v[PC::Half + k]));
             out2 += d * d;
         }
         const v4d d = vsqrt(out2), r = d + offset;
-        const v4l live = load4(&col.live[i]) != zero;
+        const v4l live = load4(cg.v[PC::Live]) != zero;
         onElement |= live & (r < InverseWarp::kOnElement);
         v4d w;
         if (inverseSquare) {
@@ -928,10 +935,8 @@ VOLMORPH_ALWAYS_INLINE inline bool AdaptiveWarp::exactSumsBody(const Vec3d& x, L
         w = live ? w : zero;
         W += w;
         for (int a = 0; a < 3; ++a) {
-            const auto& ms = col.affine[0];
-            const auto& mt = col.affine[1];
-            S[a] += w * (load4(&ms[0][a][i]) * x.x() + load4(&ms[1][a][i]) * x.y() + load4(&ms[2][a][i]) * x.z() + load4(&ms[3][a][i]));
-            T[a] += w * (load4(&mt[0][a][i]) * x.x() + load4(&mt[1][a][i]) * x.y() + load4(&mt[2][a][i]) * x.z() + load4(&mt[3][a][i]));
+            S[a] += w * (load4(cg.v[PC::Affine + 3 * 0 + a]) * x.x() + load4(cg.v[PC::Affine + 3 * 1 + a]) * x.y() + load4(cg.v[PC::Affine + 3 * 2 + a]) * x.z() + load4(cg.v[PC::Affine + 3 * 3 + a]));
+            T[a] += w * (load4(cg.v[PC::Affine + 12 + 3 * 0 + a]) * x.x() + load4(cg.v[PC::Affine + 12 + 3 * 1 + a]) * x.y() + load4(cg.v[PC::Affine + 12 + 3 * 2 + a]) * x.z() + load4(cg.v[PC::Affine + 12 + 3 * 3 + a]));
         }
     }
     auto total = [](v4d v) { return (v[0] + v[1]) + (v[2] + v[3]); };
@@ -1019,8 +1024,15 @@ double AdaptiveWarp::selectNear(Context& ctx, size_t& nearCount) const
     // Largest share first, until the far pairs' bound is within the tolerance: the far sums are
     // the totals less the near pairs' shares (infinite shares, kinks, counted apart).
     const size_t n = mWarp.pairCount();
-    const float* term = ctx.bounds[PairBounds::Term];
-    const float* hess = ctx.bounds[PairBounds::Hess];
+    // The terms and Hessian bounds, in pair order (from their groups).
+    std::vector<float>& term = ctx.termList;
+    std::vector<float>& hess = ctx.hessList;
+    term.resize(n);
+    hess.resize(n);
+    for (size_t i = 0; i < n; ++i) {
+        term[i] = ctx.bounds.get(PairBounds::Term, i);
+        hess[i] = ctx.bounds.get(PairBounds::Hess, i);
+    }
     ctx.isNear.assign(n, 0);
     double terms = 0.0, hessSum = 0.0;
     size_t kinks = 0;
@@ -1084,7 +1096,7 @@ void AdaptiveWarp::fill(Context& ctx, const Coord& origin) const
         NearTerm t;
         t.element = &mWarp.interpolated(p);
         t.scale = mWarp.weightScale(p);
-        for (int k = 0; k < 3; ++k) t.half[k] = mColumns->exact.half[k][p];
+        for (int k = 0; k < 3; ++k) t.half[k] = mColumns->exact.get(PairColumns<double>::Half + k, p);
         t.rs = mSource[p].apply(o) - bso;
         t.rt = mTarget[p].apply(o) - bto;
         for (int k = 0; k < 3; ++k) {
