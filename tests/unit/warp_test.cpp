@@ -421,7 +421,8 @@ TEST(AdaptiveWarp, ErrorBoundHoldsAtEveryVoxelOfEveryLeaf)
 
 TEST(AdaptiveWarp, VectorAndBaselineKernelsGiveTheSameBits)
 {
-    // The leaf kernel, the bound and the lattice's sums run in AVX2 where the CPU has it; a farm
+    // The leaf kernel, the bound and the lattice's sums run in AVX2 (or AVX2 with AVX-512VL) where
+    // the CPU has it, each build compared with the baseline here; a farm
     // mixing machines must still get the same frames. Every pair type, near and far pairs, both
     // weight laws, with and without the domain test (trial 2: occupancies of a sphere on both
     // sides, so that cells, leaves and the filled points' boxes are culled), compared bit for bit.
@@ -443,8 +444,8 @@ TEST(AdaptiveWarp, VectorAndBaselineKernelsGiveTheSameBits)
         // take the kernel's path with no near pair.
         for (const double tolerance : {0.25, 1e6}) {
             const detail::AdaptiveWarp adaptive(warp, tolerance);
-            auto run = [&](bool baseline) {
-                detail::useBaselineKernel(baseline);
+            auto run = [&](detail::KernelBuild build) {
+                detail::useKernelBuild(build);
                 std::mutex m;
                 std::map<std::tuple<int, int, int>, std::vector<float>> leaves;
                 detail::AdaptiveWarpStats stats;
@@ -457,25 +458,33 @@ TEST(AdaptiveWarp, VectorAndBaselineKernelsGiveTheSameBits)
                                          leaves[{leaf.origin.x(), leaf.origin.y(), leaf.origin.z()}] = std::move(v);
                                      },
                                      &stats);
-                detail::useBaselineKernel(false);
+                detail::useKernelBuild(detail::KernelBuild::Avx512);
                 EXPECT_GT(stats.nearEvaluations, 0u); // the near-pair loops ran
                 if (tolerance > 1.0) {
                     EXPECT_GT(stats.allFarLeaves, 0u); // and the path without them
                 }
                 return leaves;
             };
-            const auto vector = run(false), baseline = run(true);
+            const auto baseline = run(detail::KernelBuild::Baseline);
             if (trial < 2) {
-                ASSERT_EQ(vector.size(), 12u * 12u * 12u);
+                ASSERT_EQ(baseline.size(), 12u * 12u * 12u);
             } else {
-                ASSERT_GT(vector.size(), 0u);
-                ASSERT_LT(vector.size(), 12u * 12u * 12u); // the domain test culled leaves
+                ASSERT_GT(baseline.size(), 0u);
+                ASSERT_LT(baseline.size(), 12u * 12u * 12u); // the domain test culled leaves
             }
-            ASSERT_EQ(vector.size(), baseline.size());
-            size_t differing = 0;
-            for (const auto& [origin, v] : vector)
-                differing += std::memcmp(v.data(), baseline.at(origin).data(), v.size() * sizeof(float)) != 0;
-            EXPECT_EQ(differing, 0u) << "trial " << trial << ", tolerance " << tolerance;
+            // Each vector build this CPU has (the baseline alone where it has none).
+            for (const detail::KernelBuild build : {detail::KernelBuild::Avx2, detail::KernelBuild::Avx512}) {
+                detail::useKernelBuild(build);
+                const bool available = detail::activeKernelBuild() == build;
+                detail::useKernelBuild(detail::KernelBuild::Avx512);
+                if (!available) continue;
+                const auto vector = run(build);
+                ASSERT_EQ(vector.size(), baseline.size());
+                size_t differing = 0;
+                for (const auto& [origin, v] : vector)
+                    differing += std::memcmp(v.data(), baseline.at(origin).data(), v.size() * sizeof(float)) != 0;
+                EXPECT_EQ(differing, 0u) << "build " << int(build) << ", trial " << trial << ", tolerance " << tolerance;
+            }
         }
     }
 }

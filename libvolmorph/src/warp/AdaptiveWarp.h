@@ -57,8 +57,8 @@
 //    and divisions independent, so they overlap), then the points, in single precision as they
 //    are stored (with no near pair, a third of the leaves, the rows' sums go straight into the
 //    points, unstored: the same operations and bits, 2% less time). Each of these is compiled
-//    for AVX2 and for the baseline and picked by the CPU, with the same bits from both (no FMA
-//    contraction in this file).
+//    for AVX2, for AVX2 with AVX-512VL (32 vector registers) and for the baseline and picked by
+//    the CPU, with the same bits from all (no FMA contraction in this file).
 //
 // Lerios et al. (1995) interpolated the warp over an adaptive grid checked at the next finer
 // lattice; here no sample decides the error, and the exact warp is evaluated at about one point
@@ -109,10 +109,14 @@ struct AdaptiveWarpStats {
     uint64_t leaves = 0;             ///< leaves visited (the candidate domain)
 };
 
-/// The leaf kernel, the bound and the lattice's sums run in AVX2 where the CPU has it, with the
-/// same bits as their baseline builds; true forces the baselines (process-wide; for tests that
-/// compare the two).
-void useBaselineKernel(bool baseline);
+/// The builds of the leaf kernel, the bound and the lattice's sums, least capable first: the
+/// baseline, AVX2, and AVX2 with AVX-512VL (its 32 vector registers). All give the same bits.
+enum class KernelBuild { Baseline, Avx2, Avx512 };
+/// The most capable build the CPU has runs, at most `limit` (process-wide; for tests that compare
+/// the builds; Avx512, the default, means no limit).
+void useKernelBuild(KernelBuild limit);
+/// The build that runs now.
+KernelBuild activeKernelBuild();
 
 class AdaptiveWarp {
 public:
@@ -151,9 +155,11 @@ private:
     bool exactSums(const Vec3d& x, LatticePoint& out) const;
     bool exactSumsBody(const Vec3d& x, LatticePoint& out) const;
     bool exactSumsAvx2(const Vec3d& x, LatticePoint& out) const;
-    /// analyze() in its two builds (AVX2 and the baseline; see the kernel).
+    bool exactSumsAvx512(const Vec3d& x, LatticePoint& out) const;
+    /// analyze() and exactSums() in their builds (see KernelBuild).
     void analyzeBody(Context& ctx, const LatticePoint* const corners[8], const openvdb::Coord& origin, int size) const;
     void analyzeAvx2(Context& ctx, const LatticePoint* const corners[8], const openvdb::Coord& origin, int size) const;
+    void analyzeAvx512(Context& ctx, const LatticePoint* const corners[8], const openvdb::Coord& origin, int size) const;
     /// False when the analysed cube's image misses both sides' occupied blocks.
     bool mayTouch(Context& ctx, const openvdb::Coord& origin, int size) const;
     /// The error bound of the analysed cube from its far pairs' summed terms and Hessian bounds,
