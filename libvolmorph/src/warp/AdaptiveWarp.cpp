@@ -555,7 +555,7 @@ bool touches(const Occupancy* occ, const Vec3d& lo, const Vec3d& hi, double marg
 
 // The leaf kernel is compiled three times on x86-64 with GCC: for AVX2 (8 voxels of a row in one
 // instruction), for AVX2 with AVX-512VL (the same 8-lane code with 32 vector registers instead
-// of 16: fewer spills, 2-4% less time) and for the baseline, and picked by the CPU at run time.
+// of 16: fewer spills, about 2% less time) and for the baseline, and picked by the CPU at run time.
 // Each lane does the same IEEE operations in every build (no FMA contraction: -ffp-contract=off
 // on this file), so the points are bit-identical whatever the machine; the warp tests check it
 // with useKernelBuild.
