@@ -283,10 +283,10 @@ VOLMORPH_ALWAYS_INLINE inline void farRows(const float edge[4][8], int i, v8f& r
     dy = (row8 - row0) * 0.125f;
 }
 
-/// Row r's points from its sums (weight, then source and target residuals): p = B + sum / weight.
-VOLMORPH_ALWAYS_INLINE inline void storeRow(WarpLeaf& leaf, int r, const v8f base[6], const v8f acc[7])
+/// Row r's points from its residual sums and the reciprocal of its weight sum: p = B + sum / weight.
+/// (The slices' reciprocals are taken first, all 8 rows', for the reason given at addNearPairs.)
+VOLMORPH_ALWAYS_INLINE inline void storeRow(WarpLeaf& leaf, int r, const v8f base[6], const v8f acc[7], v8f inv)
 {
-    const v8f inv = 1.0f / acc[0];
     for (int c = 0; c < 3; ++c) {
         store8(leaf.s[c] + 8 * r, base[c] + acc[1 + c] * inv);
         store8(leaf.t[c] + 8 * r, base[3 + c] + acc[4 + c] * inv);
@@ -294,8 +294,11 @@ VOLMORPH_ALWAYS_INLINE inline void storeRow(WarpLeaf& leaf, int r, const v8f bas
 }
 
 /// Adds the near pairs of type T, [begin, end), at every row r: weight into sums[r][0], weighted
-/// residuals into sums[r][1..6] (source x, y, z, target x, y, z). Pair by pair, so that the rows'
-/// square roots and divisions are independent of each other and overlap.
+/// residuals into sums[r][1..6] (source x, y, z, target x, y, z). Pair by pair and slice by slice,
+/// in two passes over the slice's 8 rows: first their weights, then the sums. The weights' square
+/// roots and divisions are long-latency and independent from row to row; done first, they overlap,
+/// where one pass per row would fill the scheduler with the sums waiting on each row's division.
+/// (Each value takes the same operations in the same order either way, so the bits are the same.)
 template <FeatureType T, bool InverseSquare>
 VOLMORPH_ALWAYS_INLINE inline void addNearPairs(const LeafJob& job, size_t begin, size_t end, v8f sums[64][7])
 {
@@ -303,20 +306,27 @@ VOLMORPH_ALWAYS_INLINE inline void addNearPairs(const LeafJob& job, size_t begin
     for (size_t p = begin; p < end; ++p) {
         const NearRows& n = job.rows[p];
         for (int i = 0; i < 8; ++i) {
-            v8f v[9];
-            for (int c = 0; c < 9; ++c) v[c] = n.f[c].first(i);
+            v8f w[8];
+            {
+                v8f q[3];
+                for (int c = 0; c < 3; ++c) q[c] = n.f[c].first(i);
+                for (int j = 0; j < 8; ++j) {
+                    const v8f d = off + frameDistance<T>(q[0], q[1], q[2], n.half[0], n.half[1], n.half[2]);
+                    if constexpr (InverseSquare) {
+                        w[j] = 1.0f / (d * d);
+                    } else {
+                        for (int l = 0; l < 8; ++l) w[j][l] = float(double(n.scale) * std::pow(double(d[l]), -job.exponent));
+                    }
+                    for (int c = 0; c < 3; ++c) q[c] += n.f[c].dy;
+                }
+            }
+            v8f r[6];
+            for (int c = 0; c < 6; ++c) r[c] = n.f[3 + c].first(i);
             for (int j = 0; j < 8; ++j) {
                 v8f* acc = sums[8 * i + j];
-                const v8f d = off + frameDistance<T>(v[0], v[1], v[2], n.half[0], n.half[1], n.half[2]);
-                v8f w;
-                if constexpr (InverseSquare) {
-                    w = 1.0f / (d * d);
-                } else {
-                    for (int l = 0; l < 8; ++l) w[l] = float(double(n.scale) * std::pow(double(d[l]), -job.exponent));
-                }
-                acc[0] += w;
-                for (int c = 0; c < 6; ++c) acc[1 + c] += w * v[3 + c];
-                for (int c = 0; c < 9; ++c) v[c] += n.f[c].dy;
+                acc[0] += w[j];
+                for (int c = 0; c < 6; ++c) acc[1 + c] += w[j] * r[c];
+                for (int c = 0; c < 6; ++c) r[c] += n.f[3 + c].dy;
             }
         }
     }
@@ -400,12 +410,17 @@ VOLMORPH_ALWAYS_INLINE inline void fillLeafBody(LeafJob& job, WarpLeaf& leaf)
         // Every pair far: the rows' sums go straight into the points (storeRow, as below, without
         // storing the sums first).
         for (int i = 0; i < 8; ++i) {
-            v8f row[7], dy[7], base[6];
+            v8f row[7], dy[7], base[6], inv[8];
             for (int c = 0; c < 7; ++c) farRows(edge[c], i, row[c], dy[c]);
             for (int c = 0; c < 6; ++c) base[c] = b[c].first(i);
+            v8f weight = row[0];
             for (int j = 0; j < 8; ++j) {
-                storeRow(leaf, 8 * i + j, base, row);
-                for (int c = 0; c < 7; ++c) row[c] += dy[c];
+                inv[j] = 1.0f / weight;
+                weight += dy[0];
+            }
+            for (int j = 0; j < 8; ++j) {
+                storeRow(leaf, 8 * i + j, base, row, inv[j]);
+                for (int c = 1; c < 7; ++c) row[c] += dy[c];
                 for (int c = 0; c < 6; ++c) base[c] += b[c].dy;
             }
         }
@@ -426,10 +441,11 @@ VOLMORPH_ALWAYS_INLINE inline void fillLeafBody(LeafJob& job, WarpLeaf& leaf)
     addNearPairs<FeatureType::Rectangle, InverseSquare>(job, job.typeEnd[1], job.typeEnd[2], sums);
     addNearPairs<FeatureType::Box, InverseSquare>(job, job.typeEnd[2], job.typeEnd[3], sums);
     for (int i = 0; i < 8; ++i) {
-        v8f base[6];
+        v8f base[6], inv[8];
         for (int c = 0; c < 6; ++c) base[c] = b[c].first(i);
+        for (int j = 0; j < 8; ++j) inv[j] = 1.0f / sums[8 * i + j][0];
         for (int j = 0; j < 8; ++j) {
-            storeRow(leaf, 8 * i + j, base, sums[8 * i + j]);
+            storeRow(leaf, 8 * i + j, base, sums[8 * i + j], inv[j]);
             for (int c = 0; c < 6; ++c) base[c] += b[c].dy;
         }
     }
