@@ -159,7 +159,7 @@ void checkFilmMemory(int width, int height, double limitGiB)
 {
     constexpr double kBytesPerPixel = 48.0; // the float RGBA film, and a float and a half copy to write it
     const double bytes = kBytesPerPixel * double(width) * double(height);
-    const double limit = limitGiB > 0.0 ? limitGiB * double(1ull << 30) : double(defaultMemoryLimitBytes());
+    const double limit = double(memoryLimitBytes(limitGiB));
     if (bytes <= limit) return;
     char text[300];
     std::snprintf(text, sizeof text,

@@ -1,7 +1,7 @@
 // Shared pieces of the volmorph subcommands: exit codes, number formatting, stop signals.
 #pragma once
 
-#include <volmorph/Interrupter.h>
+#include <volmorph/core/Interrupter.h>
 #include <volmorph/Mesh.h>
 #include <volmorph/VoxelCache.h>
 

@@ -11,6 +11,8 @@
 // does, so a size mismatch is a failure.
 #include "Common.h"
 
+#include <volmorph/core/AtomicFile.h>
+
 #include <volmorph/render/Output.h>
 
 #include <OpenImageIO/imagebuf.h>
@@ -58,10 +60,8 @@ bool writeDifference(const DiffArgs& args, const OIIO::ImageBuf& a, const OIIO::
     OIIO::ImageBuf diff = args.absolute ? OIIO::ImageBufAlgo::absdiff(a, b) : OIIO::ImageBufAlgo::sub(a, b);
     if (args.scale != 1.0f) diff = OIIO::ImageBufAlgo::mul(diff, args.scale);
     try {
-        render::writeAtomically(args.output, [&diff](const std::filesystem::path& temporary, std::string& error) {
-            const bool ok = diff.write(temporary.string(), OIIO::TypeDesc::FLOAT);
-            if (!ok) error = diff.geterror();
-            return ok;
+        writeAtomically(args.output, [&diff](const std::filesystem::path& temporary) {
+            if (!diff.write(temporary.string(), OIIO::TypeDesc::FLOAT)) throw std::runtime_error(diff.geterror());
         });
     } catch (const std::exception& e) {
         std::fprintf(stderr, "%s: cannot write the difference image (%s)\n", args.output.c_str(), e.what());

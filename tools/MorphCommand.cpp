@@ -1,10 +1,12 @@
 // volmorph morph SCENE [--frames SPEC] [-o PATTERN.vdb]: one .vdb of the in-between per frame.
 #include "Common.h"
+#include "FrameLoop.h"
+#include "SceneMorph.h"
 
 #include <volmorph/Export.h>
 #include <volmorph/Frames.h>
 #include <volmorph/Morph.h>
-#include <volmorph/Version.h>
+#include <volmorph/core/Version.h>
 #include <volmorph/Voxelize.h>
 
 #include <unistd.h>
@@ -18,10 +20,26 @@ namespace {
 
 struct MorphArgs {
     std::string scene, frames, output, mesh, sampling = "trilinear";
-    bool exact = false, quiet = false;
+    bool exact = false, quiet = false, verbose = false;
     double memoryLimitGiB = 0.0;
     CacheArgs cache;
 };
+
+/// Writes one in-between as a .vdb at `file` (and its surface, with --mesh).
+void writeFrame(const VolumeSet& v, const std::filesystem::path& file, const MorphArgs& args, const FrameStep& step)
+{
+    if (file.has_parent_path()) std::filesystem::create_directories(file.parent_path());
+    writeVolumeSet(v, file,
+                   {{"volmorph_scene", std::filesystem::absolute(args.scene).string()},
+                    {"volmorph_frame", std::to_string(step.frame)},
+                    {"volmorph_t", fmt(step.t)},
+                    {"volmorph_version", versionString()}});
+    if (!args.mesh.empty()) {
+        const std::filesystem::path meshFile = frameFileName(args.mesh, step.frame);
+        if (meshFile.has_parent_path()) std::filesystem::create_directories(meshFile.parent_path());
+        writeMesh(surfaceMesh(v), meshFile);
+    }
+}
 
 int runMorph(const MorphArgs& args)
 {
@@ -44,44 +62,24 @@ int runMorph(const MorphArgs& args)
     }
     if (args.exact) scene.warp.toleranceVoxels = 0.0;
 
-    Interrupter interrupter(false);
+    Interrupter interrupter(false, args.verbose);
     StopSignals signals(interrupter);
-    SceneVolumes volumes = loadSceneVolumes(scene, args.cache, interrupter,
-                                            uint64_t(args.memoryLimitGiB * double(1ull << 30)), args.quiet);
     MorphOptions options;
     if (args.sampling == "triquadratic") options.sampling = MorphOptions::Sampling::Triquadratic;
-    options.memoryLimitBytes = uint64_t(args.memoryLimitGiB * double(1ull << 30));
-    const Morpher morpher(std::move(volumes.source), std::move(volumes.target), scene.pairs, scene.warp,
-                          scene.blend, options);
+    options.memoryLimitBytes = memoryLimitBytes(args.memoryLimitGiB);
+    const SceneMorph morph(scene, args.cache, interrupter, options, args.quiet);
 
-    Progress progress(int(frames.size()), args.quiet);
-    progress.update(0);
-    for (size_t i = 0; i < frames.size(); ++i) {
-        const int frame = frames[i];
-        const auto frameStart = std::chrono::steady_clock::now();
-        const double t = scene.frames.t(frame);
+    FrameLoop loop(scene, frames, 1, args.quiet, true, interrupter);
+    loop.run([&](const FrameStep& step) {
         MorphStats stats;
-        VolumeSet v = morpher.frame(t, &stats, &interrupter);
-        if (interrupter.stopRequested()) throw Interrupted();
-        const std::filesystem::path file = frameFileName(pattern, frame);
-        if (file.has_parent_path()) std::filesystem::create_directories(file.parent_path());
-        writeVolumeSet(v, file,
-                       {{"volmorph_scene", std::filesystem::absolute(args.scene).string()},
-                        {"volmorph_frame", std::to_string(frame)},
-                        {"volmorph_t", fmt(t)},
-                        {"volmorph_version", versionString()}});
-        if (!args.mesh.empty()) {
-            const std::filesystem::path meshFile = frameFileName(args.mesh, frame);
-            if (meshFile.has_parent_path()) std::filesystem::create_directories(meshFile.parent_path());
-            writeMesh(surfaceMesh(v), meshFile);
-        }
-        char line[512];
-        std::snprintf(line, sizeof line, "frame %d (t=%.4f): %llu active voxels, warp error <= %.3f voxels, %.2f s -> %s",
-                      frame, t, (unsigned long long)stats.activeVoxels, stats.maxWarpErrorVoxels,
-                      secondsSince(frameStart), file.string().c_str());
-        progress.log(line);
-        progress.update(int(i + 1));
-    }
+        const VolumeSet v = morph.frame(step.frame, &stats);
+        const std::filesystem::path file = frameFileName(pattern, step.frame);
+        writeFrame(v, file, args, step);
+        char detail[160];
+        std::snprintf(detail, sizeof detail, "%llu active voxels, warp error <= %.3f voxels",
+                      (unsigned long long)stats.activeVoxels, stats.maxWarpErrorVoxels);
+        return FrameResult{FrameResult::Outcome::Done, detail, file.string()};
+    });
     return 0;
 }
 
@@ -105,6 +103,7 @@ Command addMorphCommand(CLI::App& app)
         ->check(CLI::PositiveNumber);
     addCacheOptions(sub, args->cache);
     sub->add_flag("-q,--quiet", args->quiet, "print nothing on success");
+    sub->add_flag("-v,--verbose", args->verbose, "print each stage as it starts, with the time since the start (stderr)");
     return {sub, [args] { return runMorph(*args); }};
 }
 

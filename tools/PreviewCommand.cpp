@@ -1,6 +1,8 @@
 // volmorph preview SCENE --frame N -o OUT.png: one frame with every feature pair drawn on it, for
 // editing the pairs by hand; --contact-sheet: a grid of frames.
 #include "Common.h"
+#include "FrameLoop.h"
+#include "SceneMorph.h"
 #include "SceneRender.h"
 
 #include <volmorph/Feature.h>
@@ -27,7 +29,7 @@ constexpr render::Color kBackground{0.02f, 0.02f, 0.025f};
 struct PreviewArgs {
     std::string scene, output, frames, from;
     std::optional<int> frame;
-    bool contactSheet = false, sides = false, noFeatures = false, features = false, quiet = false;
+    bool contactSheet = false, sides = false, noFeatures = false, features = false, quiet = false, verbose = false;
     int width = 0, columns = 6, tileWidth = 240, threads = 0;
     std::optional<int> samples;
     CacheArgs cache;
@@ -77,6 +79,18 @@ void writeImage(const render::Image& image, const std::string& path, const rende
     }
 }
 
+/// A frame read back from a rendered EXR (--from).
+render::Image readFrame(const std::string& pattern, int frame)
+{
+    const std::filesystem::path file = frameFileName(pattern, frame);
+    try {
+        return render::readImage(file);
+    } catch (const std::exception& e) {
+        throw UserError(SourceLocation{file.string()}, std::string("cannot read frame ") + std::to_string(frame) + " (" +
+                                                           e.what() + "); render it first with volmorph render");
+    }
+}
+
 int runPreview(const PreviewArgs& args)
 {
     const Scene scene = loadScene(args.scene);
@@ -89,54 +103,33 @@ int runPreview(const PreviewArgs& args)
     const int width = args.contactSheet ? args.tileWidth : args.width;
 
     // Frames come from existing EXRs (--from) or are morphed and rendered here.
-    std::optional<Morpher> morpher;
-    std::optional<Interrupter> interrupter;
-    std::optional<StopSignals> signals;
+    Interrupter interrupter(false, args.verbose);
+    StopSignals signals(interrupter);
+    std::optional<SceneMorph> morph;
     SceneRender view(scene, args.threads, width);
+    view.settings.interrupter = &interrupter;
     if (args.samples) view.settings.samples = *args.samples;
-    if (args.from.empty()) {
-        interrupter.emplace(false);
-        signals.emplace(*interrupter);
-        SceneVolumes volumes = loadSceneVolumes(scene, args.cache, *interrupter, 0, args.quiet);
-        morpher.emplace(std::move(volumes.source), std::move(volumes.target), scene.pairs, scene.warp, scene.blend);
-    } else if (const std::string why = checkFramePattern(args.from); !why.empty()) {
+    if (args.from.empty()) morph.emplace(scene, args.cache, interrupter, MorphOptions{}, args.quiet);
+    else if (const std::string why = checkFramePattern(args.from); !why.empty())
         throw UserError(SourceLocation{"--from"}, "\"" + args.from + "\": " + why);
-    }
 
     std::vector<render::Image> images;
     std::vector<std::string> labels;
     bool labelsDrawn = true;
-    Progress progress(int(frames.size()), args.quiet);
-    for (size_t i = 0; i < frames.size(); ++i) {
-        const int frame = frames[i];
-        const double t = scene.frames.t(frame);
-        render::Image image;
-        if (morpher) {
-            const VolumeSet v = morpher->frame(t, nullptr, &*interrupter);
-            if (interrupter->stopRequested()) throw Interrupted();
-            image = view.renderFrame(v, frame);
-            if (interrupter->stopRequested()) throw Interrupted();
-        } else {
-            const std::filesystem::path file = frameFileName(args.from, frame);
-            try {
-                image = render::readImage(file);
-            } catch (const std::exception& e) {
-                throw UserError(SourceLocation{file.string()},
-                                std::string("cannot read frame ") + std::to_string(frame) + " (" + e.what() +
-                                    "); render it first with volmorph render");
-            }
-        }
+    FrameLoop loop(scene, frames, 1, args.quiet, false, interrupter);
+    loop.run([&](const FrameStep& step) {
+        render::Image image = morph ? view.renderFrame(morph->frame(step.frame), step.frame) : readFrame(args.from, step.frame);
         if (drawPairs) {
             // Features are drawn at the image's own size (a frame read from disk keeps its size).
             const SceneRender atSize(scene, 0, image.width);
-            labelsDrawn = drawFeatures(image, atSize.camera(frame), scene, t, args.sides) && labelsDrawn;
+            labelsDrawn = drawFeatures(image, atSize.camera(step.frame), scene, step.t, args.sides) && labelsDrawn;
         }
         char label[64];
-        std::snprintf(label, sizeof label, "frame %d  t=%.3f", frame, t);
+        std::snprintf(label, sizeof label, "frame %d  t=%.3f", step.frame, step.t);
         images.push_back(std::move(image));
         labels.push_back(label);
-        progress.update(int(i + 1));
-    }
+        return FrameResult{};
+    });
     if (!labelsDrawn)
         std::fprintf(stderr, "volmorph: warning: no font (DejaVu Sans, Debian package fonts-dejavu-core); "
                              "pair numbers are not drawn\n");
@@ -176,6 +169,7 @@ Command addPreviewCommand(CLI::App& app)
     sub->add_option("--threads", a->threads, "threads (0 = all cores)")->check(CLI::Range(0, 1024));
     addCacheOptions(sub, a->cache);
     sub->add_flag("-q,--quiet", a->quiet, "print nothing on success");
+    sub->add_flag("-v,--verbose", a->verbose, "print each stage as it starts, with the time since the start (stderr)");
     return {sub, [a] { return runPreview(*a); }};
 }
 

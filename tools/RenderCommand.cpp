@@ -1,11 +1,13 @@
 // volmorph render-vdb IN.vdb -o OUT.exr: render any float grid (flags as OpenVDB's vdb_render).
 // volmorph render SCENE [--frames SPEC] [-o PATTERN.exr]: the morph of each frame, rendered.
 #include "Common.h"
+#include "FrameLoop.h"
+#include "SceneMorph.h"
 #include "SceneRender.h"
 
 #include <volmorph/Frames.h>
 #include <volmorph/Morph.h>
-#include <volmorph/Version.h>
+#include <volmorph/core/Version.h>
 #include <volmorph/Voxelize.h>
 #include <volmorph/render/Output.h>
 #include <volmorph/render/Renderer.h>
@@ -32,7 +34,7 @@ struct RenderVdbArgs {
     int shadowCache = 2;
     int samples = 4, threads = 0;
     double memoryLimitGiB = 0.0;
-    bool floatExr = false;
+    bool floatExr = false, verbose = false;
 };
 
 void parseResolution(const std::string& text, int& width, int& height)
@@ -44,18 +46,20 @@ void parseResolution(const std::string& text, int& width, int& height)
         throw UserError(SourceLocation{"--res"}, "expected WIDTHxHEIGHT in pixels (e.g. 640x360), got \"" + text + "\"");
 }
 
-int runRenderVdb(const RenderVdbArgs& args)
-{
-    int width = 0, height = 0;
-    parseResolution(args.resolution, width, height); // flags first: no work before a usage error
-    checkFilmMemory(width, height, args.memoryLimitGiB);
-    openvdb::initialize();
+struct InputGrids {
     openvdb::FloatGrid::Ptr density;
     openvdb::Vec3SGrid::Ptr color;
+};
+
+/// The float grid to render (--grid, or the first) and the `Cd` colour grid if there is one; only
+/// those two are read (a voxelized mesh also holds its sdf).
+InputGrids readInputGrids(const RenderVdbArgs& args)
+{
+    openvdb::initialize();
+    InputGrids grids;
     try {
         openvdb::io::File file(args.input);
         file.open();
-        // Only the two grids used are read (a voxelized mesh also holds its sdf).
         std::string densityName, colorName;
         for (auto it = file.beginName(); it != file.endName(); ++it) {
             const openvdb::GridBase::Ptr g = file.readGridMetadata(it.gridName());
@@ -67,26 +71,42 @@ int runRenderVdb(const RenderVdbArgs& args)
                 densityName = it.gridName();
             }
         }
-        if (!densityName.empty()) density = openvdb::gridPtrCast<openvdb::FloatGrid>(file.readGrid(densityName));
-        if (!colorName.empty()) color = openvdb::gridPtrCast<openvdb::Vec3SGrid>(file.readGrid(colorName));
+        if (!densityName.empty()) grids.density = openvdb::gridPtrCast<openvdb::FloatGrid>(file.readGrid(densityName));
+        if (!colorName.empty()) grids.color = openvdb::gridPtrCast<openvdb::Vec3SGrid>(file.readGrid(colorName));
         file.close();
     } catch (const openvdb::Exception& e) {
         throw UserError(SourceLocation{args.input}, std::string("cannot read volume file (") + e.what() + ")");
     }
-    if (!density)
+    if (!grids.density)
         throw UserError(SourceLocation{args.input},
                         args.grid.empty() ? "no float grid to render" : "no grid named \"" + args.grid + "\"");
-    // Default view: in front of the grid's active bounds, looking at their centre.
-    openvdb::CoordBBox box = density->evalActiveVoxelBoundingBox();
-    const Vec3d lo = density->indexToWorld(box.min().asVec3d()), hi = density->indexToWorld(box.max().asVec3d());
+    return grids;
+}
+
+/// The flags' camera; by default in front of the grid's active bounds, looking at their centre.
+render::Camera vdbCamera(const RenderVdbArgs& args, const openvdb::FloatGrid& density, int width, int height)
+{
+    openvdb::CoordBBox box = density.evalActiveVoxelBoundingBox();
+    const Vec3d lo = density.indexToWorld(box.min().asVec3d()), hi = density.indexToWorld(box.max().asVec3d());
     const Vec3d centre = 0.5 * (lo + hi);
     const double extent = (hi - lo).length();
     const Vec3d lookat = args.lookat.empty() ? centre : vec3(args.lookat);
     const Vec3d eye = args.translate.empty() ? centre + Vec3d(0, 0, 1.6 * extent) : vec3(args.translate);
     const bool ortho = args.camera == "ortho";
-    const render::Camera camera(ortho ? render::Camera::Projection::Orthographic : render::Camera::Projection::Perspective,
-                                eye, lookat, vec3(args.up), args.fov, args.frameWidth > 0 ? args.frameWidth : extent,
-                                width, height);
+    return render::Camera(ortho ? render::Camera::Projection::Orthographic : render::Camera::Projection::Perspective,
+                          eye, lookat, vec3(args.up), args.fov, args.frameWidth > 0 ? args.frameWidth : extent, width,
+                          height);
+}
+
+int runRenderVdb(const RenderVdbArgs& args)
+{
+    int width = 0, height = 0;
+    parseResolution(args.resolution, width, height); // flags first: no work before a usage error
+    checkFilmMemory(width, height, args.memoryLimitGiB);
+    Interrupter interrupter(false, args.verbose);
+    StopSignals signals(interrupter);
+    const InputGrids grids = readInputGrids(args);
+    const render::Camera camera = vdbCamera(args, *grids.density, width, height);
     render::Light light;
     light.direction = -vec3(args.light); // the flag points toward the light, as vdb_render's -light
     if (args.light.size() == 6) light.color = Vec3d(args.light[3], args.light[4], args.light[5]);
@@ -99,8 +119,9 @@ int runRenderVdb(const RenderVdbArgs& args)
     settings.stepVoxels = args.step;
     settings.shadowCacheVoxels = args.shadowCache;
     settings.threads = args.threads;
+    settings.interrupter = &interrupter;
     const auto start = std::chrono::steady_clock::now();
-    const render::Image image = render::renderVolume(*density, color.get(), camera, {light}, medium, settings);
+    const render::Image image = render::renderVolume(*grids.density, grids.color.get(), camera, {light}, medium, settings);
     const double seconds = secondsSince(start);
     render::ExrOptions exr;
     exr.halfFloat = !args.floatExr;
@@ -113,7 +134,7 @@ int runRenderVdb(const RenderVdbArgs& args)
     } catch (const std::runtime_error& e) {
         throw UserError(SourceLocation{args.output}, std::string("cannot write image (") + e.what() + ")");
     }
-    std::printf("rendered %s (%dx%d, %d samples) in %.2f s -> %s\n", density->getName().c_str(), width, height,
+    std::printf("rendered %s (%dx%d, %d samples) in %.2f s -> %s\n", grids.density->getName().c_str(), width, height,
                 args.samples, seconds, args.output.c_str());
     return 0;
 }
@@ -121,7 +142,7 @@ int runRenderVdb(const RenderVdbArgs& args)
 struct RenderSceneArgs {
     std::string scene, frames, output, png;
     int threads = 0;
-    bool skipExisting = false, quiet = false;
+    bool skipExisting = false, quiet = false, verbose = false;
     double memoryLimitGiB = 0.0;
     CacheArgs cache;
 };
@@ -139,6 +160,25 @@ bool completeImage(const std::filesystem::path& path)
     }
 }
 
+/// Writes frame `frame`'s image, or returns why it could not.
+std::string writeFrameImage(const render::Image& image, const SceneRender& renderer, const std::filesystem::path& file,
+                            const RenderSceneArgs& args, const Scene& scene, const FrameStep& step, double seconds)
+{
+    render::ExrOptions exr;
+    exr.frame = step.frame;
+    exr.samples = scene.render.samples;
+    exr.renderSeconds = seconds;
+    exr.metadata["volmorph:scene"] = std::filesystem::absolute(args.scene).string();
+    exr.metadata["volmorph:t"] = fmt(step.t);
+    try {
+        if (file.has_parent_path()) std::filesystem::create_directories(file.parent_path());
+        render::writeExr(image, renderer.camera(step.frame), file, exr);
+    } catch (const std::exception& e) {
+        return file.string() + ": cannot write frame " + std::to_string(step.frame) + " (" + e.what() + ")";
+    }
+    return "";
+}
+
 int runRenderScene(const RenderSceneArgs& args)
 {
     const Scene scene = loadScene(args.scene);
@@ -147,113 +187,34 @@ int runRenderScene(const RenderSceneArgs& args)
     if (const std::string why = checkFramePattern(pattern); !why.empty())
         throw UserError(SourceLocation{"-o"}, "\"" + pattern + "\": " + why);
 
-    Interrupter interrupter(false);
+    Interrupter interrupter(false, args.verbose);
     StopSignals signals(interrupter);
     checkFilmMemory(scene.render.width, scene.render.height, args.memoryLimitGiB);
-    const uint64_t memoryLimit = uint64_t(args.memoryLimitGiB * double(1ull << 30));
-    SceneVolumes volumes = loadSceneVolumes(scene, args.cache, interrupter, memoryLimit, args.quiet);
     MorphOptions morphOptions;
-    morphOptions.memoryLimitBytes = memoryLimit;
-    const Morpher morpher(std::move(volumes.source), std::move(volumes.target), scene.pairs, scene.warp, scene.blend,
-                          morphOptions);
+    morphOptions.memoryLimitBytes = memoryLimitBytes(args.memoryLimitGiB);
+    const SceneMorph morph(scene, args.cache, interrupter, morphOptions, args.quiet);
+    SceneRender renderer(scene, args.threads);
+    renderer.settings.interrupter = &interrupter;
 
-    const SceneRender renderer(scene, args.threads);
-
-    int failed = 0;
     // Two steps per frame (morph, render), so the progress moves within long frames too.
-    Progress progress(2 * int(frames.size()), args.quiet);
-    progress.update(0);
-    for (size_t i = 0; i < frames.size(); ++i) {
-        const int frame = frames[i];
-        const std::filesystem::path file = frameFileName(pattern, frame);
-        if (args.skipExisting && completeImage(file)) {
-            progress.log("frame " + std::to_string(frame) + ": " + file.string() + " exists, skipped");
-            progress.update(2 * int(i + 1));
-            continue;
-        }
+    FrameLoop loop(scene, frames, 2, args.quiet, true, interrupter);
+    const int failed = loop.run([&](const FrameStep& step) {
+        const std::filesystem::path file = frameFileName(pattern, step.frame);
+        if (args.skipExisting && completeImage(file))
+            return FrameResult{FrameResult::Outcome::Skipped,
+                               "frame " + std::to_string(step.frame) + ": " + file.string() + " exists, skipped", ""};
         const auto start = std::chrono::steady_clock::now();
-        const VolumeSet v = morpher.frame(scene.frames.t(frame), nullptr, &interrupter);
-        if (interrupter.stopRequested()) throw Interrupted();
-        progress.update(2 * int(i) + 1);
-        const render::Image image = renderer.renderFrame(v, frame);
-        if (interrupter.stopRequested()) throw Interrupted();
-        render::ExrOptions exr;
-        exr.frame = frame;
-        exr.samples = scene.render.samples;
-        exr.renderSeconds = secondsSince(start);
-        exr.metadata["volmorph:scene"] = std::filesystem::absolute(args.scene).string();
-        exr.metadata["volmorph:t"] = fmt(scene.frames.t(frame));
-        try {
-            if (file.has_parent_path()) std::filesystem::create_directories(file.parent_path());
-            render::writeExr(image, renderer.camera(frame), file, exr);
-        } catch (const std::exception& e) {
-            std::fprintf(stderr, "%s: cannot write frame %d (%s)\n", file.string().c_str(), frame, e.what());
-            ++failed;
-            progress.update(2 * int(i + 1));
-            continue;
-        }
-        char line[512];
-        std::snprintf(line, sizeof line, "frame %d (t=%.4f): %.2f s -> %s", frame, scene.frames.t(frame),
-                      secondsSince(start), file.string().c_str());
-        progress.log(line);
-        progress.update(2 * int(i + 1));
-    }
-    if (failed) std::fprintf(stderr, "volmorph: %d of %zu frames failed\n", failed, frames.size());
+        const VolumeSet v = morph.frame(step.frame);
+        step.progress(1);
+        const render::Image image = renderer.renderFrame(v, step.frame);
+        const std::string error = writeFrameImage(image, renderer, file, args, scene, step, secondsSince(start));
+        if (!error.empty()) return FrameResult{FrameResult::Outcome::Failed, error, ""};
+        return FrameResult{FrameResult::Outcome::Done, "", file.string()};
+    });
     return failed ? kExitUserError : 0;
 }
 
 } // namespace
-
-namespace {
-
-render::Camera sceneCamera(const CameraSpec& c, const RenderSpec& r, int width)
-{
-    const int w = width > 0 ? width : r.width;
-    const int h = width > 0 ? std::max(1, int(std::lround(double(r.height) * w / r.width))) : r.height;
-    return render::Camera(c.projection == Projection::Orthographic ? render::Camera::Projection::Orthographic
-                                                                   : render::Camera::Projection::Perspective,
-                          c.eye, c.lookat, c.up, c.fovDegrees, c.orthoWidth, w, h);
-}
-
-} // namespace
-
-SceneRender::SceneRender(const Scene& scene, int threads, int width) : mSpec(scene.render), mWidth(width)
-{
-    const RenderSpec& r = scene.render;
-    medium.extinction = r.extinction;
-    medium.albedo = r.albedo;
-    medium.anisotropy = r.anisotropy;
-    medium.emission = r.emission;
-    settings.samples = r.samples;
-    settings.stepVoxels = r.stepVoxels;
-    settings.seed = r.seed;
-    settings.threads = threads;
-}
-
-render::Camera SceneRender::camera(int frame) const { return sceneCamera(mSpec.camera.at(frame), mSpec, mWidth); }
-
-std::vector<render::Light> SceneRender::lights(int frame) const
-{
-    std::vector<render::Light> lights;
-    for (const LightSpec& spec : mSpec.lights) {
-        const LightSpec l = spec.at(frame);
-        render::Light light;
-        light.type = l.type == LightType::Point ? render::Light::Type::Point : render::Light::Type::Directional;
-        light.direction = l.direction;
-        light.position = l.position;
-        light.color = l.color;
-        light.intensity = l.intensity;
-        lights.push_back(light);
-    }
-    return lights;
-}
-
-render::Image SceneRender::renderFrame(const VolumeSet& volumes, int frame) const
-{
-    render::RenderSettings s = settings;
-    s.frame = frame;
-    return render::renderVolume(*volumes.density, volumes.color.get(), camera(frame), lights(frame), medium, s);
-}
 
 Command addRenderVdbCommand(CLI::App& app)
 {
@@ -284,6 +245,7 @@ Command addRenderVdbCommand(CLI::App& app)
     sub->add_option("--memory-limit", a->memoryLimitGiB, "refuse a film above this, in GiB (default: half the machine's memory)")
         ->check(CLI::PositiveNumber);
     sub->add_flag("--float", a->floatExr, "float EXR instead of half");
+    sub->add_flag("-v,--verbose", a->verbose, "print each stage as it starts, with the time since the start (stderr)");
     return {sub, [a] { return runRenderVdb(*a); }};
 }
 
@@ -302,6 +264,7 @@ Command addRenderCommand(CLI::App& app)
         ->check(CLI::PositiveNumber);
     addCacheOptions(sub, a->cache);
     sub->add_flag("-q,--quiet", a->quiet, "print nothing on success");
+    sub->add_flag("-v,--verbose", a->verbose, "print each stage as it starts, with the time since the start (stderr)");
     return {sub, [a] { return runRenderScene(*a); }};
 }
 

@@ -1,7 +1,7 @@
 // volmorph voxelize MESH -o OUT.vdb: sdf, density and Cd grids of one mesh.
 #include "Common.h"
 
-#include <volmorph/Version.h>
+#include <volmorph/core/Version.h>
 #include <volmorph/Voxelize.h>
 
 #include <unistd.h>
@@ -33,7 +33,7 @@ int runVoxelize(const VoxelizeArgs& args)
     if (args.resolution) options.resolution = *args.resolution;
     options.halfWidthVoxels = args.halfWidth;
     if (!args.color.empty()) options.color = Vec3f(args.color[0], args.color[1], args.color[2]);
-    options.memoryLimitBytes = uint64_t(args.memoryLimitGiB * double(1ull << 30));
+    options.memoryLimitBytes = memoryLimitBytes(args.memoryLimitGiB);
     options.sign = args.sign == "winding"     ? VoxelizeOptions::Sign::WindingNumber
                    : args.sign == "floodfill" ? VoxelizeOptions::Sign::FloodFill
                                               : VoxelizeOptions::Sign::Auto;
@@ -84,7 +84,7 @@ int runCache(const CacheCommandArgs& args)
         throw UserError(SourceLocation{"--cache"}, "no cache folder: give --cache DIR or set VOLMORPH_CACHE");
     Interrupter interrupter(false);
     StopSignals signals(interrupter);
-    loadSceneVolumes(scene, args.cache, interrupter, uint64_t(args.memoryLimitGiB * double(1ull << 30)), args.quiet);
+    loadSceneVolumes(scene, args.cache, interrupter, memoryLimitBytes(args.memoryLimitGiB), args.quiet);
     return 0;
 }
 

@@ -2,7 +2,7 @@
 // Exit codes are in Common.h.
 #include "Common.h"
 
-#include <volmorph/Version.h>
+#include <volmorph/core/Version.h>
 
 #include <cstdio>
 #include <vector>

@@ -1,10 +1,11 @@
 #include <volmorph/render/Output.h>
 
+#include <volmorph/core/AtomicFile.h>
+#include <volmorph/core/Version.h>
+
 #include <OpenImageIO/imagebuf.h>
 #include <OpenImageIO/imagebufalgo.h>
 #include <OpenImageIO/imageio.h>
-
-#include <unistd.h>
 
 #include <stdexcept>
 
@@ -24,12 +25,11 @@ void writeWith(const std::filesystem::path& path, const OIIO::ImageSpec& spec, c
     // Created from the final name (format from its extension), written under a temporary one.
     auto out = OIIO::ImageOutput::create(path.string());
     if (!out) throw std::runtime_error("no image writer for " + path.string() + ": " + OIIO::geterror());
-    writeAtomically(path, [&](const std::filesystem::path& temporary, std::string& error) {
+    writeAtomically(path, [&](const std::filesystem::path& temporary) {
         bool ok = out->open(temporary.string(), spec);
         ok = ok && out->write_image(OIIO::TypeDesc::FLOAT, image.pixels.data());
         ok = out->close() && ok;
-        if (!ok) error = out->geterror();
-        return ok;
+        if (!ok) throw std::runtime_error(out->geterror());
     });
 }
 
@@ -46,36 +46,11 @@ void setMatrix(OIIO::ImageSpec& spec, const char* name, const Mat4d& m)
 
 } // namespace
 
-void writeAtomically(const std::filesystem::path& path,
-                     const std::function<bool(const std::filesystem::path& temporary, std::string& error)>& write)
-{
-    // Same folder (so rename is atomic) and same extension (so the format is unchanged).
-    const std::filesystem::path temporary = path.parent_path() / (path.stem().string() + ".partial-" +
-                                                                  std::to_string(long(getpid())) +
-                                                                  path.extension().string());
-    std::string error;
-    bool ok = false;
-    try {
-        ok = write(temporary, error);
-    } catch (const std::exception& e) {
-        error = e.what();
-    }
-    std::error_code ec;
-    if (ok) {
-        std::filesystem::rename(temporary, path, ec);
-        if (ec) error = "cannot rename " + temporary.string() + " to " + path.string();
-    }
-    if (!ok || ec) {
-        std::filesystem::remove(temporary, ec);
-        throw std::runtime_error(error.empty() ? "write failed" : error);
-    }
-}
-
 void writeExr(const Image& image, const Camera& camera, const std::filesystem::path& path, const ExrOptions& options)
 {
     OIIO::ImageSpec spec = specOf(image, options.halfFloat ? OIIO::TypeDesc::HALF : OIIO::TypeDesc::FLOAT);
     spec.attribute("compression", "zip");
-    spec.attribute("Software", "volmorph " VOLMORPH_RENDER_VERSION);
+    spec.attribute("Software", std::string("volmorph ") + versionString());
     spec.attribute("volmorph:frame", options.frame);
     spec.attribute("volmorph:samples", options.samples);
     spec.attribute("volmorph:renderSeconds", float(options.renderSeconds));
@@ -93,10 +68,8 @@ void writePng(const Image& image, const std::filesystem::path& path)
     OIIO::ImageBuf linear(specOf(image, OIIO::TypeDesc::FLOAT), const_cast<float*>(image.pixels.data()));
     OIIO::ImageBuf srgb = OIIO::ImageBufAlgo::colorconvert(linear, "linear", "sRGB");
     OIIO::ImageBuf clamped = OIIO::ImageBufAlgo::clamp(srgb, 0.0f, 1.0f);
-    writeAtomically(path, [&clamped](const std::filesystem::path& temporary, std::string& error) {
-        const bool ok = clamped.write(temporary.string(), OIIO::TypeDesc::UINT8);
-        if (!ok) error = clamped.geterror();
-        return ok;
+    writeAtomically(path, [&clamped](const std::filesystem::path& temporary) {
+        if (!clamped.write(temporary.string(), OIIO::TypeDesc::UINT8)) throw std::runtime_error(clamped.geterror());
     });
 }
 

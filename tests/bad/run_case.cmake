@@ -55,7 +55,10 @@ foreach(_crash "terminate called" "Aborted" "Sanitizer" "runtime error" "Segment
   endif()
 endforeach()
 foreach(_file IN LISTS _no_files)
-  file(GLOB _partials "${_file}*")
+  # The file itself, and writeAtomically's temporaries (<stem>.partial-<pid><ext>).
+  get_filename_component(_dir "${_file}" DIRECTORY)
+  get_filename_component(_stem "${_file}" NAME_WLE)
+  file(GLOB _partials "${_file}*" "${_dir}/${_stem}.partial-*")
   if(EXISTS "${_file}" OR _partials)
     message(SEND_ERROR "${CASE}: left a file at ${_file}")
     file(REMOVE "${_file}" ${_partials})

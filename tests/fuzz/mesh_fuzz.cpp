@@ -1,7 +1,7 @@
 // libFuzzer target: mesh import (Assimp, then welding, degenerate-triangle removal, topology).
 // The first byte picks the file extension, the rest is the file. Any input must give a Mesh or a
 // UserError naming the file; a crash, a sanitizer report, a hang or any other exception is a bug.
-#include <volmorph/Diagnostics.h>
+#include <volmorph/core/Diagnostics.h>
 #include <volmorph/Mesh.h>
 
 #include <unistd.h>

@@ -1,6 +1,6 @@
 // libFuzzer target: the scene parser. Any input must give a Scene or a UserError listing its
 // problems; a crash, a sanitizer report, a hang or any other exception is a bug.
-#include <volmorph/Diagnostics.h>
+#include <volmorph/core/Diagnostics.h>
 #include <volmorph/Scene.h>
 
 #include <cstddef>

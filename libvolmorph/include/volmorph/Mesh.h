@@ -3,6 +3,7 @@
 #pragma once
 
 #include <volmorph/Scene.h>
+#include <volmorph/core/Math.h>
 
 #include <openvdb/math/Vec3.h>
 
@@ -13,7 +14,6 @@
 
 namespace volmorph {
 
-using Vec3f = openvdb::math::Vec3s;
 using Vec3I = openvdb::math::Vec3<uint32_t>;
 
 /// What import found and repaired. Nothing here is fatal: open and non-manifold meshes are common

@@ -24,7 +24,7 @@
 // weight changes with t). The extended fields then need only the objects' box plus 8 voxels.
 #pragma once
 
-#include <volmorph/Interrupter.h>
+#include <volmorph/core/Interrupter.h>
 #include <volmorph/Scene.h>
 #include <volmorph/VolumeSet.h>
 

@@ -5,7 +5,8 @@
 // radians in code (only Camera::fovDegrees keeps degrees, as vdb_render's flag does, and says so).
 #pragma once
 
-#include <volmorph/Diagnostics.h>
+#include <volmorph/core/Diagnostics.h>
+#include <volmorph/core/Math.h>
 
 #include <openvdb/math/Mat4.h>
 #include <openvdb/math/Vec3.h>
@@ -17,9 +18,6 @@
 #include <vector>
 
 namespace volmorph {
-
-using Vec3d = openvdb::math::Vec3d;
-using Mat4d = openvdb::math::Mat4d;
 
 /// Object-to-world placement of a mesh: scale, then rotate about X, then Y, then Z, then translate.
 struct ObjectTransform {

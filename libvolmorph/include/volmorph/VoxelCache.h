@@ -11,7 +11,7 @@
 // then rename), so chunks racing to fill the same entry are safe.
 #pragma once
 
-#include <volmorph/Interrupter.h>
+#include <volmorph/core/Interrupter.h>
 #include <volmorph/Scene.h>
 #include <volmorph/Voxelize.h>
 

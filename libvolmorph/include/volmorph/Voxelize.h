@@ -22,7 +22,8 @@
 
 #include <algorithm>
 
-#include <volmorph/Interrupter.h>
+#include <volmorph/core/Interrupter.h>
+#include <volmorph/core/MemoryLimit.h>
 #include <volmorph/Mesh.h>
 #include <volmorph/VolumeSet.h>
 
@@ -82,9 +83,6 @@ double resolveVoxelSize(const Mesh& mesh, const VoxelizeOptions& options);
 
 /// An estimate of voxelize()'s peak memory in bytes, from the surface area and the band.
 uint64_t estimateVoxelizeBytes(const Mesh& mesh, double voxelSize, float halfWidthVoxels);
-
-/// The default memory limit: half of the physical memory.
-uint64_t defaultMemoryLimitBytes();
 
 /// A scene's voxel size in world units: volume.voxel_size, or volume.resolution voxels across the
 /// longest side of the source and target bounds together (both objects share one grid).

@@ -1,9 +1,10 @@
-#include <volmorph/Diagnostics.h>
-#include <volmorph/Version.h>
+#include <volmorph/core/Diagnostics.h>
+#include <volmorph/core/Version.h>
 #include <volmorph/VolumeSet.h>
 #include <volmorph/VoxelCache.h>
 
-#include "core/AtomicFile.h"
+#include <volmorph/core/AtomicFile.h>
+#include "export/VdbFile.h"
 
 #include <OpenImageIO/hash.h>
 #include <openvdb/io/File.h>
@@ -125,12 +126,12 @@ void writeEntry(const std::filesystem::path& path, const std::string& key, const
     openvdb::MetaMap meta;
     meta.insertMeta(kKeyMeta, openvdb::StringMetadata(key));
     std::filesystem::create_directories(path.parent_path());
-    detail::writeAtomically(path, "voxel cache entry", [&](const std::filesystem::path& temporary) {
+    writeAtomically(path, "voxel cache entry", [&](const std::filesystem::path& temporary) {
         detail::writeVdbChecked(temporary, openvdb::GridCPtrVec(grids.begin(), grids.end()), meta);
     });
     // The checksum last: a reader that finds it can trust the entry it names.
     const std::string digest = fileDigest(path, SourceLocation{path.string()});
-    detail::writeAtomically(checksumFile(path), "voxel cache checksum", [&](const std::filesystem::path& temporary) {
+    writeAtomically(checksumFile(path), "voxel cache checksum", [&](const std::filesystem::path& temporary) {
         std::ofstream out(temporary);
         out << digest << '\n';
         out.close();

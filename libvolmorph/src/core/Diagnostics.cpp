@@ -1,4 +1,4 @@
-#include <volmorph/Diagnostics.h>
+#include <volmorph/core/Diagnostics.h>
 
 #include <algorithm>
 #include <numeric>

@@ -1,4 +1,4 @@
-#include <volmorph/Interrupter.h>
+#include <volmorph/core/Interrupter.h>
 
 #include <cstdio>
 
@@ -8,6 +8,11 @@ void Interrupter::start(const char* name)
 {
     mName = name ? name : "";
     mLastPercent = -1;
+    if (mLogStages && !mName.empty()) {
+        const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - mCreated).count();
+        std::fprintf(stderr, "volmorph: %7.2f s  %s\n", seconds, mName.c_str());
+        std::fflush(stderr);
+    }
 }
 
 void Interrupter::end()

@@ -1,4 +1,4 @@
-#include <volmorph/Version.h>
+#include <volmorph/core/Version.h>
 
 namespace volmorph {
 

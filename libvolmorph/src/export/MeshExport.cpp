@@ -1,6 +1,6 @@
 #include <volmorph/Export.h>
 
-#include "core/AtomicFile.h"
+#include <volmorph/core/AtomicFile.h>
 
 #include <assimp/Exporter.hpp>
 #include <assimp/scene.h>
@@ -82,7 +82,7 @@ void writeMesh(const Mesh& mesh, const std::filesystem::path& path)
         m.mFaces[f].mIndices = new unsigned[3]{mesh.triangles[f][0], mesh.triangles[f][1], mesh.triangles[f][2]};
     }
 
-    detail::writeAtomically(path, "mesh", [&](const std::filesystem::path& temporary) {
+    writeAtomically(path, "mesh", [&](const std::filesystem::path& temporary) {
         Assimp::Exporter exporter;
         if (exporter.Export(scene.get(), format, temporary.string()) != aiReturn_SUCCESS)
             throw std::runtime_error(exporter.GetErrorString());

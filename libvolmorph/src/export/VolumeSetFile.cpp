@@ -1,7 +1,8 @@
-#include <volmorph/Diagnostics.h>
+#include <volmorph/core/Diagnostics.h>
 #include <volmorph/VolumeSet.h>
 
-#include "AtomicFile.h"
+#include <volmorph/core/AtomicFile.h>
+#include "export/VdbFile.h"
 
 #include <openvdb/io/File.h>
 #include <openvdb/io/Stream.h>
@@ -35,7 +36,7 @@ void writeVolumeSet(const VolumeSet& volumes, const std::filesystem::path& path,
         for (const auto& [key, value] : metadata) g->insertMeta(key, openvdb::StringMetadata(value));
         grids.push_back(g);
     }
-    detail::writeAtomically(path, "volume file", [&grids](const std::filesystem::path& temporary) {
+    writeAtomically(path, "volume file", [&grids](const std::filesystem::path& temporary) {
         detail::writeVdbChecked(temporary, openvdb::GridCPtrVec(grids.begin(), grids.end()), openvdb::MetaMap());
     });
 }

@@ -5,7 +5,7 @@
 #include "Stretch.h"
 #include "warp/AdaptiveWarp.h"
 
-#include <volmorph/Diagnostics.h>
+#include <volmorph/core/Diagnostics.h>
 #include <volmorph/Voxelize.h>
 
 #include <openvdb/tools/FastSweeping.h>

@@ -2,7 +2,7 @@
 // what was expected, and reading goes on. Private to the scene stage.
 #pragma once
 
-#include <volmorph/Diagnostics.h>
+#include <volmorph/core/Diagnostics.h>
 #include <volmorph/Scene.h>
 
 #include <toml++/toml.h>

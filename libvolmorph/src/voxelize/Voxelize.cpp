@@ -197,13 +197,6 @@ FloatGrid::Ptr fogFromLevelSet(const FloatGrid& sdf, float rampWorld)
     return density;
 }
 
-uint64_t defaultMemoryLimitBytes()
-{
-    const long pages = sysconf(_SC_PHYS_PAGES), pageSize = sysconf(_SC_PAGE_SIZE);
-    if (pages <= 0 || pageSize <= 0) return 4ull << 30;
-    return uint64_t(pages) * uint64_t(pageSize) / 2;
-}
-
 double resolveVoxelSize(const Mesh& mesh, const VoxelizeOptions& options)
 {
     if (options.voxelSize) return *options.voxelSize;

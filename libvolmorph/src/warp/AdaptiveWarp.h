@@ -65,7 +65,7 @@
 // per leaf plus the near pairs at the voxels that need them.
 #pragma once
 
-#include <volmorph/Interrupter.h>
+#include <volmorph/core/Interrupter.h>
 #include <volmorph/Mesh.h>
 #include <volmorph/Warp.h>
 

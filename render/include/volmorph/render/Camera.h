@@ -1,13 +1,9 @@
 // Cameras of volmorph's renderer. World units; fov in degrees (horizontal, as vdb_render's -fov).
 #pragma once
 
-#include <openvdb/math/Mat4.h>
-#include <openvdb/math/Vec3.h>
+#include <volmorph/core/Math.h>
 
 namespace volmorph::render {
-
-using Vec3d = openvdb::math::Vec3d;
-using Mat4d = openvdb::math::Mat4d;
 
 struct Ray {
     Vec3d origin, direction; ///< direction has unit length

@@ -5,7 +5,6 @@
 #include <volmorph/render/Renderer.h>
 
 #include <filesystem>
-#include <functional>
 #include <map>
 #include <string>
 
@@ -27,13 +26,6 @@ void writeExr(const Image& image, const Camera& camera, const std::filesystem::p
 
 /// Writes an 8-bit sRGB PNG preview (clamped, over black), atomically like writeExr.
 void writePng(const Image& image, const std::filesystem::path& path);
-
-/// Calls write(temporary) for a temporary name beside `path` with the same extension (so the rename
-/// is atomic and the format unchanged), then renames it to `path`. When write returns false or
-/// throws, or the rename fails, the temporary is removed and std::runtime_error says why (`write`'s
-/// message, or "write failed"). Every image writer here goes through it.
-void writeAtomically(const std::filesystem::path& path,
-                     const std::function<bool(const std::filesystem::path& temporary, std::string& error)>& write);
 
 /// Reads an image's RGBA pixels (tests, diff). Throws std::runtime_error when it cannot.
 Image readImage(const std::filesystem::path& path);

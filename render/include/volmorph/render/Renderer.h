@@ -33,6 +33,7 @@
 #include <volmorph/render/Camera.h>
 
 #include <openvdb/openvdb.h>
+#include <openvdb/util/NullInterrupter.h>
 
 #include <cstdint>
 #include <vector>
@@ -67,6 +68,9 @@ struct RenderSettings {
     unsigned seed = 0;
     int frame = 0;                 ///< part of the sampling seed
     int threads = 0;               ///< 0 = all cores
+    /// Asked between pixels and between the shadow maps' columns (OpenVDB's interrupter interface);
+    /// when it answers true, renderVolume throws volmorph::Interrupted. May be null.
+    openvdb::util::NullInterrupter* interrupter = nullptr;
 };
 
 /// A float RGBA image, RGB premultiplied, linear; A = 1 - transmittance. Row-major, top row first.
@@ -80,6 +84,7 @@ struct Image {
 
 /// Renders `density` (a fog: any float grid of densities, negative values counting as 0; or a level
 /// set, see Medium::Kind), coloured by `color` (linear RGB albedo colour, may be null: white).
+/// Throws volmorph::Interrupted (volmorph/core/Interrupter.h) when settings.interrupter asks to stop.
 Image renderVolume(const openvdb::FloatGrid& density, const openvdb::Vec3SGrid* color, const Camera& camera,
                    const std::vector<Light>& lights, const Medium& medium, const RenderSettings& settings);
 

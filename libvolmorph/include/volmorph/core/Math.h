@@ -1,0 +1,14 @@
+// The vector and matrix types shared by the engine and the renderer: OpenVDB's, named once here.
+// Points and directions are in world units unless a name says otherwise (index space: voxels).
+#pragma once
+
+#include <openvdb/math/Mat4.h>
+#include <openvdb/math/Vec3.h>
+
+namespace volmorph {
+
+using Vec3d = openvdb::math::Vec3d;
+using Vec3f = openvdb::math::Vec3s;
+using Mat4d = openvdb::math::Mat4d;
+
+} // namespace volmorph

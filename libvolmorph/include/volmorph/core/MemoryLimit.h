@@ -1,0 +1,15 @@
+// The memory limit that large allocations (voxels, in-betweens, films) are checked against before
+// they are made, so that a run too big for the machine is refused with a message, not killed.
+#pragma once
+
+#include <cstdint>
+
+namespace volmorph {
+
+/// Half of the machine's physical memory (4 GiB when it cannot be read).
+uint64_t defaultMemoryLimitBytes();
+
+/// A limit given in GiB (as the --memory-limit flags take it) in bytes; 0 means the default.
+uint64_t memoryLimitBytes(double gib);
+
+} // namespace volmorph

@@ -1,0 +1,174 @@
+#include "RayIntegrator.h"
+
+#include "Cell.h"
+#include "CellWalk.h"
+#include "Sampling.h"
+
+#include <openvdb/tools/Interpolation.h>
+
+#include <algorithm>
+#include <cmath>
+
+namespace volmorph::render {
+
+ThreadReaders::ThreadReaders(const FrameInputs& frame)
+    : in(frame), inter(frame.master), density(frame.density.tree(), frame.padded), shadowCaches(frame.lights.size()),
+      perRay(frame.lights.size())
+{
+    if (frame.color) colors = std::make_unique<ColorReader>(frame.color->tree());
+    for (size_t l = 0; l < frame.lights.size(); ++l)
+        if (frame.shadows[l].cache) shadowCaches[l] = std::make_unique<CacheAccessor>(frame.shadows[l].cache->tree());
+}
+
+namespace {
+
+/// The walk of one ray, and its state: transmittance and radiance so far, and the open run of steps
+/// since the last knot. Each piece of the ray inside one interpolation cell (or constant block) is cut
+/// into equal steps of at most stepVoxels. Each step's optical depth is exact (the integral of the
+/// trilinear density, see Piece). The source S (emission plus albedo times the light reaching the
+/// point) is evaluated at knots along the ray, at the first step end at least one voxel after the
+/// previous knot (so 1 to 1 + h voxels apart), and taken linearly in between: each step adds
+/// a = T (1 - e^-tau) times S at its middle. A and B sum a and a (t - knot) until the next knot,
+/// which closes them. Constructed per ray, as a local, so that its state lives in registers.
+class RayIntegrator
+{
+public:
+    RayIntegrator(ThreadReaders& readers, const Ray& ray, const Medium1D& line)
+        : mR(readers), mIn(readers.in), mRay(ray), mLine(line)
+    {
+    }
+
+    RaySample run()
+    {
+        double t0 = 0, t1 = 0;
+        auto shade = [this](const Cell& cell, double ta, double tb) { return this->shade(cell, ta, tb); };
+        while (mR.inter.march(t0, t1) && walkCells(mR.density, mLine, t0, t1, shade)) {}
+        if (mOpen) close(mLastEnd);
+        return mOut;
+    }
+
+private:
+    /// The source term at ray time t (voxels): emission plus albedo times the light arriving.
+    Vec3d sourceAt(double t)
+    {
+        const Vec3d ip = mLine.eye + mLine.dir * t;
+        Vec3d albedo(mIn.medium.albedo);
+        if (mR.colors) albedo = mR.colors->at(ip) * mIn.medium.albedo;
+        Vec3d source = mIn.medium.emission;
+        for (size_t l = 0; l < mIn.lights.size(); ++l) {
+            const Light& light = mIn.lights[l];
+            Vec3d c = mR.perRay[l];
+            double Tl;
+            if (light.type == Light::Type::Point) {
+                Vec3d travel = mIn.density.indexToWorld(ip) - light.position;
+                const double d2 = travel.lengthSqr();
+                travel /= std::sqrt(d2);
+                c = light.color * (light.intensity / d2 *
+                    henyeyGreenstein(travel.dot(-mRay.direction), mIn.medium.anisotropy));
+                // The cache shares the density's origin, at `factor` times its voxel.
+                Tl = openvdb::tools::BoxSampler::sample(*mR.shadowCaches[l], ip * mIn.inverseFactor);
+            } else {
+                Tl = mIn.shadows[l].map->lookup(ip);
+            }
+            source += Vec3d(albedo.x() * c.x(), albedo.y() * c.y(), albedo.z() * c.z()) * Tl;
+        }
+        return source;
+    }
+
+    /// A knot at t: settles the steps since the last one.
+    void close(double t)
+    {
+        const Vec3d next = sourceAt(t);
+        if (mA > 0.0) mOut.L += mKnotSource * mA + (next - mKnotSource) * (t > mKnot ? mB / (t - mKnot) : 0.0);
+        mKnot = t;
+        mKnotSource = next;
+        mA = mB = 0.0;
+    }
+
+    /// Steps of one piece [ta, tb]: n steps of length dt, optical depth from tauOf(k, dt). Returns false
+    /// when the ray is opaque enough to stop.
+    template <typename TauOf>
+    bool march(double ta, double tb, int n, TauOf&& tauOf)
+    {
+        if (!mOpen || ta != mLastEnd) { // a gap: settle the run before it
+            if (mOpen) close(mLastEnd);
+            mKnot = ta;
+            mKnotSource = sourceAt(ta);
+            mA = mB = 0.0;
+            mOpen = true;
+        }
+        const double dt = (tb - ta) / n;
+        double lastTau = -1.0, transmitted = 1.0;
+        for (int k = 0; k < n; ++k) {
+            const double tau = tauOf(k, dt);
+            const double end = k + 1 == n ? tb : ta + (k + 1) * dt;
+            if (tau > 0.0) {
+                if (tau != lastTau) { // equal steps of a constant piece: once
+                    lastTau = tau;
+                    transmitted = expNegative(tau);
+                }
+                const double a = mOut.T * (1.0 - transmitted);
+                mA += a;
+                mB += a * (end - 0.5 * dt - mKnot);
+                mOut.T *= transmitted;
+            }
+            if (mOut.T <= kMinTransmittance) {
+                close(end);
+                mOpen = false;
+                return false;
+            }
+            if (end - mKnot >= 1.0) close(end);
+        }
+        mLastEnd = tb;
+        return true;
+    }
+
+    /// One piece [ta, tb] of the ray inside `cell` (or a constant run of cells).
+    bool shade(const Cell& cell, double ta, double tb)
+    {
+        const double sigma = mIn.sigmaPerVoxel;
+        const int n = std::max(1, int(std::ceil((tb - ta) / mIn.stepVoxels - 1e-9)));
+        if (cell.block) {
+            const double rho = mIn.levelSet ? (cell.lo < 0.0f ? 1.0 : 0.0) : double(cell.hi);
+            return march(ta, tb, n, [&](int, double dt) { return sigma * rho * dt; });
+        }
+        const Piece piece(mLine, cell, ta);
+        double before = 0.0; // piece.mass at the start of step k
+        return march(ta, tb, n, [&](int k, double dt) {
+            if (!piece.exact) return sigma * mLine.mass(cell, ta + k * dt, ta + (k + 1) * dt);
+            const double after = piece.mass((k + 1) * dt);
+            const double tau = sigma * (after - before);
+            before = after;
+            return tau;
+        });
+    }
+
+    ThreadReaders& mR;
+    const FrameInputs& mIn;
+    const Ray& mRay;
+    const Medium1D mLine;
+    RaySample mOut;
+    bool mOpen = false; ///< a knot is placed and steps since it are pending
+    double mKnot = 0.0, mA = 0.0, mB = 0.0, mLastEnd = -1.0;
+    Vec3d mKnotSource{0.0};
+};
+
+} // namespace
+
+RaySample integrateRay(ThreadReaders& readers, const Ray& ray)
+{
+    if (!readers.inter.setWorldRay(VdbRay(ray.origin, ray.direction))) return RaySample{};
+    const FrameInputs& in = readers.in;
+    // A directional light's phase and colour are constant along a ray.
+    for (size_t l = 0; l < in.lights.size(); ++l) {
+        const Light& light = in.lights[l];
+        readers.perRay[l] = light.color * (light.intensity *
+            henyeyGreenstein(light.direction.unit().dot(-ray.direction), in.medium.anisotropy));
+    }
+    const Medium1D line{readers.inter.getIndexPos(0.0),
+                        readers.inter.getIndexPos(1.0) - readers.inter.getIndexPos(0.0), in.levelSet};
+    RayIntegrator integrator(readers, ray, line);
+    return integrator.run();
+}
+
+} // namespace volmorph::render

@@ -1,0 +1,56 @@
+// One camera ray's integral through the volume: emission, absorption and single scattering toward
+// every light, with the optical depth of each step exact (Cell.h) and the source term taken linearly
+// between knots (Renderer.h states the approximation). The renderer's three levels, as pbrt-v4 has
+// them: the tile loop and a pixel's samples (Renderer.cpp), and here what happens along one ray.
+#pragma once
+
+#include <volmorph/render/Camera.h>
+#include <volmorph/render/Renderer.h>
+
+#include "GridReaders.h"
+#include "Shadows.h"
+
+#include <memory>
+#include <vector>
+
+namespace volmorph::render {
+
+/// What every ray of one image reads and nothing writes: built once per image.
+struct FrameInputs {
+    const openvdb::FloatGrid& density;
+    const openvdb::Vec3SGrid* color; ///< may be null: white
+    const std::vector<Light>& lights;
+    const Medium& medium;
+    bool levelSet;
+    double sigmaPerVoxel;    ///< extinction per index unit at density 1
+    double stepVoxels;       ///< longest step of the scattering integral
+    double inverseFactor;    ///< 1 / the point lights' shadow grid spacing in voxels
+    const PaddedLeaves& padded;
+    const Intersector& master;
+    const std::vector<Shadow>& shadows;
+};
+
+/// One thread's readers of the frame's grids (accessors keep per-thread caches).
+struct ThreadReaders {
+    using CacheAccessor = openvdb::tree::ValueAccessor<const openvdb::FloatTree>;
+
+    const FrameInputs& in;
+    Intersector inter;
+    DensityReader density;
+    std::unique_ptr<ColorReader> colors;
+    std::vector<std::unique_ptr<CacheAccessor>> shadowCaches; ///< per light: its point-light grid, or null
+    std::vector<Vec3d> perRay;                                ///< per light: scratch for one ray
+
+    explicit ThreadReaders(const FrameInputs& frame);
+};
+
+/// The radiance L (linear RGB, premultiplied) and the transmittance T along one camera ray.
+struct RaySample {
+    Vec3d L{0.0};
+    double T = 1.0;
+};
+
+/// Integrates one world-space camera ray through the frame's volume.
+RaySample integrateRay(ThreadReaders& readers, const Ray& ray);
+
+} // namespace volmorph::render

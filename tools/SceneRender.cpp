@@ -1,0 +1,59 @@
+#include "SceneRender.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace volmorph::cli {
+
+namespace {
+
+render::Camera sceneCamera(const CameraSpec& c, const RenderSpec& r, int width)
+{
+    const int w = width > 0 ? width : r.width;
+    const int h = width > 0 ? std::max(1, int(std::lround(double(r.height) * w / r.width))) : r.height;
+    return render::Camera(c.projection == Projection::Orthographic ? render::Camera::Projection::Orthographic
+                                                                   : render::Camera::Projection::Perspective,
+                          c.eye, c.lookat, c.up, c.fovDegrees, c.orthoWidth, w, h);
+}
+
+} // namespace
+
+SceneRender::SceneRender(const Scene& scene, int threads, int width) : mSpec(scene.render), mWidth(width)
+{
+    const RenderSpec& r = scene.render;
+    medium.extinction = r.extinction;
+    medium.albedo = r.albedo;
+    medium.anisotropy = r.anisotropy;
+    medium.emission = r.emission;
+    settings.samples = r.samples;
+    settings.stepVoxels = r.stepVoxels;
+    settings.seed = r.seed;
+    settings.threads = threads;
+}
+
+render::Camera SceneRender::camera(int frame) const { return sceneCamera(mSpec.camera.at(frame), mSpec, mWidth); }
+
+std::vector<render::Light> SceneRender::lights(int frame) const
+{
+    std::vector<render::Light> lights;
+    for (const LightSpec& spec : mSpec.lights) {
+        const LightSpec l = spec.at(frame);
+        render::Light light;
+        light.type = l.type == LightType::Point ? render::Light::Type::Point : render::Light::Type::Directional;
+        light.direction = l.direction;
+        light.position = l.position;
+        light.color = l.color;
+        light.intensity = l.intensity;
+        lights.push_back(light);
+    }
+    return lights;
+}
+
+render::Image SceneRender::renderFrame(const VolumeSet& volumes, int frame) const
+{
+    render::RenderSettings s = settings;
+    s.frame = frame;
+    return render::renderVolume(*volumes.density, volumes.color.get(), camera(frame), lights(frame), medium, s);
+}
+
+} // namespace volmorph::cli
