@@ -1,0 +1,187 @@
+// Fixtures shared by the unit tests of the feature, warp, morph and export stages: feature pairs,
+// voxelized test meshes, moments of a fog, random pair configurations, the approximated warp's
+// error against the exact one.
+#pragma once
+
+#include <volmorph/Export.h>
+#include <volmorph/Feature.h>
+#include <volmorph/Morph.h>
+#include <volmorph/Voxelize.h>
+#include <volmorph/Warp.h>
+
+#include "morph/Stretch.h"      // private to the library; tested directly
+#include "warp/AdaptiveWarp.h" // private to the library; tested directly
+
+#include <openvdb/tools/Composite.h>
+#include <openvdb/tools/LevelSetSphere.h>
+#include <openvdb/tools/Morphology.h>
+
+#include <gtest/gtest.h>
+
+#include <array>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
+#include <iostream>
+#include <map>
+#include <mutex>
+#include <random>
+#include <set>
+#include <tuple>
+
+namespace volmorph::test {
+
+
+inline const std::filesystem::path kMeshes = std::filesystem::path(VOLMORPH_SOURCE_DIR) / "scenes" / "meshes";
+
+inline FeatureElement element(const Vec3d& origin, const Vec3d& x = Vec3d(1, 0, 0), const Vec3d& y = Vec3d(0, 1, 0),
+                       const Vec3d& scale = Vec3d(1.0))
+{
+    FeatureElement e;
+    e.origin = origin;
+    e.xAxis = x.unit();
+    e.yAxis = y.unit();
+    e.zAxis = e.xAxis.cross(e.yAxis);
+    e.scale = scale;
+    return e;
+}
+
+inline FeaturePairSpec pair(FeatureType type, const FeatureElement& s, const FeatureElement& t)
+{
+    FeaturePairSpec p;
+    p.type = type;
+    p.source = s;
+    p.target = t;
+    return p;
+}
+
+inline VolumeSet voxelized(const std::string& mesh, double voxelSize, const ObjectTransform& xf = {})
+{
+    VoxelizeOptions o;
+    o.voxelSize = voxelSize;
+    return voxelize(importMesh(kMeshes / mesh, xf), o);
+}
+
+struct Moments {
+    double mass = 0.0;
+    Vec3d centroid{0.0};
+    double ixx = 0, iyy = 0, ixy = 0; ///< central second moments in the xy plane
+};
+
+inline Moments moments(const openvdb::FloatGrid& density)
+{
+    Moments m;
+    std::vector<std::pair<Vec3d, double>> samples;
+    for (auto it = density.cbeginValueOn(); it; ++it) {
+        const openvdb::CoordBBox b = it.getBoundingBox();
+        if (it.isVoxelValue()) {
+            samples.emplace_back(density.indexToWorld(it.getCoord()), double(*it));
+        } else {
+            for (auto c = b.begin(); c; ++c) samples.emplace_back(density.indexToWorld(*c), double(*it));
+        }
+    }
+    for (const auto& [p, w] : samples) {
+        m.mass += w;
+        m.centroid += w * p;
+    }
+    m.centroid /= m.mass;
+    for (const auto& [p, w] : samples) {
+        const Vec3d d = p - m.centroid;
+        m.ixx += w * d.x() * d.x();
+        m.iyy += w * d.y() * d.y();
+        m.ixy += w * d.x() * d.y();
+    }
+    return m;
+}
+
+/// Largest |a - b| of two density grids over the union of their active voxels.
+inline double maxDifference(const openvdb::FloatGrid& a, const openvdb::FloatGrid& b)
+{
+    double worst = 0.0;
+    auto ba = b.getConstAccessor();
+    for (auto it = a.cbeginValueOn(); it; ++it)
+        for (auto c = it.getBoundingBox().begin(); c; ++c)
+            worst = std::max(worst, double(std::abs(a.tree().getValue(*c) - ba.getValue(*c))));
+    auto aa = a.getConstAccessor();
+    for (auto it = b.cbeginValueOn(); it; ++it)
+        for (auto c = it.getBoundingBox().begin(); c; ++c)
+            worst = std::max(worst, double(std::abs(aa.getValue(*c) - b.tree().getValue(*c))));
+    return worst;
+}
+
+/// Rodrigues' rotation of v about the unit axis k by angle (radians).
+inline Vec3d rotate(const Vec3d& v, const Vec3d& k, double angle)
+{
+    return v * std::cos(angle) + k.cross(v) * std::sin(angle) + k * (k.dot(v) * (1.0 - std::cos(angle)));
+}
+
+/// A random configuration of n pairs of random types inside a cube of `extent` units, made the way
+/// a user makes them: each target element is its source element moved by up to a quarter of the
+/// extent, scaled by 0.6 to 1.6 per axis and turned by up to 60 degrees.
+inline std::vector<FeaturePairSpec> randomPairs(std::mt19937& random, int n, double extent)
+{
+    std::uniform_real_distribution<double> u(0.0, 1.0);
+    auto vec = [&] { return Vec3d(u(random), u(random), u(random)); };
+    auto direction = [&] {
+        Vec3d d = vec() - Vec3d(0.5);
+        while (d.length() < 0.1) d = vec() - Vec3d(0.5);
+        return d.unit();
+    };
+    std::vector<FeaturePairSpec> pairs;
+    for (int i = 0; i < n; ++i) {
+        FeaturePairSpec p;
+        p.type = FeatureType(random() % 4);
+        FeatureElement& s = p.source;
+        s.origin = vec() * extent;
+        s.xAxis = direction();
+        Vec3d across = s.xAxis.cross(direction());
+        while (across.length() < 0.1) across = s.xAxis.cross(direction()); // a frame, not a near-degenerate one
+        s.yAxis = across.unit();
+        s.zAxis = s.xAxis.cross(s.yAxis);
+        s.scale = (Vec3d(0.1) + vec()) * (extent / 4);
+        FeatureElement& t = p.target;
+        t.origin = s.origin + (vec() - Vec3d(0.5)) * (extent / 2);
+        const Vec3d axis = direction();
+        const double angle = (u(random) - 0.5) * (2.0 * M_PI / 3.0);
+        t.xAxis = rotate(s.xAxis, axis, angle);
+        t.yAxis = rotate(s.yAxis, axis, angle);
+        t.zAxis = t.xAxis.cross(t.yAxis);
+        const Vec3d factor = Vec3d(0.6) + vec();
+        t.scale = Vec3d(s.scale.x() * factor.x(), s.scale.y() * factor.y(), s.scale.z() * factor.z());
+        pairs.push_back(p);
+    }
+    return pairs;
+}
+
+/// The largest distance between a leaf's approximated points and the exact warp's, on either side,
+/// over every `stride`-th voxel.
+inline double leafError(const InverseWarp& warp, const detail::WarpLeaf& leaf, int stride)
+{
+    double local = 0.0;
+    Vec3d s, d;
+    for (int i = 0; i < 512; i += stride) {
+        warp.map(leaf.origin.offsetBy(i >> 6, (i >> 3) & 7, i & 7).asVec3d(), s, d);
+        local = std::max({local, (Vec3d(leaf.source(i)) - s).length(), (Vec3d(leaf.target(i)) - d).length()});
+    }
+    return local;
+}
+
+/// The largest leafError over every leaf of the box [0, last]^3 (index space).
+inline double largestError(const InverseWarp& warp, const detail::AdaptiveWarp& adaptive, int last, int stride,
+                    detail::AdaptiveWarpStats& stats)
+{
+    std::mutex m;
+    double worst = 0.0;
+    adaptive.forEachLeaf(openvdb::CoordBBox(openvdb::Coord(0), openvdb::Coord(last)), nullptr, nullptr,
+                         [&](const detail::WarpLeaf& leaf) {
+                             const double local = leafError(warp, leaf, stride);
+                             std::lock_guard<std::mutex> lock(m);
+                             worst = std::max(worst, local);
+                         },
+                         &stats);
+    return worst;
+}
+
+
+} // namespace volmorph::test
