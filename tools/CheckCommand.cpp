@@ -16,14 +16,16 @@ void printMesh(const char* label, const ObjectSpec& spec, const Mesh& mesh)
     const auto [lo, hi] = mesh.bounds();
     const MeshReport& r = mesh.report;
     std::printf("%-7s %s\n", label, spec.mesh.string().c_str());
-    std::printf("        %zu vertices, %zu triangles, %s\n", mesh.points.size(), mesh.triangles.size(),
-                describeTopology(r).c_str());
+    std::printf("        %zu vertices, %zu triangles, %s\n", mesh.points.size(),
+                mesh.triangles.size(), describeTopology(r).c_str());
     if (r.degenerateTriangles)
         std::printf("        repaired: %zu degenerate (zero-area) triangles dropped\n",
                     r.degenerateTriangles);
     std::printf("        bounds %s .. %s world units\n", fmt(lo).c_str(), fmt(hi).c_str());
-    if (spec.color) std::printf("        colour %s (constant)\n", fmt(*spec.color).c_str());
-    else if (mesh.hasColors()) std::printf("        colour from the mesh's vertex colours\n");
+    if (spec.color)
+        std::printf("        colour %s (constant)\n", fmt(*spec.color).c_str());
+    else if (mesh.hasColors())
+        std::printf("        colour from the mesh's vertex colours\n");
 }
 
 /// Hand-placed features far from their mesh are usually a typo in a coordinate.
@@ -40,10 +42,12 @@ void warnFarFeatures(const Scene& scene, const Mesh& source, const Mesh& target)
     for (size_t i = 0; i < scene.pairs.size(); ++i) {
         const FeaturePairSpec& pair = scene.pairs[i];
         if (outside(pair.source.origin, sb))
-            std::fprintf(stderr, "%s: warning: pair %zu: source origin %s is far outside the source mesh\n",
+            std::fprintf(stderr,
+                         "%s: warning: pair %zu: source origin %s is far outside the source mesh\n",
                          pair.where.str().c_str(), i + 1, fmt(pair.source.origin).c_str());
         if (outside(pair.target.origin, tb))
-            std::fprintf(stderr, "%s: warning: pair %zu: target origin %s is far outside the target mesh\n",
+            std::fprintf(stderr,
+                         "%s: warning: pair %zu: target origin %s is far outside the target mesh\n",
                          pair.where.str().c_str(), i + 1, fmt(pair.target.origin).c_str());
     }
 }
@@ -55,8 +59,10 @@ void warnCoincidentFeatures(const Scene& scene)
 {
     auto same = [](const FeatureElement& a, const FeatureElement& b) {
         constexpr double kTolerance = 1e-9;
-        return (a.origin - b.origin).length() < kTolerance && (a.xAxis - b.xAxis).length() < kTolerance &&
-               (a.yAxis - b.yAxis).length() < kTolerance && (a.scale - b.scale).length() < kTolerance;
+        return (a.origin - b.origin).length() < kTolerance &&
+               (a.xAxis - b.xAxis).length() < kTolerance &&
+               (a.yAxis - b.yAxis).length() < kTolerance &&
+               (a.scale - b.scale).length() < kTolerance;
     };
     for (size_t j = 1; j < scene.pairs.size(); ++j)
         for (size_t i = 0; i < j; ++i) {
@@ -65,8 +71,12 @@ void warnCoincidentFeatures(const Scene& scene)
             if (a.type != b.type) continue;
             const bool s = same(a.source, b.source), t = same(a.target, b.target);
             if (!s && !t) continue;
-            std::fprintf(stderr, "%s: warning: pair %zu has the same %s element as pair %zu%s\n", b.where.str().c_str(),
-                         j + 1, s && t ? "source and target" : s ? "source" : "target", i + 1,
+            std::fprintf(stderr, "%s: warning: pair %zu has the same %s element as pair %zu%s\n",
+                         b.where.str().c_str(), j + 1,
+                         s && t ? "source and target"
+                         : s    ? "source"
+                                : "target",
+                         i + 1,
                          s && t ? " (a duplicate: its weight counts twice)"
                          : s    ? ": one place is sent to two destinations, which are averaged"
                                 : ": two places are sent to one destination");
@@ -89,10 +99,11 @@ int runCheck(const std::string& scenePath)
                 fmt(voxel).c_str(), std::ceil(extent.x() / voxel), std::ceil(extent.y() / voxel),
                 std::ceil(extent.z() / voxel));
     const double gib = double(1ull << 30);
-    std::printf("        voxelizing needs about %.2f + %.2f GiB (limit %.1f GiB, half the memory)\n",
-                double(estimateVoxelizeBytes(meshes.source, voxel, 3.0f)) / gib,
-                double(estimateVoxelizeBytes(meshes.target, voxel, 3.0f)) / gib,
-                double(defaultMemoryLimitBytes()) / gib);
+    std::printf(
+        "        voxelizing needs about %.2f + %.2f GiB (limit %.1f GiB, half the memory)\n",
+        double(estimateVoxelizeBytes(meshes.source, voxel, 3.0f)) / gib,
+        double(estimateVoxelizeBytes(meshes.target, voxel, 3.0f)) / gib,
+        double(defaultMemoryLimitBytes()) / gib);
 
     std::printf("pairs   %zu\n", scene.pairs.size());
     for (size_t i = 0; i < scene.pairs.size(); ++i) {
@@ -116,9 +127,10 @@ int runCheck(const std::string& scenePath)
                 b.mode == BlendMode::Sdf ? "sdf" : "density", b.density.str().c_str(),
                 b.color.str().c_str(), b.sdf.str().c_str());
     const RenderSpec& r = scene.render;
-    std::printf("render  %dx%d, %d samples, step %s voxels, extinction %s per world unit, albedo %s\n",
-                r.width, r.height, r.samples, fmt(r.stepVoxels).c_str(), fmt(r.extinction).c_str(),
-                fmt(r.albedo).c_str());
+    std::printf(
+        "render  %dx%d, %d samples, step %s voxels, extinction %s per world unit, albedo %s\n",
+        r.width, r.height, r.samples, fmt(r.stepVoxels).c_str(), fmt(r.extinction).c_str(),
+        fmt(r.albedo).c_str());
     const CameraSpec& c = r.camera;
     if (c.projection == Projection::Perspective)
         std::printf("camera  perspective, eye %s, lookat %s, fov %s degrees (horizontal)\n",
@@ -126,8 +138,11 @@ int runCheck(const std::string& scenePath)
     else
         std::printf("camera  orthographic, eye %s, lookat %s, width %s world units\n",
                     fmt(c.eye).c_str(), fmt(c.lookat).c_str(), fmt(c.orthoWidth).c_str());
-    if (!c.keys.empty()) std::printf("        animated: %zu keys, frames %d to %d\n", c.keys.size(), c.keys.front().frame, c.keys.back().frame);
-    if (r.emission != Vec3d(0.0)) std::printf("emission %s per unit optical depth\n", fmt(r.emission).c_str());
+    if (!c.keys.empty())
+        std::printf("        animated: %zu keys, frames %d to %d\n", c.keys.size(),
+                    c.keys.front().frame, c.keys.back().frame);
+    if (r.emission != Vec3d(0.0))
+        std::printf("emission %s per unit optical depth\n", fmt(r.emission).c_str());
     for (const LightSpec& l : r.lights) {
         if (l.type == LightType::Directional)
             std::printf("light   directional, travelling %s, colour %s, intensity %s\n",
@@ -136,7 +151,8 @@ int runCheck(const std::string& scenePath)
             std::printf("light   point at %s, colour %s, intensity %s\n", fmt(l.position).c_str(),
                         fmt(l.color).c_str(), fmt(l.intensity).c_str());
         if (!l.keys.empty())
-            std::printf("        animated: %zu keys, frames %d to %d\n", l.keys.size(), l.keys.front().frame, l.keys.back().frame);
+            std::printf("        animated: %zu keys, frames %d to %d\n", l.keys.size(),
+                        l.keys.front().frame, l.keys.back().frame);
     }
     const FramesSpec& f = scene.frames;
     std::printf("frames  %d-%d (%d frames) -> %s\n", f.first, f.last, f.count(),

@@ -55,13 +55,15 @@ std::string fmt(const Vec3d& v)
 std::string describeTopology(const MeshReport& r)
 {
     std::ostringstream s;
-    if (r.watertight()) s << "watertight";
+    if (r.watertight())
+        s << "watertight";
     else {
         s << "open";
         if (r.boundaryEdges) s << ", " << r.boundaryEdges << " boundary edges";
         if (r.nonManifoldEdges) s << ", " << r.nonManifoldEdges << " non-manifold edges";
     }
-    if (!r.consistentlyOriented()) s << ", " << r.misorientedEdges << " inconsistently oriented edges";
+    if (!r.consistentlyOriented())
+        s << ", " << r.misorientedEdges << " inconsistently oriented edges";
     s << ", " << r.components << (r.components == 1 ? " shell" : " shells");
     return s.str();
 }
@@ -75,9 +77,10 @@ std::filesystem::path CacheArgs::resolve() const
 
 void addCacheOptions(CLI::App* command, CacheArgs& args)
 {
-    command->add_option("--cache", args.folder,
-                        "voxel cache folder (default: $VOLMORPH_CACHE, else $XDG_CACHE_HOME/volmorph, else "
-                        "~/.cache/volmorph); share it between the chunks of a farm job");
+    command->add_option(
+        "--cache", args.folder,
+        "voxel cache folder (default: $VOLMORPH_CACHE, else $XDG_CACHE_HOME/volmorph, else "
+        "~/.cache/volmorph); share it between the chunks of a farm job");
     command->add_flag("--no-cache", args.disabled, "voxelize without reading or writing the cache");
 }
 
@@ -86,20 +89,24 @@ SceneVolumes loadSceneVolumes(const Scene& scene, const CacheArgs& cache, Interr
 {
     const auto start = std::chrono::steady_clock::now();
     CacheReport report;
-    SceneVolumes volumes = voxelizeSceneCached(scene, cache.resolve(), &interrupter, memoryLimitBytes, &report);
+    SceneVolumes volumes =
+        voxelizeSceneCached(scene, cache.resolve(), &interrupter, memoryLimitBytes, &report);
     const std::string entry = report.entry.string();
     if (report.outcome == CacheReport::Outcome::Rebuilt)
-        std::fprintf(stderr, "%s: voxel cache entry not used (%s); voxelized again and replaced\n", entry.c_str(),
-                     report.problem.c_str());
+        std::fprintf(stderr, "%s: voxel cache entry not used (%s); voxelized again and replaced\n",
+                     entry.c_str(), report.problem.c_str());
     if (!report.storeProblem.empty())
-        std::fprintf(stderr, "volmorph: warning: the voxels were not cached: %s\n", report.storeProblem.c_str());
+        std::fprintf(stderr, "volmorph: warning: the voxels were not cached: %s\n",
+                     report.storeProblem.c_str());
     if (!quiet) {
         const double seconds = secondsSince(start);
         if (report.outcome == CacheReport::Outcome::Hit)
-            std::printf("voxels of source and target read from the cache in %.2f s (%s)\n", seconds, entry.c_str());
+            std::printf("voxels of source and target read from the cache in %.2f s (%s)\n", seconds,
+                        entry.c_str());
         else
-            std::printf("voxelized source and target at %g world units in %.2f s%s%s\n", volumes.source.voxelSize(),
-                        seconds, report.storeProblem.empty() && !entry.empty() ? "; cached in " : "",
+            std::printf("voxelized source and target at %g world units in %.2f s%s%s\n",
+                        volumes.source.voxelSize(), seconds,
+                        report.storeProblem.empty() && !entry.empty() ? "; cached in " : "",
                         report.storeProblem.empty() ? entry.c_str() : "");
         std::fflush(stdout);
     }
@@ -132,10 +139,11 @@ void Progress::update(int done)
     bar.append(size_t(kWidth - filled), '.');
     char text[160];
     if (done > 0)
-        std::snprintf(text, sizeof text, "\r[%s] %3d%%  %d/%d  elapsed %.0f s  ETA %.0f s ", bar.c_str(), percent,
-                      done, mSteps, elapsed, eta);
+        std::snprintf(text, sizeof text, "\r[%s] %3d%%  %d/%d  elapsed %.0f s  ETA %.0f s ",
+                      bar.c_str(), percent, done, mSteps, elapsed, eta);
     else
-        std::snprintf(text, sizeof text, "\r[%s] %3d%%  %d/%d ", bar.c_str(), percent, done, mSteps);
+        std::snprintf(text, sizeof text, "\r[%s] %3d%%  %d/%d ", bar.c_str(), percent, done,
+                      mSteps);
     std::fputs(text, stdout);
     std::fflush(stdout);
     mBarShown = true;
@@ -144,7 +152,8 @@ void Progress::update(int done)
 void Progress::log(const std::string& line)
 {
     if (mQuiet) return;
-    if (mTerminal && mBarShown) std::fputs("\r\033[K", stdout); // clear the bar, print, redraw below
+    if (mTerminal && mBarShown)
+        std::fputs("\r\033[K", stdout); // clear the bar, print, redraw below
     std::printf("%s\n", line.c_str());
     if (mTerminal && mBarShown) update(mLastDone);
     std::fflush(stdout);
@@ -157,13 +166,15 @@ Progress::~Progress()
 
 void checkFilmMemory(int width, int height, double limitGiB)
 {
-    constexpr double kBytesPerPixel = 48.0; // the float RGBA film, and a float and a half copy to write it
+    constexpr double kBytesPerPixel =
+        48.0; // the float RGBA film, and a float and a half copy to write it
     const double bytes = kBytesPerPixel * double(width) * double(height);
     const double limit = double(memoryLimitBytes(limitGiB));
     if (bytes <= limit) return;
     char text[300];
     std::snprintf(text, sizeof text,
-                  "a %dx%d image needs about %.1f GiB, more than the memory limit of %.1f GiB; render fewer pixels "
+                  "a %dx%d image needs about %.1f GiB, more than the memory limit of %.1f GiB; "
+                  "render fewer pixels "
                   "or raise --memory-limit (default: half the machine's memory)",
                   width, height, bytes / double(1ull << 30), limit / double(1ull << 30));
     throw UserError(SourceLocation{"render"}, text);

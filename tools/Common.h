@@ -87,7 +87,8 @@ public:
     ~StopSignals();
 
 private:
-    struct sigaction mOldInt {}, mOldTerm {};
+    struct sigaction mOldInt {
+    }, mOldTerm{};
 };
 
 } // namespace volmorph::cli

@@ -5,8 +5,8 @@
 
 namespace volmorph::cli {
 
-FrameLoop::FrameLoop(const Scene& scene, std::vector<int> frames, int stepsPerFrame, bool quiet, bool logFrames,
-                     Interrupter& interrupter)
+FrameLoop::FrameLoop(const Scene& scene, std::vector<int> frames, int stepsPerFrame, bool quiet,
+                     bool logFrames, Interrupter& interrupter)
     : mScene(scene), mFrames(std::move(frames)), mSteps(stepsPerFrame), mLogFrames(logFrames),
       mInterrupter(interrupter), mProgress(stepsPerFrame * int(mFrames.size()), quiet)
 {
@@ -44,7 +44,8 @@ void FrameLoop::report(const FrameStep& step, const FrameResult& result, double 
         if (!mLogFrames) return;
         char line[1024];
         std::snprintf(line, sizeof line, "frame %d (t=%.4f): %s%s%.2f s -> %s", step.frame, step.t,
-                      result.detail.c_str(), result.detail.empty() ? "" : ", ", seconds, result.output.c_str());
+                      result.detail.c_str(), result.detail.empty() ? "" : ", ", seconds,
+                      result.output.c_str());
         mProgress.log(line);
         return;
     }

@@ -36,8 +36,8 @@ class FrameLoop {
 public:
     /// `stepsPerFrame`: how many progress steps one frame counts (e.g. morph and render: 2).
     /// `logFrames`: print a line per frame ("frame 3 (t=0.0870): 1.52 s -> out.0003.exr").
-    FrameLoop(const Scene& scene, std::vector<int> frames, int stepsPerFrame, bool quiet, bool logFrames,
-              Interrupter& interrupter);
+    FrameLoop(const Scene& scene, std::vector<int> frames, int stepsPerFrame, bool quiet,
+              bool logFrames, Interrupter& interrupter);
 
     /// Calls `work` for each frame in order. Throws Interrupted as soon as the interrupter asked
     /// to stop (after the frame at work). Returns the number of frames whose work failed.

@@ -26,7 +26,8 @@ struct MorphArgs {
 };
 
 /// Writes one in-between as a .vdb at `file` (and its surface, with --mesh).
-void writeFrame(const VolumeSet& v, const std::filesystem::path& file, const MorphArgs& args, const FrameStep& step)
+void writeFrame(const VolumeSet& v, const std::filesystem::path& file, const MorphArgs& args,
+                const FrameStep& step)
 {
     if (file.has_parent_path()) std::filesystem::create_directories(file.parent_path());
     writeVolumeSet(v, file,
@@ -48,17 +49,21 @@ int runMorph(const MorphArgs& args)
     // Default: the scene's output pattern with .vdb for .exr, relative to the scene's folder.
     std::string pattern = args.output;
     if (pattern.empty())
-        pattern = (scene.folder / std::filesystem::path(scene.frames.output).replace_extension(".vdb")).string();
+        pattern =
+            (scene.folder / std::filesystem::path(scene.frames.output).replace_extension(".vdb"))
+                .string();
     if (const std::string why = checkFramePattern(pattern); !why.empty())
         throw UserError(SourceLocation{"-o"}, "\"" + pattern + "\": " + why);
     if (frames.size() > 1 && frameFileName(pattern, frames[0]) == frameFileName(pattern, frames[1]))
-        throw UserError(SourceLocation{"-o"}, "\"" + pattern + "\" has no frame number placeholder (#### or %04d)");
+        throw UserError(SourceLocation{"-o"},
+                        "\"" + pattern + "\" has no frame number placeholder (#### or %04d)");
     if (!args.mesh.empty()) {
         if (const std::string why = checkFramePattern(args.mesh); !why.empty())
             throw UserError(SourceLocation{"--mesh"}, "\"" + args.mesh + "\": " + why);
         const std::string ext = std::filesystem::path(args.mesh).extension().string();
         if (ext != ".ply" && ext != ".obj")
-            throw UserError(SourceLocation{"--mesh"}, "expected a pattern ending in .ply or .obj, got \"" + args.mesh + "\"");
+            throw UserError(SourceLocation{"--mesh"},
+                            "expected a pattern ending in .ply or .obj, got \"" + args.mesh + "\"");
     }
     if (args.exact) scene.warp.toleranceVoxels = 0.0;
 
@@ -88,22 +93,28 @@ int runMorph(const MorphArgs& args)
 Command addMorphCommand(CLI::App& app)
 {
     auto args = std::make_shared<MorphArgs>();
-    CLI::App* sub = app.add_subcommand("morph", "Write the morphed volume of each frame as a .vdb (grids density, Cd)");
+    CLI::App* sub = app.add_subcommand(
+        "morph", "Write the morphed volume of each frame as a .vdb (grids density, Cd)");
     sub->add_option("SCENE", args->scene, "scene file (TOML)")->required();
-    sub->add_option("--frames", args->frames, "frames to write, e.g. 1-10, 1-100x2, 1,5,10-20 (default: all)");
-    sub->add_option("-o,--output", args->output,
-                    "output pattern, e.g. out/morph.####.vdb (default: the scene's output with .vdb)");
-    sub->add_option("--mesh", args->mesh,
-                    "also write each in-between's surface, e.g. out/morph.####.ply (PLY with colours, or OBJ)");
+    sub->add_option("--frames", args->frames,
+                    "frames to write, e.g. 1-10, 1-100x2, 1,5,10-20 (default: all)");
+    sub->add_option(
+        "-o,--output", args->output,
+        "output pattern, e.g. out/morph.####.vdb (default: the scene's output with .vdb)");
+    sub->add_option(
+        "--mesh", args->mesh,
+        "also write each in-between's surface, e.g. out/morph.####.ply (PLY with colours, or OBJ)");
     sub->add_flag("--exact", args->exact, "use the exact warp everywhere (the reference; slow)");
     sub->add_option("--sampling", args->sampling, "resampling filter: trilinear or triquadratic")
         ->check(CLI::IsMember({"trilinear", "triquadratic"}));
-    sub->add_option("--memory-limit", args->memoryLimitGiB,
-                    "voxelization and in-between memory limit in GiB (default: half the machine's memory)")
+    sub->add_option(
+           "--memory-limit", args->memoryLimitGiB,
+           "voxelization and in-between memory limit in GiB (default: half the machine's memory)")
         ->check(CLI::PositiveNumber);
     addCacheOptions(sub, args->cache);
     sub->add_flag("-q,--quiet", args->quiet, "print nothing on success");
-    sub->add_flag("-v,--verbose", args->verbose, "print each stage as it starts, with the time since the start (stderr)");
+    sub->add_flag("-v,--verbose", args->verbose,
+                  "print each stage as it starts, with the time since the start (stderr)");
     return {sub, [args] { return runMorph(*args); }};
 }
 

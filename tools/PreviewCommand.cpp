@@ -29,13 +29,15 @@ constexpr render::Color kBackground{0.02f, 0.02f, 0.025f};
 struct PreviewArgs {
     std::string scene, output, frames, from;
     std::optional<int> frame;
-    bool contactSheet = false, sides = false, noFeatures = false, features = false, quiet = false, verbose = false;
+    bool contactSheet = false, sides = false, noFeatures = false, features = false, quiet = false,
+         verbose = false;
     int width = 0, columns = 6, tileWidth = 240, threads = 0;
     std::optional<int> samples;
     CacheArgs cache;
 };
 
-void drawElement(render::Image& image, const render::Camera& camera, const Feature& f, const render::Color& color)
+void drawElement(render::Image& image, const render::Camera& camera, const Feature& f,
+                 const render::Color& color)
 {
     for (const auto& [a, b] : f.outline()) render::drawSegment(image, camera, a, b, color);
     render::drawMarker(image, camera, f.origin, color, f.type == FeatureType::Point ? 5 : 2);
@@ -43,7 +45,8 @@ void drawElement(render::Image& image, const render::Camera& camera, const Featu
 
 /// Draws every pair at time t: the interpolated element with its number, and optionally the
 /// source-side and target-side elements. Returns false when the labels could not be drawn.
-bool drawFeatures(render::Image& image, const render::Camera& camera, const Scene& scene, double t, bool sides)
+bool drawFeatures(render::Image& image, const render::Camera& camera, const Scene& scene, double t,
+                  bool sides)
 {
     bool labels = true;
     for (size_t i = 0; i < scene.pairs.size(); ++i) {
@@ -57,12 +60,14 @@ bool drawFeatures(render::Image& image, const render::Camera& camera, const Scen
         const Feature now = interpolate(source, target, t);
         drawElement(image, camera, now, kInterpolated);
         if (const auto q = render::project(camera, now.origin); q && labels)
-            labels = render::drawText(image, int((*q)[0]) + 7, int((*q)[1]) - 7, std::to_string(i + 1), kInterpolated, 16);
+            labels = render::drawText(image, int((*q)[0]) + 7, int((*q)[1]) - 7,
+                                      std::to_string(i + 1), kInterpolated, 16);
     }
     return labels;
 }
 
-void writeImage(const render::Image& image, const std::string& path, const render::Camera& camera, int frame)
+void writeImage(const render::Image& image, const std::string& path, const render::Camera& camera,
+                int frame)
 {
     const std::filesystem::path file(path);
     if (file.has_parent_path()) std::filesystem::create_directories(file.parent_path());
@@ -75,7 +80,8 @@ void writeImage(const render::Image& image, const std::string& path, const rende
             render::writePng(image, file);
         }
     } catch (const std::exception& e) {
-        throw UserError(SourceLocation{path}, std::string("cannot write the preview (") + e.what() + ")");
+        throw UserError(SourceLocation{path},
+                        std::string("cannot write the preview (") + e.what() + ")");
     }
 }
 
@@ -86,8 +92,9 @@ render::Image readFrame(const std::string& pattern, int frame)
     try {
         return render::readImage(file);
     } catch (const std::exception& e) {
-        throw UserError(SourceLocation{file.string()}, std::string("cannot read frame ") + std::to_string(frame) + " (" +
-                                                           e.what() + "); render it first with volmorph render");
+        throw UserError(SourceLocation{file.string()},
+                        std::string("cannot read frame ") + std::to_string(frame) + " (" +
+                            e.what() + "); render it first with volmorph render");
     }
 }
 
@@ -97,8 +104,10 @@ int runPreview(const PreviewArgs& args)
     if (args.contactSheet == args.frame.has_value())
         throw UserError(SourceLocation{"preview"}, "give either --frame N or --contact-sheet");
     std::vector<int> frames;
-    if (args.frame) frames = selectFrames(scene.frames, std::to_string(*args.frame));
-    else frames = selectFrames(scene.frames, args.frames);
+    if (args.frame)
+        frames = selectFrames(scene.frames, std::to_string(*args.frame));
+    else
+        frames = selectFrames(scene.frames, args.frames);
     const bool drawPairs = args.contactSheet ? args.features : !args.noFeatures;
     const int width = args.contactSheet ? args.tileWidth : args.width;
 
@@ -109,7 +118,8 @@ int runPreview(const PreviewArgs& args)
     SceneRender view(scene, args.threads, width);
     view.settings.interrupter = &interrupter;
     if (args.samples) view.settings.samples = *args.samples;
-    if (args.from.empty()) morph.emplace(scene, args.cache, interrupter, MorphOptions{}, args.quiet);
+    if (args.from.empty())
+        morph.emplace(scene, args.cache, interrupter, MorphOptions{}, args.quiet);
     else if (const std::string why = checkFramePattern(args.from); !why.empty())
         throw UserError(SourceLocation{"--from"}, "\"" + args.from + "\": " + why);
 
@@ -118,11 +128,14 @@ int runPreview(const PreviewArgs& args)
     bool labelsDrawn = true;
     FrameLoop loop(scene, frames, 1, args.quiet, false, interrupter);
     loop.run([&](const FrameStep& step) {
-        render::Image image = morph ? view.renderFrame(morph->frame(step.frame), step.frame) : readFrame(args.from, step.frame);
+        render::Image image = morph ? view.renderFrame(morph->frame(step.frame), step.frame)
+                                    : readFrame(args.from, step.frame);
         if (drawPairs) {
             // Features are drawn at the image's own size (a frame read from disk keeps its size).
             const SceneRender atSize(scene, 0, image.width);
-            labelsDrawn = drawFeatures(image, atSize.camera(step.frame), scene, step.t, args.sides) && labelsDrawn;
+            labelsDrawn =
+                drawFeatures(image, atSize.camera(step.frame), scene, step.t, args.sides) &&
+                labelsDrawn;
         }
         char label[64];
         std::snprintf(label, sizeof label, "frame %d  t=%.3f", step.frame, step.t);
@@ -131,16 +144,21 @@ int runPreview(const PreviewArgs& args)
         return FrameResult{};
     });
     if (!labelsDrawn)
-        std::fprintf(stderr, "volmorph: warning: no font (DejaVu Sans, Debian package fonts-dejavu-core); "
-                             "pair numbers are not drawn\n");
+        std::fprintf(stderr,
+                     "volmorph: warning: no font (DejaVu Sans, Debian package fonts-dejavu-core); "
+                     "pair numbers are not drawn\n");
 
     if (args.contactSheet) {
-        const render::Image sheet = render::contactSheet(images, labels, args.columns, args.tileWidth, kBackground);
+        const render::Image sheet =
+            render::contactSheet(images, labels, args.columns, args.tileWidth, kBackground);
         writeImage(sheet, args.output, view.camera(frames.front()), frames.front());
     } else {
-        writeImage(render::overBackground(images.front(), kBackground), args.output, view.camera(frames.front()), frames.front());
+        writeImage(render::overBackground(images.front(), kBackground), args.output,
+                   view.camera(frames.front()), frames.front());
     }
-    if (!args.quiet) std::printf("wrote %s (%zu frame%s)\n", args.output.c_str(), frames.size(), frames.size() == 1 ? "" : "s");
+    if (!args.quiet)
+        std::printf("wrote %s (%zu frame%s)\n", args.output.c_str(), frames.size(),
+                    frames.size() == 1 ? "" : "s");
     return 0;
 }
 
@@ -150,26 +168,34 @@ Command addPreviewCommand(CLI::App& app)
 {
     auto a = std::make_shared<PreviewArgs>();
     CLI::App* sub = app.add_subcommand(
-        "preview", "A frame with the feature pairs drawn on it (PNG), or a contact sheet of frames");
+        "preview",
+        "A frame with the feature pairs drawn on it (PNG), or a contact sheet of frames");
     sub->add_option("SCENE", a->scene, "scene file (TOML)")->required();
-    sub->add_option("-o,--output", a->output, "output image (.png: sRGB 8-bit; .exr: linear)")->required();
+    sub->add_option("-o,--output", a->output, "output image (.png: sRGB 8-bit; .exr: linear)")
+        ->required();
     sub->add_option("--frame", a->frame, "the frame to show, with its features");
     sub->add_flag("--contact-sheet", a->contactSheet, "a grid of frames instead of one");
     sub->add_option("--frames", a->frames, "contact sheet frames, e.g. 1-48x4 (default: all)");
-    sub->add_option("--columns", a->columns, "contact sheet columns (default 6)")->check(CLI::Range(1, 64));
-    sub->add_option("--tile-width", a->tileWidth, "contact sheet tile width in pixels (default 240)")
+    sub->add_option("--columns", a->columns, "contact sheet columns (default 6)")
+        ->check(CLI::Range(1, 64));
+    sub->add_option("--tile-width", a->tileWidth,
+                    "contact sheet tile width in pixels (default 240)")
         ->check(CLI::Range(16, 4096));
-    sub->add_option("--from", a->from, "read the frames from these EXRs (e.g. out/f.####.exr) instead of rendering");
-    sub->add_flag("--sides", a->sides, "also draw the source-side (blue) and target-side (pink) elements");
+    sub->add_option("--from", a->from,
+                    "read the frames from these EXRs (e.g. out/f.####.exr) instead of rendering");
+    sub->add_flag("--sides", a->sides,
+                  "also draw the source-side (blue) and target-side (pink) elements");
     sub->add_flag("--no-features", a->noFeatures, "--frame: the frame alone");
     sub->add_flag("--features", a->features, "--contact-sheet: draw the features on every tile");
     sub->add_option("--width", a->width, "--frame: image width in pixels (default: the scene's)")
         ->check(CLI::Range(16, 16384));
-    sub->add_option("--samples", a->samples, "samples per pixel (default: the scene's)")->check(CLI::Range(1, 4096));
+    sub->add_option("--samples", a->samples, "samples per pixel (default: the scene's)")
+        ->check(CLI::Range(1, 4096));
     sub->add_option("--threads", a->threads, "threads (0 = all cores)")->check(CLI::Range(0, 1024));
     addCacheOptions(sub, a->cache);
     sub->add_flag("-q,--quiet", a->quiet, "print nothing on success");
-    sub->add_flag("-v,--verbose", a->verbose, "print each stage as it starts, with the time since the start (stderr)");
+    sub->add_flag("-v,--verbose", a->verbose,
+                  "print each stage as it starts, with the time since the start (stderr)");
     return {sub, [a] { return runPreview(*a); }};
 }
 

@@ -25,7 +25,10 @@
 namespace volmorph::cli {
 namespace {
 
-Vec3d vec3(const std::vector<double>& v) { return Vec3d(v[0], v[1], v[2]); }
+Vec3d vec3(const std::vector<double>& v)
+{
+    return Vec3d(v[0], v[1], v[2]);
+}
 
 struct RenderVdbArgs {
     std::string input, output, png, camera = "persp", grid, resolution = "640x360";
@@ -41,9 +44,10 @@ void parseResolution(const std::string& text, int& width, int& height)
 {
     char x = 0;
     std::istringstream in(text);
-    if (!(in >> width >> x >> height) || x != 'x' || width < 1 || height < 1 || width > 16384 || height > 16384 ||
-        !in.eof())
-        throw UserError(SourceLocation{"--res"}, "expected WIDTHxHEIGHT in pixels (e.g. 640x360), got \"" + text + "\"");
+    if (!(in >> width >> x >> height) || x != 'x' || width < 1 || height < 1 || width > 16384 ||
+        height > 16384 || !in.eof())
+        throw UserError(SourceLocation{"--res"},
+                        "expected WIDTHxHEIGHT in pixels (e.g. 640x360), got \"" + text + "\"");
 }
 
 struct InputGrids {
@@ -63,39 +67,49 @@ InputGrids readInputGrids(const RenderVdbArgs& args)
         std::string densityName, colorName;
         for (auto it = file.beginName(); it != file.endName(); ++it) {
             const openvdb::GridBase::Ptr g = file.readGridMetadata(it.gridName());
-            if (colorName.empty() && g->getName() == "Cd" && g->isType<openvdb::Vec3SGrid>()) colorName = it.gridName();
+            if (colorName.empty() && g->getName() == "Cd" && g->isType<openvdb::Vec3SGrid>())
+                colorName = it.gridName();
             if (!densityName.empty()) continue;
             if (!args.grid.empty() ? g->getName() == args.grid : g->isType<openvdb::FloatGrid>()) {
                 if (!g->isType<openvdb::FloatGrid>())
-                    throw UserError(SourceLocation{args.input}, "grid \"" + args.grid + "\" is not a float grid");
+                    throw UserError(SourceLocation{args.input},
+                                    "grid \"" + args.grid + "\" is not a float grid");
                 densityName = it.gridName();
             }
         }
-        if (!densityName.empty()) grids.density = openvdb::gridPtrCast<openvdb::FloatGrid>(file.readGrid(densityName));
-        if (!colorName.empty()) grids.color = openvdb::gridPtrCast<openvdb::Vec3SGrid>(file.readGrid(colorName));
+        if (!densityName.empty())
+            grids.density = openvdb::gridPtrCast<openvdb::FloatGrid>(file.readGrid(densityName));
+        if (!colorName.empty())
+            grids.color = openvdb::gridPtrCast<openvdb::Vec3SGrid>(file.readGrid(colorName));
         file.close();
     } catch (const openvdb::Exception& e) {
-        throw UserError(SourceLocation{args.input}, std::string("cannot read volume file (") + e.what() + ")");
+        throw UserError(SourceLocation{args.input},
+                        std::string("cannot read volume file (") + e.what() + ")");
     }
     if (!grids.density)
-        throw UserError(SourceLocation{args.input},
-                        args.grid.empty() ? "no float grid to render" : "no grid named \"" + args.grid + "\"");
+        throw UserError(SourceLocation{args.input}, args.grid.empty()
+                                                        ? "no float grid to render"
+                                                        : "no grid named \"" + args.grid + "\"");
     return grids;
 }
 
 /// The flags' camera; by default in front of the grid's active bounds, looking at their centre.
-render::Camera vdbCamera(const RenderVdbArgs& args, const openvdb::FloatGrid& density, int width, int height)
+render::Camera vdbCamera(const RenderVdbArgs& args, const openvdb::FloatGrid& density, int width,
+                         int height)
 {
     openvdb::CoordBBox box = density.evalActiveVoxelBoundingBox();
-    const Vec3d lo = density.indexToWorld(box.min().asVec3d()), hi = density.indexToWorld(box.max().asVec3d());
+    const Vec3d lo = density.indexToWorld(box.min().asVec3d()),
+                hi = density.indexToWorld(box.max().asVec3d());
     const Vec3d centre = 0.5 * (lo + hi);
     const double extent = (hi - lo).length();
     const Vec3d lookat = args.lookat.empty() ? centre : vec3(args.lookat);
-    const Vec3d eye = args.translate.empty() ? centre + Vec3d(0, 0, 1.6 * extent) : vec3(args.translate);
+    const Vec3d eye =
+        args.translate.empty() ? centre + Vec3d(0, 0, 1.6 * extent) : vec3(args.translate);
     const bool ortho = args.camera == "ortho";
-    return render::Camera(ortho ? render::Camera::Projection::Orthographic : render::Camera::Projection::Perspective,
-                          eye, lookat, vec3(args.up), args.fov, args.frameWidth > 0 ? args.frameWidth : extent, width,
-                          height);
+    return render::Camera(ortho ? render::Camera::Projection::Orthographic
+                                : render::Camera::Projection::Perspective,
+                          eye, lookat, vec3(args.up), args.fov,
+                          args.frameWidth > 0 ? args.frameWidth : extent, width, height);
 }
 
 int runRenderVdb(const RenderVdbArgs& args)
@@ -121,7 +135,8 @@ int runRenderVdb(const RenderVdbArgs& args)
     settings.threads = args.threads;
     settings.interrupter = &interrupter;
     const auto start = std::chrono::steady_clock::now();
-    const render::Image image = render::renderVolume(*grids.density, grids.color.get(), camera, {light}, medium, settings);
+    const render::Image image =
+        render::renderVolume(*grids.density, grids.color.get(), camera, {light}, medium, settings);
     const double seconds = secondsSince(start);
     render::ExrOptions exr;
     exr.halfFloat = !args.floatExr;
@@ -132,10 +147,12 @@ int runRenderVdb(const RenderVdbArgs& args)
         render::writeExr(image, camera, args.output, exr);
         if (!args.png.empty()) render::writePng(image, args.png);
     } catch (const std::runtime_error& e) {
-        throw UserError(SourceLocation{args.output}, std::string("cannot write image (") + e.what() + ")");
+        throw UserError(SourceLocation{args.output},
+                        std::string("cannot write image (") + e.what() + ")");
     }
-    std::printf("rendered %s (%dx%d, %d samples) in %.2f s -> %s\n", grids.density->getName().c_str(), width, height,
-                args.samples, seconds, args.output.c_str());
+    std::printf("rendered %s (%dx%d, %d samples) in %.2f s -> %s\n",
+                grids.density->getName().c_str(), width, height, args.samples, seconds,
+                args.output.c_str());
     return 0;
 }
 
@@ -161,8 +178,9 @@ bool completeImage(const std::filesystem::path& path)
 }
 
 /// Writes frame `frame`'s image, or returns why it could not.
-std::string writeFrameImage(const render::Image& image, const SceneRender& renderer, const std::filesystem::path& file,
-                            const RenderSceneArgs& args, const Scene& scene, const FrameStep& step, double seconds)
+std::string writeFrameImage(const render::Image& image, const SceneRender& renderer,
+                            const std::filesystem::path& file, const RenderSceneArgs& args,
+                            const Scene& scene, const FrameStep& step, double seconds)
 {
     render::ExrOptions exr;
     exr.frame = step.frame;
@@ -174,7 +192,8 @@ std::string writeFrameImage(const render::Image& image, const SceneRender& rende
         if (file.has_parent_path()) std::filesystem::create_directories(file.parent_path());
         render::writeExr(image, renderer.camera(step.frame), file, exr);
     } catch (const std::exception& e) {
-        return file.string() + ": cannot write frame " + std::to_string(step.frame) + " (" + e.what() + ")";
+        return file.string() + ": cannot write frame " + std::to_string(step.frame) + " (" +
+               e.what() + ")";
     }
     return "";
 }
@@ -183,7 +202,8 @@ int runRenderScene(const RenderSceneArgs& args)
 {
     const Scene scene = loadScene(args.scene);
     const std::vector<int> frames = selectFrames(scene.frames, args.frames);
-    const std::string pattern = args.output.empty() ? (scene.folder / scene.frames.output).string() : args.output;
+    const std::string pattern =
+        args.output.empty() ? (scene.folder / scene.frames.output).string() : args.output;
     if (const std::string why = checkFramePattern(pattern); !why.empty())
         throw UserError(SourceLocation{"-o"}, "\"" + pattern + "\": " + why);
 
@@ -202,12 +222,15 @@ int runRenderScene(const RenderSceneArgs& args)
         const std::filesystem::path file = frameFileName(pattern, step.frame);
         if (args.skipExisting && completeImage(file))
             return FrameResult{FrameResult::Outcome::Skipped,
-                               "frame " + std::to_string(step.frame) + ": " + file.string() + " exists, skipped", ""};
+                               "frame " + std::to_string(step.frame) + ": " + file.string() +
+                                   " exists, skipped",
+                               ""};
         const auto start = std::chrono::steady_clock::now();
         const VolumeSet v = morph.frame(step.frame);
         step.progress(1);
         const render::Image image = renderer.renderFrame(v, step.frame);
-        const std::string error = writeFrameImage(image, renderer, file, args, scene, step, secondsSince(start));
+        const std::string error =
+            writeFrameImage(image, renderer, file, args, scene, step, secondsSince(start));
         if (!error.empty()) return FrameResult{FrameResult::Outcome::Failed, error, ""};
         return FrameResult{FrameResult::Outcome::Done, "", file.string()};
     });
@@ -219,52 +242,76 @@ int runRenderScene(const RenderSceneArgs& args)
 Command addRenderVdbCommand(CLI::App& app)
 {
     auto a = std::make_shared<RenderVdbArgs>();
-    CLI::App* sub = app.add_subcommand("render-vdb", "Render a float grid of a .vdb file to OpenEXR (like vdb_render)");
+    CLI::App* sub = app.add_subcommand(
+        "render-vdb", "Render a float grid of a .vdb file to OpenEXR (like vdb_render)");
     sub->add_option("IN", a->input, "input .vdb")->required();
     sub->add_option("-o,--output", a->output, "output .exr")->required();
     sub->add_option("--png", a->png, "also write an sRGB PNG preview");
-    sub->add_option("--camera", a->camera, "persp or ortho")->check(CLI::IsMember({"persp", "ortho"}));
-    sub->add_option("--translate", a->translate, "camera position X,Y,Z (world units)")->delimiter(',')->expected(3);
-    sub->add_option("--lookat", a->lookat, "point the camera looks at X,Y,Z")->delimiter(',')->expected(3);
+    sub->add_option("--camera", a->camera, "persp or ortho")
+        ->check(CLI::IsMember({"persp", "ortho"}));
+    sub->add_option("--translate", a->translate, "camera position X,Y,Z (world units)")
+        ->delimiter(',')
+        ->expected(3);
+    sub->add_option("--lookat", a->lookat, "point the camera looks at X,Y,Z")
+        ->delimiter(',')
+        ->expected(3);
     sub->add_option("--up", a->up, "camera up vector X,Y,Z")->delimiter(',')->expected(3);
-    sub->add_option("--fov", a->fov, "horizontal field of view, degrees (perspective)")->check(CLI::Range(0.01, 179.0));
-    sub->add_option("--frame", a->frameWidth, "orthographic frame width, world units")->check(CLI::PositiveNumber);
+    sub->add_option("--fov", a->fov, "horizontal field of view, degrees (perspective)")
+        ->check(CLI::Range(0.01, 179.0));
+    sub->add_option("--frame", a->frameWidth, "orthographic frame width, world units")
+        ->check(CLI::PositiveNumber);
     sub->add_option("--res", a->resolution, "image size WIDTHxHEIGHT");
-    sub->add_option("--extinction", a->extinction, "extinction per world unit at density 1")->check(CLI::NonNegativeNumber);
+    sub->add_option("--extinction", a->extinction, "extinction per world unit at density 1")
+        ->check(CLI::NonNegativeNumber);
     sub->add_option("--albedo", a->albedo, "scattering albedo 0..1")->check(CLI::Range(0.0, 1.0));
-    sub->add_option("--emission", a->emission, "emitted radiance per unit optical depth R,G,B (linear, >= 0)")
-        ->delimiter(',')->expected(3)->check(CLI::NonNegativeNumber);
-    sub->add_option("--light", a->light, "direction toward the light X,Y,Z[,R,G,B] (as vdb_render)")->delimiter(',')
+    sub->add_option("--emission", a->emission,
+                    "emitted radiance per unit optical depth R,G,B (linear, >= 0)")
+        ->delimiter(',')
+        ->expected(3)
+        ->check(CLI::NonNegativeNumber);
+    sub->add_option("--light", a->light, "direction toward the light X,Y,Z[,R,G,B] (as vdb_render)")
+        ->delimiter(',')
         ->expected(3, 6);
     sub->add_option("--samples", a->samples, "samples per pixel")->check(CLI::Range(1, 65536));
-    sub->add_option("--step", a->step, "longest step of the scattering integral, in voxels (optical depth is exact)")->check(CLI::Range(0.01, 8.0));
-    sub->add_option("--shadow-cache", a->shadowCache, "shadow map (directional) or grid (point light) spacing, in voxels")
+    sub->add_option("--step", a->step,
+                    "longest step of the scattering integral, in voxels (optical depth is exact)")
+        ->check(CLI::Range(0.01, 8.0));
+    sub->add_option("--shadow-cache", a->shadowCache,
+                    "shadow map (directional) or grid (point light) spacing, in voxels")
         ->check(CLI::Range(1, 16));
     sub->add_option("--threads", a->threads, "threads (0 = all cores)")->check(CLI::Range(0, 1024));
     sub->add_option("--grid", a->grid, "name of the float grid (default: the first)");
-    sub->add_option("--memory-limit", a->memoryLimitGiB, "refuse a film above this, in GiB (default: half the machine's memory)")
+    sub->add_option("--memory-limit", a->memoryLimitGiB,
+                    "refuse a film above this, in GiB (default: half the machine's memory)")
         ->check(CLI::PositiveNumber);
     sub->add_flag("--float", a->floatExr, "float EXR instead of half");
-    sub->add_flag("-v,--verbose", a->verbose, "print each stage as it starts, with the time since the start (stderr)");
+    sub->add_flag("-v,--verbose", a->verbose,
+                  "print each stage as it starts, with the time since the start (stderr)");
     return {sub, [a] { return runRenderVdb(*a); }};
 }
 
 Command addRenderCommand(CLI::App& app)
 {
     auto a = std::make_shared<RenderSceneArgs>();
-    CLI::App* sub = app.add_subcommand("render", "Render the scene's morph to one OpenEXR per frame");
+    CLI::App* sub =
+        app.add_subcommand("render", "Render the scene's morph to one OpenEXR per frame");
     sub->add_option("SCENE", a->scene, "scene file (TOML)")->required();
-    sub->add_option("--frames", a->frames, "frames to render, e.g. 1-10, 1-100x2, 1,5,10-20 (default: all)");
-    sub->add_option("-o,--output", a->output, "output pattern, e.g. out/f.####.exr (default: the scene's)");
+    sub->add_option("--frames", a->frames,
+                    "frames to render, e.g. 1-10, 1-100x2, 1,5,10-20 (default: all)");
+    sub->add_option("-o,--output", a->output,
+                    "output pattern, e.g. out/f.####.exr (default: the scene's)");
     sub->add_option("--threads", a->threads, "threads (0 = all cores)")->check(CLI::Range(0, 1024));
-    sub->add_flag("--skip-existing", a->skipExisting, "skip frames whose file exists and reads back whole");
+    sub->add_flag("--skip-existing", a->skipExisting,
+                  "skip frames whose file exists and reads back whole");
     sub->add_option("--memory-limit", a->memoryLimitGiB,
-                    "voxels, in-betweens and film above this estimate are refused, in GiB (default: half the "
+                    "voxels, in-betweens and film above this estimate are refused, in GiB "
+                    "(default: half the "
                     "machine's memory)")
         ->check(CLI::PositiveNumber);
     addCacheOptions(sub, a->cache);
     sub->add_flag("-q,--quiet", a->quiet, "print nothing on success");
-    sub->add_flag("-v,--verbose", a->verbose, "print each stage as it starts, with the time since the start (stderr)");
+    sub->add_flag("-v,--verbose", a->verbose,
+                  "print each stage as it starts, with the time since the start (stderr)");
     return {sub, [a] { return runRenderScene(*a); }};
 }
 

@@ -8,9 +8,10 @@ SceneMorph::SceneMorph(const Scene& scene, const CacheArgs& cache, Interrupter& 
                        const MorphOptions& options, bool quiet)
     : mScene(scene), mInterrupter(interrupter)
 {
-    SceneVolumes volumes = loadSceneVolumes(scene, cache, interrupter, options.memoryLimitBytes, quiet);
-    mMorpher.emplace(std::move(volumes.source), std::move(volumes.target), scene.pairs, scene.warp, scene.blend,
-                     options);
+    SceneVolumes volumes =
+        loadSceneVolumes(scene, cache, interrupter, options.memoryLimitBytes, quiet);
+    mMorpher.emplace(std::move(volumes.source), std::move(volumes.target), scene.pairs, scene.warp,
+                     scene.blend, options);
 }
 
 VolumeSet SceneMorph::frame(int frame, MorphStats* stats) const

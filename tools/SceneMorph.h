@@ -13,8 +13,8 @@ namespace volmorph::cli {
 class SceneMorph {
 public:
     /// Voxelizes (or reads from the cache) the scene's source and target, and builds the Morpher.
-    SceneMorph(const Scene& scene, const CacheArgs& cache, Interrupter& interrupter, const MorphOptions& options,
-               bool quiet);
+    SceneMorph(const Scene& scene, const CacheArgs& cache, Interrupter& interrupter,
+               const MorphOptions& options, bool quiet);
 
     /// The in-between of frame `frame` (at its t in the scene's range). Throws Interrupted when the
     /// interrupter asked to stop during it.

@@ -10,15 +10,18 @@ namespace {
 render::Camera sceneCamera(const CameraSpec& c, const RenderSpec& r, int width)
 {
     const int w = width > 0 ? width : r.width;
-    const int h = width > 0 ? std::max(1, int(std::lround(double(r.height) * w / r.width))) : r.height;
-    return render::Camera(c.projection == Projection::Orthographic ? render::Camera::Projection::Orthographic
-                                                                   : render::Camera::Projection::Perspective,
+    const int h =
+        width > 0 ? std::max(1, int(std::lround(double(r.height) * w / r.width))) : r.height;
+    return render::Camera(c.projection == Projection::Orthographic
+                              ? render::Camera::Projection::Orthographic
+                              : render::Camera::Projection::Perspective,
                           c.eye, c.lookat, c.up, c.fovDegrees, c.orthoWidth, w, h);
 }
 
 } // namespace
 
-SceneRender::SceneRender(const Scene& scene, int threads, int width) : mSpec(scene.render), mWidth(width)
+SceneRender::SceneRender(const Scene& scene, int threads, int width)
+    : mSpec(scene.render), mWidth(width)
 {
     const RenderSpec& r = scene.render;
     medium.extinction = r.extinction;
@@ -31,7 +34,10 @@ SceneRender::SceneRender(const Scene& scene, int threads, int width) : mSpec(sce
     settings.threads = threads;
 }
 
-render::Camera SceneRender::camera(int frame) const { return sceneCamera(mSpec.camera.at(frame), mSpec, mWidth); }
+render::Camera SceneRender::camera(int frame) const
+{
+    return sceneCamera(mSpec.camera.at(frame), mSpec, mWidth);
+}
 
 std::vector<render::Light> SceneRender::lights(int frame) const
 {
@@ -39,7 +45,8 @@ std::vector<render::Light> SceneRender::lights(int frame) const
     for (const LightSpec& spec : mSpec.lights) {
         const LightSpec l = spec.at(frame);
         render::Light light;
-        light.type = l.type == LightType::Point ? render::Light::Type::Point : render::Light::Type::Directional;
+        light.type = l.type == LightType::Point ? render::Light::Type::Point
+                                                : render::Light::Type::Directional;
         light.direction = l.direction;
         light.position = l.position;
         light.color = l.color;
@@ -53,7 +60,8 @@ render::Image SceneRender::renderFrame(const VolumeSet& volumes, int frame) cons
 {
     render::RenderSettings s = settings;
     s.frame = frame;
-    return render::renderVolume(*volumes.density, volumes.color.get(), camera(frame), lights(frame), medium, s);
+    return render::renderVolume(*volumes.density, volumes.color.get(), camera(frame), lights(frame),
+                                medium, s);
 }
 
 } // namespace volmorph::cli

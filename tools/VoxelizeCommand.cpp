@@ -48,7 +48,8 @@ int runVoxelize(const VoxelizeArgs& args)
     VoxelizeStats stats;
     const auto start = std::chrono::steady_clock::now();
     const VolumeSet volumes = voxelize(mesh, options, &interrupter, &stats);
-    const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    const double seconds =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     if (interrupter.stopRequested()) throw Interrupted();
     std::ostringstream voxel;
     voxel << stats.voxelSize;
@@ -61,10 +62,11 @@ int runVoxelize(const VoxelizeArgs& args)
         std::printf("%s: %zu triangles, %s\n", args.mesh.c_str(), mesh.triangles.size(),
                     describeTopology(mesh.report).c_str());
         std::printf("voxel size %s world units; inside/outside by %s\n", voxel.str().c_str(),
-                    stats.usedWindingNumber ? "winding number" : "flood fill (watertight, one shell)");
+                    stats.usedWindingNumber ? "winding number"
+                                            : "flood fill (watertight, one shell)");
         std::printf("sdf %llu active voxels, density %llu active voxels, %.2f s\n",
-                    (unsigned long long)stats.sdfActiveVoxels, (unsigned long long)stats.densityActiveVoxels,
-                    seconds);
+                    (unsigned long long)stats.sdfActiveVoxels,
+                    (unsigned long long)stats.densityActiveVoxels, seconds);
         std::printf("wrote %s (grids sdf, density, Cd)\n", args.output.c_str());
     }
     return 0;
@@ -81,10 +83,12 @@ int runCache(const CacheCommandArgs& args)
 {
     const Scene scene = loadScene(args.scene);
     if (args.cache.resolve().empty())
-        throw UserError(SourceLocation{"--cache"}, "no cache folder: give --cache DIR or set VOLMORPH_CACHE");
+        throw UserError(SourceLocation{"--cache"},
+                        "no cache folder: give --cache DIR or set VOLMORPH_CACHE");
     Interrupter interrupter(false);
     StopSignals signals(interrupter);
-    loadSceneVolumes(scene, args.cache, interrupter, memoryLimitBytes(args.memoryLimitGiB), args.quiet);
+    loadSceneVolumes(scene, args.cache, interrupter, memoryLimitBytes(args.memoryLimitGiB),
+                     args.quiet);
     return 0;
 }
 
@@ -93,12 +97,14 @@ int runCache(const CacheCommandArgs& args)
 Command addCacheCommand(CLI::App& app)
 {
     auto a = std::make_shared<CacheCommandArgs>();
-    CLI::App* sub = app.add_subcommand(
-        "cache", "Voxelize a scene's source and target into the voxel cache (once, before a farm job's chunks)");
+    CLI::App* sub = app.add_subcommand("cache", "Voxelize a scene's source and target into the "
+                                                "voxel cache (once, before a farm job's chunks)");
     sub->add_option("SCENE", a->scene, "scene file (TOML)")->required();
     sub->add_option("--cache", a->cache.folder,
-                    "voxel cache folder (default: $VOLMORPH_CACHE, else $XDG_CACHE_HOME/volmorph, else ~/.cache/volmorph)");
-    sub->add_option("--memory-limit", a->memoryLimitGiB, "voxelization memory limit in GiB")->check(CLI::PositiveNumber);
+                    "voxel cache folder (default: $VOLMORPH_CACHE, else $XDG_CACHE_HOME/volmorph, "
+                    "else ~/.cache/volmorph)");
+    sub->add_option("--memory-limit", a->memoryLimitGiB, "voxelization memory limit in GiB")
+        ->check(CLI::PositiveNumber);
     sub->add_flag("-q,--quiet", a->quiet, "print nothing on success");
     return {sub, [a] { return runCache(*a); }};
 }
@@ -106,21 +112,28 @@ Command addCacheCommand(CLI::App& app)
 Command addVoxelizeCommand(CLI::App& app)
 {
     auto vox = std::make_shared<VoxelizeArgs>();
-    CLI::App* voxelizeCmd = app.add_subcommand("voxelize", "Voxelize a mesh into sdf, density and Cd grids");
-    voxelizeCmd->add_option("MESH", vox->mesh, "mesh file (OBJ, PLY, STL, OFF, glTF, ...)")->required();
+    CLI::App* voxelizeCmd =
+        app.add_subcommand("voxelize", "Voxelize a mesh into sdf, density and Cd grids");
+    voxelizeCmd->add_option("MESH", vox->mesh, "mesh file (OBJ, PLY, STL, OFF, glTF, ...)")
+        ->required();
     voxelizeCmd->add_option("-o,--output", vox->output, "output .vdb file")->required();
-    auto* sizeOpt = voxelizeCmd->add_option("--voxel-size", vox->voxelSize, "voxel edge in world units")
-                        ->check(CLI::PositiveNumber);
-    voxelizeCmd->add_option("--resolution", vox->resolution, "voxels across the longest side (default 128)")
+    auto* sizeOpt =
+        voxelizeCmd->add_option("--voxel-size", vox->voxelSize, "voxel edge in world units")
+            ->check(CLI::PositiveNumber);
+    voxelizeCmd
+        ->add_option("--resolution", vox->resolution,
+                     "voxels across the longest side (default 128)")
         ->check(CLI::Range(8, 16384))
         ->excludes(sizeOpt);
-    voxelizeCmd->add_option("--half-width", vox->halfWidth, "narrow band half width in voxels (>= 3)")
+    voxelizeCmd
+        ->add_option("--half-width", vox->halfWidth, "narrow band half width in voxels (>= 3)")
         ->check(CLI::Range(3.0f, 64.0f));
     voxelizeCmd->add_option("--color", vox->color, "constant linear RGB colour R,G,B")
         ->delimiter(',')
         ->expected(3);
-    voxelizeCmd->add_option("--memory-limit", vox->memoryLimitGiB,
-                            "refuse above this estimate, in GiB (default: half the machine's memory)")
+    voxelizeCmd
+        ->add_option("--memory-limit", vox->memoryLimitGiB,
+                     "refuse above this estimate, in GiB (default: half the machine's memory)")
         ->check(CLI::PositiveNumber);
     voxelizeCmd->add_option("--sign", vox->sign, "inside/outside: auto, floodfill or winding")
         ->check(CLI::IsMember({"auto", "floodfill", "winding"}));

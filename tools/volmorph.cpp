@@ -13,10 +13,10 @@ int main(int argc, char** argv)
     CLI::App app{"volmorph: feature-based volumetric morphing of meshes through OpenVDB grids"};
     app.set_version_flag("--version", std::string("volmorph ") + volmorph::versionString());
     app.require_subcommand(1);
-    const std::vector<Command> commands = {addCheckCommand(app), addVoxelizeCommand(app), addMorphCommand(app),
-                                          addRenderVdbCommand(app), addRenderCommand(app),
-                                          addDiffCommand(app), addCacheCommand(app),
-                                          addPreviewCommand(app), addFramesCommand(app)};
+    const std::vector<Command> commands = {
+        addCheckCommand(app),     addVoxelizeCommand(app), addMorphCommand(app),
+        addRenderVdbCommand(app), addRenderCommand(app),   addDiffCommand(app),
+        addCacheCommand(app),     addPreviewCommand(app),  addFramesCommand(app)};
 
     try {
         app.parse(argc, argv);
@@ -32,7 +32,8 @@ int main(int argc, char** argv)
         std::fprintf(stderr, "volmorph: interrupted; no output written for the current item\n");
         return kExitInterrupted;
     } catch (const volmorph::UserError& e) {
-        for (const volmorph::Diagnostic& d : e.diagnostics()) std::fprintf(stderr, "%s\n", d.str().c_str());
+        for (const volmorph::Diagnostic& d : e.diagnostics())
+            std::fprintf(stderr, "%s\n", d.str().c_str());
         return kExitUserError;
     } catch (const std::bad_alloc&) {
         std::fprintf(stderr, "volmorph: out of memory\n");

@@ -4,15 +4,16 @@
 
 namespace volmorph::render {
 
-Camera::Camera(Projection projection, const Vec3d& eye, const Vec3d& lookat, const Vec3d& up, double fovDegrees,
-               double orthoWidth, int width, int height)
+Camera::Camera(Projection projection, const Vec3d& eye, const Vec3d& lookat, const Vec3d& up,
+               double fovDegrees, double orthoWidth, int width, int height)
     : mProjection(projection), mEye(eye), mWidth(width), mHeight(height)
 {
     mForward = (lookat - eye).unit();
     mRight = mForward.cross(up).unit();
     mUp = mRight.cross(mForward);
     const double aspect = double(height) / double(width);
-    mHalfWidth = projection == Projection::Perspective ? std::tan(0.5 * fovDegrees * M_PI / 180.0) : 0.5 * orthoWidth;
+    mHalfWidth = projection == Projection::Perspective ? std::tan(0.5 * fovDegrees * M_PI / 180.0)
+                                                       : 0.5 * orthoWidth;
     mHalfHeight = mHalfWidth * aspect;
 }
 

@@ -27,7 +27,8 @@ struct Cell {
     float lo, hi;       ///< smallest and largest corner value
     bool block = false; ///< one constant value over a whole block crossing (see walkCells)
 
-    __attribute__((always_inline)) double at(const Vec3d& u) const // u: local coordinates in [0, 1]^3
+    __attribute__((always_inline)) double
+    at(const Vec3d& u) const // u: local coordinates in [0, 1]^3
     {
         const double x = u.x(), y = u.y(), z = u.z();
         const double a = v[0][0][0] + (v[0][0][1] - v[0][0][0]) * z;
@@ -55,9 +56,9 @@ struct Medium1D {
     inline double mass(const Cell& cell, double ta, double tb) const;
 };
 
-/// The density along one piece of a ray inside one cell, as a polynomial in s = t - ta (voxels), for
-/// a fog whose corners are non-negative: the trilinear interpolant restricted to a line is a cubic.
-/// mass(s) is its integral over [0, s]; exact is false for other cells (use Medium1D::mass).
+/// The density along one piece of a ray inside one cell, as a polynomial in s = t - ta (voxels),
+/// for a fog whose corners are non-negative: the trilinear interpolant restricted to a line is a
+/// cubic. mass(s) is its integral over [0, s]; exact is false for other cells (use Medium1D::mass).
 struct Piece {
     bool exact = false;
     double c[4] = {0, 0, 0, 0};
@@ -66,7 +67,8 @@ struct Piece {
     {
         if (ray.levelSet || cell.lo < 0.0f) return;
         exact = true;
-        const Vec3d u = ray.eye + ray.dir * ta - Vec3d(cell.origin.x(), cell.origin.y(), cell.origin.z());
+        const Vec3d u =
+            ray.eye + ray.dir * ta - Vec3d(cell.origin.x(), cell.origin.y(), cell.origin.z());
         const Vec3d& d = ray.dir;
         // Weights of the corners 0 and 1 along each axis, as linear functions w0 + w1 s.
         const double z[2][2] = {{1.0 - u.z(), -d.z()}, {u.z(), d.z()}};
@@ -91,7 +93,10 @@ struct Piece {
         }
     }
 
-    double mass(double s) const { return s * (c[0] + s * (0.5 * c[1] + s * (c[2] * (1.0 / 3.0) + s * 0.25 * c[3]))); }
+    double mass(double s) const
+    {
+        return s * (c[0] + s * (0.5 * c[1] + s * (c[2] * (1.0 / 3.0) + s * 0.25 * c[3])));
+    }
 };
 
 double Medium1D::mass(const Cell& cell, double ta, double tb) const
@@ -103,13 +108,16 @@ double Medium1D::mass(const Cell& cell, double ta, double tb) const
         if (cell.hi <= 0.0f) return 0.0;
         if (cell.lo >= 0.0f) return Piece(*this, cell, ta).mass(length);
         double sum = 0.0;
-        for (int k = 0; k < 4; ++k) sum += std::max(0.0, cell.at(local(ta + (k + 0.5) * 0.25 * length)));
+        for (int k = 0; k < 4; ++k)
+            sum += std::max(0.0, cell.at(local(ta + (k + 0.5) * 0.25 * length)));
         return 0.25 * length * sum;
     }
     if (cell.lo >= 0.0f) return 0.0;
     if (cell.hi < 0.0f) return length;
-    const double f0 = cell.at(local(ta)), f1 = cell.at(local(0.5 * (ta + tb))), f2 = cell.at(local(tb));
-    auto inside = [](double a, double b, double h) { // length of the negative part of a linear piece
+    const double f0 = cell.at(local(ta)), f1 = cell.at(local(0.5 * (ta + tb))),
+                 f2 = cell.at(local(tb));
+    auto inside = [](double a, double b,
+                     double h) { // length of the negative part of a linear piece
         if (a < 0.0 && b < 0.0) return h;
         if (a >= 0.0 && b >= 0.0) return 0.0;
         const double crossing = a / (a - b) * h; // from the start
@@ -123,7 +131,11 @@ double Medium1D::mass(const Cell& cell, double ta, double tb) const
 inline double expNegative(double x)
 {
     constexpr double third = 1.0 / 3.0, sixth = 1.0 / 6.0;
-    if (x < 0.05) return 1.0 - x * (1.0 - x * 0.5 * (1.0 - x * third * (1.0 - x * 0.25 * (1.0 - x * 0.2 * (1.0 - x * sixth)))));
+    if (x < 0.05)
+        return 1.0 -
+               x * (1.0 -
+                    x * 0.5 *
+                        (1.0 - x * third * (1.0 - x * 0.25 * (1.0 - x * 0.2 * (1.0 - x * sixth)))));
     return std::exp(-x);
 }
 

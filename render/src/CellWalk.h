@@ -11,8 +11,8 @@
 
 namespace volmorph::render {
 
-/// Amanatides and Woo's 3D DDA over interpolation cells: the cell the ray is in, and the ray times at
-/// which it crosses the next cell wall along each axis.
+/// Amanatides and Woo's 3D DDA over interpolation cells: the cell the ray is in, and the ray times
+/// at which it crosses the next cell wall along each axis.
 struct CellDda {
     int cell[3], step[3];
     double next[3], delta[3];
@@ -55,7 +55,8 @@ struct CellDda {
 
 /// The ray time (voxels) at which the ray leaves the constant region [b, b + 7]^3 of the 8^3 block
 /// holding `cell`, at most tb.
-__attribute__((always_inline)) inline double blockExit(const Medium1D& ray, const int (&cell)[3], double tb)
+__attribute__((always_inline)) inline double blockExit(const Medium1D& ray, const int (&cell)[3],
+                                                       double tb)
 {
     double exit = tb;
     for (int k = 0; k < 3; ++k) {

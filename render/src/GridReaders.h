@@ -21,8 +21,8 @@ using VdbRay = openvdb::math::Ray<double>;
 /// Empty-space skipping: OpenVDB's hierarchical DDA over rayMask()'s topology.
 using Intersector = openvdb::tools::VolumeRayIntersector<openvdb::BoolGrid>;
 
-/// Where a trilinear sample of `density` can be non-zero: its active voxels and tiles, dilated by one
-/// voxel. (VolumeRayIntersector's own dilation ignores tiles, so a tile on a volume's boundary
+/// Where a trilinear sample of `density` can be non-zero: its active voxels and tiles, dilated by
+/// one voxel. (VolumeRayIntersector's own dilation ignores tiles, so a tile on a volume's boundary
 /// would lose the half voxel of ramp outside it.)
 openvdb::BoolGrid::Ptr rayMask(const openvdb::FloatGrid& density, bool levelSet);
 
@@ -47,8 +47,7 @@ inline Vec3d trilinear(const openvdb::Vec3s (&v)[2][2][2], const Vec3d& u)
 /// loads, also for cells that straddle two, four or eight leaves. A leaf whose 512 values are equal
 /// is left out: readers treat it as a tile of that value (interpolation reads values, never active
 /// states), which walkCells crosses in one piece.
-class PaddedLeaves
-{
+class PaddedLeaves {
 public:
     using Leaf = openvdb::FloatTree::LeafNodeType;
     static constexpr int kSide = Leaf::DIM + 1, kSize = kSide * kSide * kSide;
@@ -92,10 +91,14 @@ struct ColorReader {
         if ((c.x() & 7) != 7 && (c.y() & 7) != 7 && (c.z() & 7) != 7) {
             if (!leaf) return Vec3d(tile.x(), tile.y(), tile.z());
             const openvdb::Vec3s* d = leaf->buffer().data() + Leaf::coordToOffset(c);
-            v[0][0][0] = d[0];   v[0][0][1] = d[1];
-            v[0][1][0] = d[8];   v[0][1][1] = d[9];
-            v[1][0][0] = d[64];  v[1][0][1] = d[65];
-            v[1][1][0] = d[72];  v[1][1][1] = d[73];
+            v[0][0][0] = d[0];
+            v[0][0][1] = d[1];
+            v[0][1][0] = d[8];
+            v[0][1][1] = d[9];
+            v[1][0][0] = d[64];
+            v[1][0][1] = d[65];
+            v[1][1][0] = d[72];
+            v[1][1][1] = d[73];
         } else {
             openvdb::tools::BoxSampler::getValues(v, acc, c);
         }
@@ -122,7 +125,8 @@ struct DensityReader {
 
     const Block& blockAt(const Coord& b) // b: a block origin (multiples of 8)
     {
-        Block& e = cache[((b.x() >> 3) & 3) | (((b.y() >> 3) & 3) << 2) | (((b.z() >> 3) & 3) << 4)];
+        Block& e =
+            cache[((b.x() >> 3) & 3) | (((b.y() >> 3) & 3) << 2) | (((b.z() >> 3) & 3) << 4)];
         if (e.origin != b) {
             e.origin = b;
             const PaddedLeaves::Leaf* leaf = acc.probeConstLeaf(b);
@@ -132,8 +136,8 @@ struct DensityReader {
         return e;
     }
 
-    /// Fills `v` for the cell at `c` and returns true, or returns false (filling nothing, `tile` set)
-    /// if c's block has one value and c lies inside it (not on its +x, +y or +z face layer).
+    /// Fills `v` for the cell at `c` and returns true, or returns false (filling nothing, `tile`
+    /// set) if c's block has one value and c lies inside it (not on its +x, +y or +z face layer).
     bool cell(const Coord& c, float (&v)[2][2][2])
     {
         const Coord b(c.x() & ~7, c.y() & ~7, c.z() & ~7);
@@ -141,10 +145,14 @@ struct DensityReader {
         if (own.values) {
             constexpr int s = PaddedLeaves::kSide;
             const float* p = own.values + ((c.x() & 7) * s + (c.y() & 7)) * s + (c.z() & 7);
-            v[0][0][0] = p[0];         v[0][0][1] = p[1];
-            v[0][1][0] = p[s];         v[0][1][1] = p[s + 1];
-            v[1][0][0] = p[s * s];     v[1][0][1] = p[s * s + 1];
-            v[1][1][0] = p[s * s + s]; v[1][1][1] = p[s * s + s + 1];
+            v[0][0][0] = p[0];
+            v[0][0][1] = p[1];
+            v[0][1][0] = p[s];
+            v[0][1][1] = p[s + 1];
+            v[1][0][0] = p[s * s];
+            v[1][0][1] = p[s * s + 1];
+            v[1][1][0] = p[s * s + s];
+            v[1][1][1] = p[s * s + s + 1];
             return true;
         }
         tile = own.tile;
@@ -155,7 +163,8 @@ struct DensityReader {
             for (int j = 0; j < 2; ++j)
                 for (int k = 0; k < 2; ++k) {
                     const Coord corner = c.offsetBy(i, j, k);
-                    const Block& e = blockAt(Coord(corner.x() & ~7, corner.y() & ~7, corner.z() & ~7));
+                    const Block& e =
+                        blockAt(Coord(corner.x() & ~7, corner.y() & ~7, corner.z() & ~7));
                     v[i][j][k] = e.values ? acc.getValue(corner) : e.tile;
                 }
         return true;

@@ -24,7 +24,8 @@ void writeWith(const std::filesystem::path& path, const OIIO::ImageSpec& spec, c
 {
     // Created from the final name (format from its extension), written under a temporary one.
     auto out = OIIO::ImageOutput::create(path.string());
-    if (!out) throw std::runtime_error("no image writer for " + path.string() + ": " + OIIO::geterror());
+    if (!out)
+        throw std::runtime_error("no image writer for " + path.string() + ": " + OIIO::geterror());
     writeAtomically(path, [&](const std::filesystem::path& temporary) {
         bool ok = out->open(temporary.string(), spec);
         ok = ok && out->write_image(OIIO::TypeDesc::FLOAT, image.pixels.data());
@@ -33,7 +34,10 @@ void writeWith(const std::filesystem::path& path, const OIIO::ImageSpec& spec, c
     });
 }
 
-OIIO::TypeDesc matrixType() { return OIIO::TypeDesc(OIIO::TypeDesc::FLOAT, OIIO::TypeDesc::MATRIX44); }
+OIIO::TypeDesc matrixType()
+{
+    return OIIO::TypeDesc(OIIO::TypeDesc::FLOAT, OIIO::TypeDesc::MATRIX44);
+}
 
 void setMatrix(OIIO::ImageSpec& spec, const char* name, const Mat4d& m)
 {
@@ -46,9 +50,11 @@ void setMatrix(OIIO::ImageSpec& spec, const char* name, const Mat4d& m)
 
 } // namespace
 
-void writeExr(const Image& image, const Camera& camera, const std::filesystem::path& path, const ExrOptions& options)
+void writeExr(const Image& image, const Camera& camera, const std::filesystem::path& path,
+              const ExrOptions& options)
 {
-    OIIO::ImageSpec spec = specOf(image, options.halfFloat ? OIIO::TypeDesc::HALF : OIIO::TypeDesc::FLOAT);
+    OIIO::ImageSpec spec =
+        specOf(image, options.halfFloat ? OIIO::TypeDesc::HALF : OIIO::TypeDesc::FLOAT);
     spec.attribute("compression", "zip");
     spec.attribute("Software", std::string("volmorph ") + versionString());
     spec.attribute("volmorph:frame", options.frame);
@@ -65,11 +71,13 @@ void writeExr(const Image& image, const Camera& camera, const std::filesystem::p
 
 void writePng(const Image& image, const std::filesystem::path& path)
 {
-    OIIO::ImageBuf linear(specOf(image, OIIO::TypeDesc::FLOAT), const_cast<float*>(image.pixels.data()));
+    OIIO::ImageBuf linear(specOf(image, OIIO::TypeDesc::FLOAT),
+                          const_cast<float*>(image.pixels.data()));
     OIIO::ImageBuf srgb = OIIO::ImageBufAlgo::colorconvert(linear, "linear", "sRGB");
     OIIO::ImageBuf clamped = OIIO::ImageBufAlgo::clamp(srgb, 0.0f, 1.0f);
     writeAtomically(path, [&clamped](const std::filesystem::path& temporary) {
-        if (!clamped.write(temporary.string(), OIIO::TypeDesc::UINT8)) throw std::runtime_error(clamped.geterror());
+        if (!clamped.write(temporary.string(), OIIO::TypeDesc::UINT8))
+            throw std::runtime_error(clamped.geterror());
     });
 }
 
@@ -86,7 +94,8 @@ Image readImage(const std::filesystem::path& path)
     if (!in->read_image(0, 0, 0, spec.nchannels, OIIO::TypeDesc::FLOAT, all.data()))
         throw std::runtime_error(in->geterror());
     for (size_t p = 0; p < size_t(spec.width) * size_t(spec.height); ++p)
-        for (int c = 0; c < std::min(4, spec.nchannels); ++c) image.pixels[4 * p + size_t(c)] = all[p * size_t(spec.nchannels) + size_t(c)];
+        for (int c = 0; c < std::min(4, spec.nchannels); ++c)
+            image.pixels[4 * p + size_t(c)] = all[p * size_t(spec.nchannels) + size_t(c)];
     return image;
 }
 

@@ -24,7 +24,8 @@ std::array<double, 4> clip(const Mat4d& worldToNdc, const Vec3d& p)
 {
     std::array<double, 4> h{};
     for (int i = 0; i < 4; ++i)
-        h[size_t(i)] = worldToNdc(i, 0) * p.x() + worldToNdc(i, 1) * p.y() + worldToNdc(i, 2) * p.z() + worldToNdc(i, 3);
+        h[size_t(i)] = worldToNdc(i, 0) * p.x() + worldToNdc(i, 1) * p.y() +
+                       worldToNdc(i, 2) * p.z() + worldToNdc(i, 3);
     return h;
 }
 
@@ -41,8 +42,10 @@ bool clip2d(double& x0, double& y0, double& x1, double& y1, double lo, double hi
             continue;
         }
         const double r = q[i] / p[i];
-        if (p[i] < 0.0) t0 = std::max(t0, r);
-        else t1 = std::min(t1, r);
+        if (p[i] < 0.0)
+            t0 = std::max(t0, r);
+        else
+            t1 = std::min(t1, r);
         if (t0 > t1) return false;
     }
     const double ax = x0 + t0 * dx, ay = y0 + t0 * dy;
@@ -53,7 +56,10 @@ bool clip2d(double& x0, double& y0, double& x1, double& y1, double lo, double hi
     return true;
 }
 
-std::vector<float> rgba(const Color& c) { return {c[0], c[1], c[2], 1.0f}; }
+std::vector<float> rgba(const Color& c)
+{
+    return {c[0], c[1], c[2], 1.0f};
+}
 
 } // namespace
 
@@ -64,7 +70,8 @@ std::optional<std::array<double, 2>> project(const Camera& camera, const Vec3d& 
     return std::array<double, 2>{h[0] / h[3] * camera.width(), h[1] / h[3] * camera.height()};
 }
 
-void drawSegment(Image& image, const Camera& camera, const Vec3d& a, const Vec3d& b, const Color& color, int thickness)
+void drawSegment(Image& image, const Camera& camera, const Vec3d& a, const Vec3d& b,
+                 const Color& color, int thickness)
 {
     const Mat4d m = camera.worldToNdc();
     std::array<double, 4> ha = clip(m, a), hb = clip(m, b);
@@ -84,8 +91,9 @@ void drawSegment(Image& image, const Camera& camera, const Vec3d& a, const Vec3d
     const std::vector<float> c = rgba(color);
     for (int dy = 0; dy < std::max(1, thickness); ++dy)
         for (int dx = 0; dx < std::max(1, thickness); ++dx)
-            OIIO::ImageBufAlgo::render_line(buffer, int(std::lround(x0)) + dx, int(std::lround(y0)) + dy,
-                                            int(std::lround(x1)) + dx, int(std::lround(y1)) + dy, c);
+            OIIO::ImageBufAlgo::render_line(buffer, int(std::lround(x0)) + dx,
+                                            int(std::lround(y0)) + dy, int(std::lround(x1)) + dx,
+                                            int(std::lround(y1)) + dy, c);
 }
 
 void drawMarker(Image& image, const Camera& camera, const Vec3d& p, const Color& color, int radius)
@@ -101,7 +109,8 @@ void drawMarker(Image& image, const Camera& camera, const Vec3d& p, const Color&
     OIIO::ImageBufAlgo::render_line(buffer, x, y - radius, x, y + radius, c);
 }
 
-bool drawText(Image& image, int x, int y, const std::string& text, const Color& color, int sizePixels)
+bool drawText(Image& image, int x, int y, const std::string& text, const Color& color,
+              int sizePixels)
 {
     OIIO::ImageBuf buffer = wrap(image);
     const std::vector<float> c = rgba(color);
@@ -118,13 +127,14 @@ Image overBackground(const Image& image, const Color& background)
     return out;
 }
 
-Image contactSheet(const std::vector<Image>& tiles, const std::vector<std::string>& labels, int columns,
-                   int tileWidth, const Color& background)
+Image contactSheet(const std::vector<Image>& tiles, const std::vector<std::string>& labels,
+                   int columns, int tileWidth, const Color& background)
 {
     if (tiles.empty()) throw std::invalid_argument("contactSheet: no tiles");
     columns = std::max(1, std::min(columns, int(tiles.size())));
     const int rows = (int(tiles.size()) + columns - 1) / columns;
-    const int tileHeight = std::max(1, int(std::lround(double(tileWidth) * tiles[0].height / tiles[0].width)));
+    const int tileHeight =
+        std::max(1, int(std::lround(double(tileWidth) * tiles[0].height / tiles[0].width)));
     constexpr int kGap = 6, kLabel = 22;
     Image sheet;
     sheet.width = columns * (tileWidth + kGap) + kGap;
@@ -144,8 +154,9 @@ Image contactSheet(const std::vector<Image>& tiles, const std::vector<std::strin
         const int y = kGap + int(i) / columns * (tileHeight + kLabel + kGap);
         OIIO::ImageBufAlgo::paste(out, x, y, 0, 0, scaled);
         if (i < labels.size() && labelsDrawn)
-            labelsDrawn = OIIO::ImageBufAlgo::render_text(out, x + 2, y + tileHeight + 16, labels[i], 14, "DejaVuSans",
-                                                          std::vector<float>{0.8f, 0.8f, 0.8f, 1.0f});
+            labelsDrawn = OIIO::ImageBufAlgo::render_text(
+                out, x + 2, y + tileHeight + 16, labels[i], 14, "DejaVuSans",
+                std::vector<float>{0.8f, 0.8f, 0.8f, 1.0f});
     }
     return sheet; // `out` wrote into its pixels
 }

@@ -12,26 +12,26 @@
 namespace volmorph::render {
 
 ThreadReaders::ThreadReaders(const FrameInputs& frame)
-    : in(frame), inter(frame.master), density(frame.density.tree(), frame.padded), shadowCaches(frame.lights.size()),
-      perRay(frame.lights.size())
+    : in(frame), inter(frame.master), density(frame.density.tree(), frame.padded),
+      shadowCaches(frame.lights.size()), perRay(frame.lights.size())
 {
     if (frame.color) colors = std::make_unique<ColorReader>(frame.color->tree());
     for (size_t l = 0; l < frame.lights.size(); ++l)
-        if (frame.shadows[l].cache) shadowCaches[l] = std::make_unique<CacheAccessor>(frame.shadows[l].cache->tree());
+        if (frame.shadows[l].cache)
+            shadowCaches[l] = std::make_unique<CacheAccessor>(frame.shadows[l].cache->tree());
 }
 
 namespace {
 
 /// The walk of one ray, and its state: transmittance and radiance so far, and the open run of steps
-/// since the last knot. Each piece of the ray inside one interpolation cell (or constant block) is cut
-/// into equal steps of at most stepVoxels. Each step's optical depth is exact (the integral of the
-/// trilinear density, see Piece). The source S (emission plus albedo times the light reaching the
-/// point) is evaluated at knots along the ray, at the first step end at least one voxel after the
-/// previous knot (so 1 to 1 + h voxels apart), and taken linearly in between: each step adds
+/// since the last knot. Each piece of the ray inside one interpolation cell (or constant block) is
+/// cut into equal steps of at most stepVoxels. Each step's optical depth is exact (the integral of
+/// the trilinear density, see Piece). The source S (emission plus albedo times the light reaching
+/// the point) is evaluated at knots along the ray, at the first step end at least one voxel after
+/// the previous knot (so 1 to 1 + h voxels apart), and taken linearly in between: each step adds
 /// a = T (1 - e^-tau) times S at its middle. A and B sum a and a (t - knot) until the next knot,
 /// which closes them. Constructed per ray, as a local, so that its state lives in registers.
-class RayIntegrator
-{
+class RayIntegrator {
 public:
     RayIntegrator(ThreadReaders& readers, const Ray& ray, const Medium1D& line)
         : mR(readers), mIn(readers.in), mRay(ray), mLine(line)
@@ -41,7 +41,9 @@ public:
     RaySample run()
     {
         double t0 = 0, t1 = 0;
-        auto shade = [this](const Cell& cell, double ta, double tb) { return this->shade(cell, ta, tb); };
+        auto shade = [this](const Cell& cell, double ta, double tb) {
+            return this->shade(cell, ta, tb);
+        };
         while (mR.inter.march(t0, t1) && walkCells(mR.density, mLine, t0, t1, shade)) {}
         if (mOpen) close(mLastEnd);
         return mOut;
@@ -63,10 +65,12 @@ private:
                 Vec3d travel = mIn.density.indexToWorld(ip) - light.position;
                 const double d2 = travel.lengthSqr();
                 travel /= std::sqrt(d2);
-                c = light.color * (light.intensity / d2 *
-                    henyeyGreenstein(travel.dot(-mRay.direction), mIn.medium.anisotropy));
+                c = light.color *
+                    (light.intensity / d2 *
+                     henyeyGreenstein(travel.dot(-mRay.direction), mIn.medium.anisotropy));
                 // The cache shares the density's origin, at `factor` times its voxel.
-                Tl = openvdb::tools::BoxSampler::sample(*mR.shadowCaches[l], ip * mIn.inverseFactor);
+                Tl =
+                    openvdb::tools::BoxSampler::sample(*mR.shadowCaches[l], ip * mIn.inverseFactor);
             } else {
                 Tl = mIn.shadows[l].map->lookup(ip);
             }
@@ -79,14 +83,16 @@ private:
     void close(double t)
     {
         const Vec3d next = sourceAt(t);
-        if (mA > 0.0) mOut.L += mKnotSource * mA + (next - mKnotSource) * (t > mKnot ? mB / (t - mKnot) : 0.0);
+        if (mA > 0.0)
+            mOut.L +=
+                mKnotSource * mA + (next - mKnotSource) * (t > mKnot ? mB / (t - mKnot) : 0.0);
         mKnot = t;
         mKnotSource = next;
         mA = mB = 0.0;
     }
 
-    /// Steps of one piece [ta, tb]: n steps of length dt, optical depth from tauOf(k, dt). Returns false
-    /// when the ray is opaque enough to stop.
+    /// Steps of one piece [ta, tb]: n steps of length dt, optical depth from tauOf(k, dt). Returns
+    /// false when the ray is opaque enough to stop.
     template <typename TauOf>
     bool march(double ta, double tb, int n, TauOf&& tauOf)
     {
@@ -162,11 +168,14 @@ RaySample integrateRay(ThreadReaders& readers, const Ray& ray)
     // A directional light's phase and colour are constant along a ray.
     for (size_t l = 0; l < in.lights.size(); ++l) {
         const Light& light = in.lights[l];
-        readers.perRay[l] = light.color * (light.intensity *
-            henyeyGreenstein(light.direction.unit().dot(-ray.direction), in.medium.anisotropy));
+        readers.perRay[l] =
+            light.color *
+            (light.intensity *
+             henyeyGreenstein(light.direction.unit().dot(-ray.direction), in.medium.anisotropy));
     }
     const Medium1D line{readers.inter.getIndexPos(0.0),
-                        readers.inter.getIndexPos(1.0) - readers.inter.getIndexPos(0.0), in.levelSet};
+                        readers.inter.getIndexPos(1.0) - readers.inter.getIndexPos(0.0),
+                        in.levelSet};
     RayIntegrator integrator(readers, ray, line);
     return integrator.run();
 }

@@ -1,7 +1,8 @@
 // One camera ray's integral through the volume: emission, absorption and single scattering toward
-// every light, with the optical depth of each step exact (Cell.h) and the source term taken linearly
-// between knots (Renderer.h states the approximation). The renderer's three levels, as pbrt-v4 has
-// them: the tile loop and a pixel's samples (Renderer.cpp), and here what happens along one ray.
+// every light, with the optical depth of each step exact (Cell.h) and the source term taken
+// linearly between knots (Renderer.h states the approximation). The renderer's three levels, as
+// pbrt-v4 has them: the tile loop and a pixel's samples (Renderer.cpp), and here what happens along
+// one ray.
 #pragma once
 
 #include <volmorph/render/Camera.h>
@@ -22,9 +23,9 @@ struct FrameInputs {
     const std::vector<Light>& lights;
     const Medium& medium;
     bool levelSet;
-    double sigmaPerVoxel;    ///< extinction per index unit at density 1
-    double stepVoxels;       ///< longest step of the scattering integral
-    double inverseFactor;    ///< 1 / the point lights' shadow grid spacing in voxels
+    double sigmaPerVoxel; ///< extinction per index unit at density 1
+    double stepVoxels;    ///< longest step of the scattering integral
+    double inverseFactor; ///< 1 / the point lights' shadow grid spacing in voxels
     const PaddedLeaves& padded;
     const Intersector& master;
     const std::vector<Shadow>& shadows;
@@ -38,8 +39,9 @@ struct ThreadReaders {
     Intersector inter;
     DensityReader density;
     std::unique_ptr<ColorReader> colors;
-    std::vector<std::unique_ptr<CacheAccessor>> shadowCaches; ///< per light: its point-light grid, or null
-    std::vector<Vec3d> perRay;                                ///< per light: scratch for one ray
+    std::vector<std::unique_ptr<CacheAccessor>>
+        shadowCaches;          ///< per light: its point-light grid, or null
+    std::vector<Vec3d> perRay; ///< per light: scratch for one ray
 
     explicit ThreadReaders(const FrameInputs& frame);
 };

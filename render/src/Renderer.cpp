@@ -33,14 +33,15 @@ void stage(openvdb::util::NullInterrupter* interrupter, const char* name)
 }
 
 /// The pixel (x, y)'s samples averaged: RGB premultiplied, A = 1 - transmittance.
-void renderPixel(ThreadReaders& readers, const Camera& camera, const RenderSettings& settings, int x, int y,
-                 float* px)
+void renderPixel(ThreadReaders& readers, const Camera& camera, const RenderSettings& settings,
+                 int x, int y, float* px)
 {
     const int samples = std::max(1, settings.samples);
     const int strata = int(std::ceil(std::sqrt(double(samples))));
     double r = 0, g = 0, b = 0, alpha = 0;
     for (int s = 0; s < samples; ++s) {
-        Random random(uint64_t(y) * 65536u + uint64_t(x), uint64_t(s), (uint64_t(settings.frame) << 32) ^ settings.seed);
+        Random random(uint64_t(y) * 65536u + uint64_t(x), uint64_t(s),
+                      (uint64_t(settings.frame) << 32) ^ settings.seed);
         // One sample goes through the pixel centre (no antialiasing, as vdb_render); more are
         // stratified and jittered over the pixel.
         const double jx = random.next(), jy = random.next();
@@ -61,23 +62,25 @@ void renderPixel(ThreadReaders& readers, const Camera& camera, const RenderSetti
 /// Every pixel of `image`, tiles in parallel. Pixels are independent and each one's samples are
 /// seeded by its position, so the result does not depend on how the tiles are scheduled. Stops
 /// starting pixels once the interrupter asks (the image is then incomplete).
-void renderTiles(const FrameInputs& frame, const Camera& camera, const RenderSettings& settings, Image& image)
+void renderTiles(const FrameInputs& frame, const Camera& camera, const RenderSettings& settings,
+                 Image& image)
 {
     tbb::parallel_for(tbb::blocked_range2d<int>(0, image.height, 16, 0, image.width, 16),
                       [&](const tbb::blocked_range2d<int>& tile) {
-        ThreadReaders readers(frame);
-        for (int y = tile.rows().begin(); y != tile.rows().end(); ++y)
-            for (int x = tile.cols().begin(); x != tile.cols().end(); ++x) {
-                if (interrupted(settings.interrupter)) return;
-                renderPixel(readers, camera, settings, x, y, image.at(x, y));
-            }
-    });
+                          ThreadReaders readers(frame);
+                          for (int y = tile.rows().begin(); y != tile.rows().end(); ++y)
+                              for (int x = tile.cols().begin(); x != tile.cols().end(); ++x) {
+                                  if (interrupted(settings.interrupter)) return;
+                                  renderPixel(readers, camera, settings, x, y, image.at(x, y));
+                              }
+                      });
 }
 
 /// Prepares what every ray reads (the empty-space mask, padded leaves, every light's shadow), then
 /// renders the tiles. Throws Interrupted when the interrupter asked to stop.
-void renderFrame(const openvdb::FloatGrid& density, const openvdb::Vec3SGrid* color, const Camera& camera,
-                 const std::vector<Light>& lights, const Medium& medium, const RenderSettings& settings, Image& image)
+void renderFrame(const openvdb::FloatGrid& density, const openvdb::Vec3SGrid* color,
+                 const Camera& camera, const std::vector<Light>& lights, const Medium& medium,
+                 const RenderSettings& settings, Image& image)
 {
     const bool levelSet = medium.kind == Medium::Kind::LevelSet;
     const double sigmaPerVoxel = medium.extinction * density.voxelSize()[0]; // per index unit
@@ -87,8 +90,8 @@ void renderFrame(const openvdb::FloatGrid& density, const openvdb::Vec3SGrid* co
     if (interrupted(settings.interrupter)) throw Interrupted();
     stage(settings.interrupter, "render: shadows");
     const std::vector<Shadow> shadows =
-        buildShadows(density, padded, *mask, levelSet, lights, sigmaPerVoxel, settings.shadowCacheVoxels,
-                     settings.interrupter);
+        buildShadows(density, padded, *mask, levelSet, lights, sigmaPerVoxel,
+                     settings.shadowCacheVoxels, settings.interrupter);
     if (interrupted(settings.interrupter)) throw Interrupted();
     const Intersector master(*mask);
     const FrameInputs frame{density,
@@ -110,8 +113,9 @@ void renderFrame(const openvdb::FloatGrid& density, const openvdb::Vec3SGrid* co
 
 } // namespace
 
-Image renderVolume(const openvdb::FloatGrid& density, const openvdb::Vec3SGrid* color, const Camera& camera,
-                   const std::vector<Light>& lights, const Medium& medium, const RenderSettings& settings)
+Image renderVolume(const openvdb::FloatGrid& density, const openvdb::Vec3SGrid* color,
+                   const Camera& camera, const std::vector<Light>& lights, const Medium& medium,
+                   const RenderSettings& settings)
 {
     Image image;
     image.width = camera.width();
@@ -119,8 +123,10 @@ Image renderVolume(const openvdb::FloatGrid& density, const openvdb::Vec3SGrid* 
     image.pixels.assign(size_t(image.width) * size_t(image.height) * 4, 0.0f);
     if (density.tree().activeVoxelCount() == 0) return image;
     auto body = [&] { renderFrame(density, color, camera, lights, medium, settings, image); };
-    if (settings.threads > 0) tbb::task_arena(settings.threads).execute(body);
-    else body();
+    if (settings.threads > 0)
+        tbb::task_arena(settings.threads).execute(body);
+    else
+        body();
     return image;
 }
 

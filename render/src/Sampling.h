@@ -12,7 +12,8 @@ struct Random {
     uint64_t state;
     Random(uint64_t a, uint64_t b, uint64_t c)
     {
-        state = mix(a * 0x9E3779B97F4A7C15ull ^ mix(b + 0x632BE59BD9B4E019ull) ^ mix(c + 0x85157AF5ull));
+        state = mix(a * 0x9E3779B97F4A7C15ull ^ mix(b + 0x632BE59BD9B4E019ull) ^
+                    mix(c + 0x85157AF5ull));
     }
     static uint64_t mix(uint64_t z)
     {

@@ -19,8 +19,8 @@ using openvdb::FloatGrid;
 
 /// Optical depth (index units times sigma) from world point p along `direction` for up to
 /// `distance` world units, integrated cell by cell.
-double opticalDepth(Intersector& inter, bool levelSet, DensityReader& acc,
-                    const Vec3d& p, const Vec3d& direction, double distance, double sigmaPerVoxel)
+double opticalDepth(Intersector& inter, bool levelSet, DensityReader& acc, const Vec3d& p,
+                    const Vec3d& direction, double distance, double sigmaPerVoxel)
 {
     if (!inter.setWorldRay(VdbRay(p, direction, 0.0, distance))) return 0.0;
     Medium1D ray{inter.getIndexPos(0.0), inter.getIndexPos(1.0) - inter.getIndexPos(0.0), levelSet};
@@ -39,8 +39,9 @@ namespace {
 
 /// Transmittance toward a point light, on a coarse grid over the occupied region: one march toward
 /// the light per grid point, sampled trilinearly.
-FloatGrid::Ptr pointLightCache(const FloatGrid& density, const PaddedLeaves& padded, const openvdb::BoolGrid& mask,
-                               bool levelSet, const Light& light, double sigmaPerVoxel, int shadowCacheVoxels,
+FloatGrid::Ptr pointLightCache(const FloatGrid& density, const PaddedLeaves& padded,
+                               const openvdb::BoolGrid& mask, bool levelSet, const Light& light,
+                               double sigmaPerVoxel, int shadowCacheVoxels,
                                openvdb::util::NullInterrupter* interrupter)
 {
     const int factor = std::max(1, shadowCacheVoxels);
@@ -62,12 +63,13 @@ FloatGrid::Ptr pointLightCache(const FloatGrid& density, const PaddedLeaves& pad
         const CoordBBox b = tiles.getBoundingBox();
         cache->tree().fill(CoordBBox(coarse(b.min()), coarse(b.max())), 1.0f, true);
     }
-    openvdb::tools::dilateActiveValues(cache->tree(), 1, openvdb::tools::NN_FACE_EDGE_VERTEX, openvdb::tools::IGNORE_TILES);
+    openvdb::tools::dilateActiveValues(cache->tree(), 1, openvdb::tools::NN_FACE_EDGE_VERTEX,
+                                       openvdb::tools::IGNORE_TILES);
     cache->tree().voxelizeActiveTiles();
 
     const Intersector master(mask);
     openvdb::tree::LeafManager<openvdb::FloatTree> leaves(cache->tree());
-    leaves.foreach([&](openvdb::FloatTree::LeafNodeType& leaf, size_t) {
+    leaves.foreach ([&](openvdb::FloatTree::LeafNodeType& leaf, size_t) {
         if (interrupter && interrupter->wasInterrupted()) return;
         Intersector inter(master);
         DensityReader acc(density.tree(), padded);
@@ -77,7 +79,8 @@ FloatGrid::Ptr pointLightCache(const FloatGrid& density, const PaddedLeaves& pad
             const double distance = toward.length();
             if (distance <= 0.0) continue;
             toward /= distance;
-            it.setValue(float(std::exp(-opticalDepth(inter, levelSet, acc, p, toward, distance, sigmaPerVoxel))));
+            it.setValue(float(
+                std::exp(-opticalDepth(inter, levelSet, acc, p, toward, distance, sigmaPerVoxel))));
         }
     });
     return cache;
@@ -85,8 +88,9 @@ FloatGrid::Ptr pointLightCache(const FloatGrid& density, const PaddedLeaves& pad
 
 } // namespace
 
-ShadowMap::ShadowMap(const FloatGrid& density, const PaddedLeaves& padded, const openvdb::BoolGrid& mask, bool levelSet,
-                     const Vec3d& travel, double sigmaPerVoxel, double spacing,
+ShadowMap::ShadowMap(const FloatGrid& density, const PaddedLeaves& padded,
+                     const openvdb::BoolGrid& mask, bool levelSet, const Vec3d& travel,
+                     double sigmaPerVoxel, double spacing,
                      openvdb::util::NullInterrupter* interrupter)
     : mDensity(density), mSpacing(spacing)
 {
@@ -96,7 +100,8 @@ ShadowMap::ShadowMap(const FloatGrid& density, const PaddedLeaves& padded, const
     pack(columns);
 }
 
-double ShadowMap::placeLattice(const FloatGrid& density, const openvdb::BoolGrid& mask, const Vec3d& travel)
+double ShadowMap::placeLattice(const FloatGrid& density, const openvdb::BoolGrid& mask,
+                               const Vec3d& travel)
 {
     mW = travel.unit();
     mU = (std::abs(mW.x()) < 0.9 ? Vec3d(1, 0, 0) : Vec3d(0, 1, 0)).cross(mW).unit();
@@ -117,7 +122,8 @@ double ShadowMap::placeLattice(const FloatGrid& density, const openvdb::BoolGrid
     mLinear = density.transform().isLinear();
     if (mLinear) {
         const Vec3d w0 = density.indexToWorld(Vec3d(0.0));
-        const Vec3d ex = density.indexToWorld(Vec3d(1, 0, 0)) - w0, ey = density.indexToWorld(Vec3d(0, 1, 0)) - w0,
+        const Vec3d ex = density.indexToWorld(Vec3d(1, 0, 0)) - w0,
+                    ey = density.indexToWorld(Vec3d(0, 1, 0)) - w0,
                     ez = density.indexToWorld(Vec3d(0, 0, 1)) - w0;
         const Vec3d* axes[3] = {&mU, &mV, &mW};
         for (int r = 0; r < 3; ++r) {
@@ -130,22 +136,26 @@ double ShadowMap::placeLattice(const FloatGrid& density, const openvdb::BoolGrid
     return hi.z() - mOrigin.z() + 2.0 * mSpacing;
 }
 
-void ShadowMap::marchColumns(const FloatGrid& density, const PaddedLeaves& padded, const openvdb::BoolGrid& mask,
-                             bool levelSet, double length, double sigmaPerVoxel,
-                             openvdb::util::NullInterrupter* interrupter, std::vector<Column>& columns) const
+void ShadowMap::marchColumns(const FloatGrid& density, const PaddedLeaves& padded,
+                             const openvdb::BoolGrid& mask, bool levelSet, double length,
+                             double sigmaPerVoxel, openvdb::util::NullInterrupter* interrupter,
+                             std::vector<Column>& columns) const
 {
     const Intersector master(mask);
-    tbb::parallel_for(tbb::blocked_range<size_t>(0, columns.size(), 64), [&](const tbb::blocked_range<size_t>& range) {
-        Intersector inter(master);
-        DensityReader acc(density.tree(), padded);
-        for (size_t c = range.begin(); c != range.end(); ++c) {
-            if (interrupter && interrupter->wasInterrupted()) return;
-            const int i = int(c % size_t(mCount[0])), j = int(c / size_t(mCount[0]));
-            const Vec3d start = mU * (mOrigin.x() + i * mSpacing) + mV * (mOrigin.y() + j * mSpacing) +
-                                mW * mOrigin.z();
-            march(inter, acc, levelSet, start, length, sigmaPerVoxel, columns[c]);
-        }
-    });
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, columns.size(), 64),
+                      [&](const tbb::blocked_range<size_t>& range) {
+                          Intersector inter(master);
+                          DensityReader acc(density.tree(), padded);
+                          for (size_t c = range.begin(); c != range.end(); ++c) {
+                              if (interrupter && interrupter->wasInterrupted()) return;
+                              const int i = int(c % size_t(mCount[0])),
+                                        j = int(c / size_t(mCount[0]));
+                              const Vec3d start = mU * (mOrigin.x() + i * mSpacing) +
+                                                  mV * (mOrigin.y() + j * mSpacing) +
+                                                  mW * mOrigin.z();
+                              march(inter, acc, levelSet, start, length, sigmaPerVoxel, columns[c]);
+                          }
+                      });
 }
 
 void ShadowMap::pack(const std::vector<Column>& columns)
@@ -161,16 +171,20 @@ void ShadowMap::pack(const std::vector<Column>& columns)
     }
 }
 
-void ShadowMap::march(Intersector& inter, DensityReader& acc, bool levelSet,
-           const Vec3d& start, double length, double sigmaPerVoxel, Column& column) const
+void ShadowMap::march(Intersector& inter, DensityReader& acc, bool levelSet, const Vec3d& start,
+                      double length, double sigmaPerVoxel, Column& column) const
 {
     if (!inter.setWorldRay(VdbRay(start, mW, 0.0, length))) return;
-    const Medium1D ray{inter.getIndexPos(0.0), inter.getIndexPos(1.0) - inter.getIndexPos(0.0), levelSet};
+    const Medium1D ray{inter.getIndexPos(0.0), inter.getIndexPos(1.0) - inter.getIndexPos(0.0),
+                       levelSet};
     // Index time per lattice step (the index ray has unit speed in voxels).
     const double h = inter.getWorldTime(1.0) > 0.0 ? mSpacing / inter.getWorldTime(1.0) : mSpacing;
     double tau = 0.0, t0 = 0.0, t1 = 0.0;
     int k = -1; // the last lattice index stored
-    auto push = [&] { column.values.push_back(float(std::exp(-tau))); ++k; };
+    auto push = [&] {
+        column.values.push_back(float(std::exp(-tau)));
+        ++k;
+    };
     bool going = true;
     while (going && inter.march(t0, t1)) {
         if (k < 0) { // nothing is absorbed before the first span: the column starts there
@@ -193,8 +207,9 @@ void ShadowMap::march(Intersector& inter, DensityReader& acc, bool levelSet,
     }
     column.last = float(std::exp(-tau));
 }
-std::vector<Shadow> buildShadows(const FloatGrid& density, const PaddedLeaves& padded, const openvdb::BoolGrid& mask,
-                                 bool levelSet, const std::vector<Light>& lights, double sigmaPerVoxel,
+std::vector<Shadow> buildShadows(const FloatGrid& density, const PaddedLeaves& padded,
+                                 const openvdb::BoolGrid& mask, bool levelSet,
+                                 const std::vector<Light>& lights, double sigmaPerVoxel,
                                  int shadowCacheVoxels, openvdb::util::NullInterrupter* interrupter)
 {
     const double voxel = density.voxelSize()[0];
@@ -202,12 +217,12 @@ std::vector<Shadow> buildShadows(const FloatGrid& density, const PaddedLeaves& p
     for (size_t l = 0; l < lights.size(); ++l) {
         if (interrupter && interrupter->wasInterrupted()) break;
         if (lights[l].type == Light::Type::Directional)
-            shadows[l].map = std::make_unique<ShadowMap>(density, padded, mask, levelSet, lights[l].direction,
-                                                         sigmaPerVoxel, voxel * std::max(1, shadowCacheVoxels),
-                                                         interrupter);
+            shadows[l].map = std::make_unique<ShadowMap>(
+                density, padded, mask, levelSet, lights[l].direction, sigmaPerVoxel,
+                voxel * std::max(1, shadowCacheVoxels), interrupter);
         else
-            shadows[l].cache = pointLightCache(density, padded, mask, levelSet, lights[l], sigmaPerVoxel,
-                                               shadowCacheVoxels, interrupter);
+            shadows[l].cache = pointLightCache(density, padded, mask, levelSet, lights[l],
+                                               sigmaPerVoxel, shadowCacheVoxels, interrupter);
     }
     return shadows;
 }

@@ -16,22 +16,21 @@ namespace volmorph::render {
 
 /// Optical depth (index units times sigma) from world point p along `direction` for up to
 /// `distance` world units, integrated cell by cell.
-double opticalDepth(Intersector& inter, bool levelSet, DensityReader& acc, const Vec3d& p, const Vec3d& direction,
-                    double distance, double sigmaPerVoxel);
+double opticalDepth(Intersector& inter, bool levelSet, DensityReader& acc, const Vec3d& p,
+                    const Vec3d& direction, double distance, double sigmaPerVoxel);
 
 /// Transmittance toward a directional light: a deep shadow map (Lokovic and Veach). A lattice of
 /// columns parallel to the light, `spacing` world units apart, each marched once through the
 /// volume cell by cell, keeping the transmittance every `spacing` along it; looked up by bilinear
 /// interpolation across columns and linear along them. Only the span of each column that crosses
 /// the occupied region is stored.
-class ShadowMap
-{
+class ShadowMap {
 public:
-    /// `travel`: the way the light travels. Columns are skipped once `interrupter` asks to stop (the
-    /// map is then incomplete: the caller checks the interrupter and discards it).
-    ShadowMap(const openvdb::FloatGrid& density, const PaddedLeaves& padded, const openvdb::BoolGrid& mask,
-              bool levelSet, const Vec3d& travel, double sigmaPerVoxel, double spacing,
-              openvdb::util::NullInterrupter* interrupter);
+    /// `travel`: the way the light travels. Columns are skipped once `interrupter` asks to stop
+    /// (the map is then incomplete: the caller checks the interrupter and discards it).
+    ShadowMap(const openvdb::FloatGrid& density, const PaddedLeaves& padded,
+              const openvdb::BoolGrid& mask, bool levelSet, const Vec3d& travel,
+              double sigmaPerVoxel, double spacing, openvdb::util::NullInterrupter* interrupter);
 
     /// Transmittance toward the light at index point ip of the density grid.
     double lookup(const Vec3d& ip) const
@@ -50,7 +49,8 @@ public:
         const double fa = std::floor(a), fb = std::floor(b), fc = std::floor(c);
         const int i = int(fa), j = int(fb), k = int(fc);
         const double u = a - fa, v = b - fb, w = c - fc;
-        auto column = [&](int ci, int cj) __attribute__((always_inline)) {
+        auto column = [&](int ci, int cj) __attribute__((always_inline))
+        {
             if (ci < 0 || cj < 0 || ci >= mCount[0] || cj >= mCount[1]) return 1.0;
             const Span& span = mSpans[size_t(cj) * size_t(mCount[0]) + size_t(ci)];
             const float* data = mData.data() + span.offset;
@@ -66,21 +66,24 @@ public:
 
 private:
     struct Column {
-        int first = 0;           ///< lattice index of values[0]; before it the transmittance is 1
-        float last = 1.0f;       ///< the transmittance after the stored span
+        int first = 0;     ///< lattice index of values[0]; before it the transmittance is 1
+        float last = 1.0f; ///< the transmittance after the stored span
         std::vector<float> values;
     };
 
     /// The light's frame, the lattice's origin, size and index-space map; returns the columns'
     /// length in world units.
-    double placeLattice(const openvdb::FloatGrid& density, const openvdb::BoolGrid& mask, const Vec3d& travel);
+    double placeLattice(const openvdb::FloatGrid& density, const openvdb::BoolGrid& mask,
+                        const Vec3d& travel);
     /// Marches every column (in parallel) into `columns`.
-    void marchColumns(const openvdb::FloatGrid& density, const PaddedLeaves& padded, const openvdb::BoolGrid& mask,
-                      bool levelSet, double length, double sigmaPerVoxel, openvdb::util::NullInterrupter* interrupter,
+    void marchColumns(const openvdb::FloatGrid& density, const PaddedLeaves& padded,
+                      const openvdb::BoolGrid& mask, bool levelSet, double length,
+                      double sigmaPerVoxel, openvdb::util::NullInterrupter* interrupter,
                       std::vector<Column>& columns) const;
-    /// One column: the transmittance at each lattice point from `start` along the light for `length`.
-    void march(Intersector& inter, DensityReader& acc, bool levelSet, const Vec3d& start, double length,
-               double sigmaPerVoxel, Column& column) const;
+    /// One column: the transmittance at each lattice point from `start` along the light for
+    /// `length`.
+    void march(Intersector& inter, DensityReader& acc, bool levelSet, const Vec3d& start,
+               double length, double sigmaPerVoxel, Column& column) const;
     /// The columns packed into one contiguous array for lookups.
     void pack(const std::vector<Column>& columns);
 
@@ -88,7 +91,7 @@ private:
     Vec3d mU, mV, mW, mOrigin; ///< light frame; origin in its coordinates (world units)
     double mSpacing;
     bool mLinear = false;
-    Vec3d mRow[3], mOffset;    ///< index space to lattice coordinates, for a linear transform
+    Vec3d mRow[3], mOffset; ///< index space to lattice coordinates, for a linear transform
     int mCount[2];
     struct Span {         ///< a column in mData
         int first, count; ///< lattice index of its first value, and how many
@@ -99,18 +102,19 @@ private:
     std::vector<float> mData;
 };
 
-
-/// One light's shadow: a deep shadow map for a directional light, a grid of marches for a point light.
+/// One light's shadow: a deep shadow map for a directional light, a grid of marches for a point
+/// light.
 struct Shadow {
     std::unique_ptr<ShadowMap> map;
     openvdb::FloatGrid::Ptr cache; ///< transmittance, `shadowCacheVoxels` times the density's voxel
 };
 
-/// The shadows of every light, in the order of `lights`; spacing `shadowCacheVoxels` voxels. Returns
-/// early (with incomplete shadows) once `interrupter` asks to stop: the caller checks it.
+/// The shadows of every light, in the order of `lights`; spacing `shadowCacheVoxels` voxels.
+/// Returns early (with incomplete shadows) once `interrupter` asks to stop: the caller checks it.
 std::vector<Shadow> buildShadows(const openvdb::FloatGrid& density, const PaddedLeaves& padded,
-                                 const openvdb::BoolGrid& mask, bool levelSet, const std::vector<Light>& lights,
-                                 double sigmaPerVoxel, int shadowCacheVoxels,
+                                 const openvdb::BoolGrid& mask, bool levelSet,
+                                 const std::vector<Light>& lights, double sigmaPerVoxel,
+                                 int shadowCacheVoxels,
                                  openvdb::util::NullInterrupter* interrupter);
 
 } // namespace volmorph::render

@@ -24,7 +24,8 @@ using namespace volmorph;
 
 namespace {
 
-const std::filesystem::path kMeshes = std::filesystem::path(VOLMORPH_SOURCE_DIR) / "scenes" / "meshes";
+const std::filesystem::path kMeshes =
+    std::filesystem::path(VOLMORPH_SOURCE_DIR) / "scenes" / "meshes";
 constexpr int kIntervals = 24;
 constexpr int kRuns = 3;
 
@@ -65,8 +66,9 @@ int main()
     options.voxelSize = 1.0 / 128.0; // the sphere is 1 world unit across: 128 voxels
     const VolumeSet sphere = voxelize(importMesh(kMeshes / "sphere.obj"), options);
     const VolumeSet knot = voxelize(importMesh(kMeshes / "knot1.off"), options);
-    std::printf("sphere -> knot at voxel %.5f world units (128 across), %d intervals, median of %d runs\n",
-                *options.voxelSize, kIntervals, kRuns);
+    std::printf(
+        "sphere -> knot at voxel %.5f world units (128 across), %d intervals, median of %d runs\n",
+        *options.voxelSize, kIntervals, kRuns);
 
     std::vector<double> oursSetup, oursFrame, lsmFrame;
     double oursMismatch = 0.0, lsmMismatch = 0.0;
@@ -90,15 +92,17 @@ int main()
         for (int i = 0; i < kIntervals; ++i) lsm.advect(0.0, 0.25);
         lsmFrame.push_back(seconds(start) / kIntervals);
         lsmMismatch = signMismatch(*moving, *knot.sdf);
-        std::printf("  run %d: volmorph %.3f s/frame (+ %.2f s once), LevelSetMorphing %.3f s/interval\n", run + 1,
-                    oursFrame.back(), oursSetup.back(), lsmFrame.back());
+        std::printf(
+            "  run %d: volmorph %.3f s/frame (+ %.2f s once), LevelSetMorphing %.3f s/interval\n",
+            run + 1, oursFrame.back(), oursSetup.back(), lsmFrame.back());
     }
     const double ours = median(oursFrame), setup = median(oursSetup), theirs = median(lsmFrame);
-    std::printf("volmorph sdf mode     %.3f s per frame, %.2f s once per sequence; last frame sign mismatch %.3f%%\n",
+    std::printf("volmorph sdf mode     %.3f s per frame, %.2f s once per sequence; last frame sign "
+                "mismatch %.3f%%\n",
                 ours, setup, 100.0 * oursMismatch);
-    std::printf("LevelSetMorphing      %.3f s per interval; last frame sign mismatch %.3f%%\n", theirs,
-                100.0 * lsmMismatch);
-    std::printf("ratio per frame %.1fx; over the whole sequence (setup included) %.1fx\n", theirs / ours,
-                theirs * kIntervals / (ours * kIntervals + setup));
+    std::printf("LevelSetMorphing      %.3f s per interval; last frame sign mismatch %.3f%%\n",
+                theirs, 100.0 * lsmMismatch);
+    std::printf("ratio per frame %.1fx; over the whole sequence (setup included) %.1fx\n",
+                theirs / ours, theirs * kIntervals / (ours * kIntervals + setup));
     return 0;
 }

@@ -17,14 +17,17 @@ using namespace volmorph;
 
 namespace {
 
-const std::vector<std::string> kMeshes = {"bunny.obj", "knot1.off", "elephant.off", "elephant-with-holes.off"};
+const std::vector<std::string> kMeshes = {"bunny.obj", "knot1.off", "elephant.off",
+                                          "elephant-with-holes.off"};
 
 const Mesh& mesh(size_t i)
 {
     static std::map<size_t, Mesh> cache;
     auto it = cache.find(i);
     if (it == cache.end())
-        it = cache.emplace(i, importMesh(std::filesystem::path(VOLMORPH_SOURCE_DIR) / "scenes" / "meshes" / kMeshes[i]))
+        it = cache
+                 .emplace(i, importMesh(std::filesystem::path(VOLMORPH_SOURCE_DIR) / "scenes" /
+                                        "meshes" / kMeshes[i]))
                  .first;
     return it->second;
 }
@@ -43,8 +46,8 @@ void openvdbLevelSetAndFog(benchmark::State& state)
     const auto xform = openvdb::math::Transform::createLinearTransform(voxelSize);
     uint64_t active = 0;
     for (auto _ : state) {
-        openvdb::FloatGrid::Ptr sdf = openvdb::tools::meshToLevelSet<openvdb::FloatGrid>(
-            *xform, m.points, m.triangles, 3.0f);
+        openvdb::FloatGrid::Ptr sdf =
+            openvdb::tools::meshToLevelSet<openvdb::FloatGrid>(*xform, m.points, m.triangles, 3.0f);
         openvdb::FloatGrid::Ptr fog = sdf->deepCopy();
         openvdb::tools::sdfToFogVolume(*fog);
         active = fog->activeVoxelCount();

@@ -7,7 +7,8 @@
 //    linear blend: morphFrameDensity, identityResampleDensity) and in the default scene's sdf mode
 //    (issue 5: morphFrame, identityResample);
 //  - frames at 128, 256 and 512 voxels across: time per active voxel.
-// Run: build-bench/tests/bench/volmorph_bench_warp --benchmark_repetitions=5 --benchmark_report_aggregates_only=true
+// Run: build-bench/tests/bench/volmorph_bench_warp --benchmark_repetitions=5
+// --benchmark_report_aggregates_only=true
 #include <volmorph/Morph.h>
 #include <volmorph/Voxelize.h>
 #include <volmorph/Warp.h>
@@ -28,25 +29,29 @@ using namespace volmorph;
 
 namespace {
 
-const std::filesystem::path kScene = std::filesystem::path(VOLMORPH_SOURCE_DIR) / "scenes" / "bunny-to-knot.toml";
+const std::filesystem::path kScene =
+    std::filesystem::path(VOLMORPH_SOURCE_DIR) / "scenes" / "bunny-to-knot.toml";
 
 Vec3d rotate(const Vec3d& v, const Vec3d& k, double angle)
 {
-    return v * std::cos(angle) + k.cross(v) * std::sin(angle) + k * (k.dot(v) * (1.0 - std::cos(angle)));
+    return v * std::cos(angle) + k.cross(v) * std::sin(angle) +
+           k * (k.dot(v) * (1.0 - std::cos(angle)));
 }
 
 /// The default scene's pairs, cut to n or extended with random pairs of the kind a user places:
 /// inside the bunny's bounds, moved by at most 0.15, turned by at most 45 degrees, scaled 0.7-1.4.
 std::vector<FeaturePairSpec> pairsFor(const Scene& scene, int n)
 {
-    std::vector<FeaturePairSpec> pairs(scene.pairs.begin(), scene.pairs.begin() + std::min<size_t>(n, scene.pairs.size()));
+    std::vector<FeaturePairSpec> pairs(
+        scene.pairs.begin(), scene.pairs.begin() + std::min<size_t>(n, scene.pairs.size()));
     std::mt19937 random(1995);
     std::uniform_real_distribution<double> u(0.0, 1.0);
     auto vec = [&] { return Vec3d(u(random), u(random), u(random)); };
     while (int(pairs.size()) < n) {
         FeaturePairSpec p;
         p.type = FeatureType(random() % 4);
-        p.source.origin = Vec3d(-0.4, 0.05, -0.3) + Vec3d(0.8 * u(random), 0.85 * u(random), 0.6 * u(random));
+        p.source.origin =
+            Vec3d(-0.4, 0.05, -0.3) + Vec3d(0.8 * u(random), 0.85 * u(random), 0.6 * u(random));
         p.source.xAxis = (vec() - Vec3d(0.5)).unit();
         p.source.yAxis = p.source.xAxis.cross((vec() - Vec3d(0.5)).unit()).unit();
         p.source.zAxis = p.source.xAxis.cross(p.source.yAxis);
@@ -59,7 +64,8 @@ std::vector<FeaturePairSpec> pairsFor(const Scene& scene, int n)
         p.target.yAxis = rotate(p.source.yAxis, axis, angle);
         p.target.zAxis = p.target.xAxis.cross(p.target.yAxis);
         const Vec3d f = Vec3d(0.7) + vec() * 0.7;
-        p.target.scale = Vec3d(p.source.scale.x() * f.x(), p.source.scale.y() * f.y(), p.source.scale.z() * f.z());
+        p.target.scale = Vec3d(p.source.scale.x() * f.x(), p.source.scale.y() * f.y(),
+                               p.source.scale.z() * f.z());
         pairs.push_back(p);
     }
     return pairs;
@@ -133,15 +139,16 @@ void warpOnly(benchmark::State& state, double tolerance)
     const Morpher morpher(s.volumes.source, s.volumes.target, pairs, s.scene.warp, s.scene.blend);
     const openvdb::CoordBBox box = morpher.candidateBounds(t);
     const InverseWarp warp(pairs, s.scene.warp, t, 1.0 / voxel);
-    const detail::Occupancy occS(s.volumes.source.density->tree()), occT(s.volumes.target.density->tree());
+    const detail::Occupancy occS(s.volumes.source.density->tree()),
+        occT(s.volumes.target.density->tree());
     const detail::AdaptiveWarp adaptive(warp, tolerance);
     detail::AdaptiveWarpStats stats;
     std::atomic<uint64_t> sink{0};
     for (auto _ : state) {
         stats = {};
-        adaptive.forEachLeaf(box, &occS, &occT,
-                             [&](const detail::WarpLeaf& leaf) { sink += consume(leaf); },
-                             &stats);
+        adaptive.forEachLeaf(
+            box, &occS, &occT, [&](const detail::WarpLeaf& leaf) { sink += consume(leaf); },
+            &stats);
     }
     state.counters["leaves"] = double(stats.leaves);
     state.counters["exact_evals"] = double(stats.exactEvaluations);
@@ -157,7 +164,8 @@ void warpOnly(benchmark::State& state, double tolerance)
             Vec3d ps, pt;
             for (int i = 0; i < 512; i += 3) {
                 warp.map(leaf.origin.offsetBy(i >> 6, (i >> 3) & 7, i & 7).asVec3d(), ps, pt);
-                local = std::max({local, (Vec3d(leaf.source(i)) - ps).length(), (Vec3d(leaf.target(i)) - pt).length()});
+                local = std::max({local, (Vec3d(leaf.source(i)) - ps).length(),
+                                  (Vec3d(leaf.target(i)) - pt).length()});
             }
             std::lock_guard<std::mutex> lock(m);
             worst = std::max(worst, local);
@@ -169,8 +177,14 @@ void warpOnly(benchmark::State& state, double tolerance)
     }
 }
 
-void exactWarp(benchmark::State& state) { warpOnly(state, 0.0); }
-void approximatedWarp(benchmark::State& state) { warpOnly(state, 0.25); }
+void exactWarp(benchmark::State& state)
+{
+    warpOnly(state, 0.0);
+}
+void approximatedWarp(benchmark::State& state)
+{
+    warpOnly(state, 0.25);
+}
 
 /// One whole frame at t = 0.5 with the scene's pairs, in the given blend mode.
 void frame(benchmark::State& state, BlendMode mode)
@@ -188,17 +202,23 @@ void frame(benchmark::State& state, BlendMode mode)
     state.counters["candidate_leaves"] = double(stats.candidateLeaves);
     state.counters["output_leaves"] = double(stats.outputLeaves);
     if (mode == BlendMode::Sdf) state.counters["blend_samples"] = double(stats.blendSamples);
-    state.counters["ns_per_active_voxel"] =
-        benchmark::Counter(double(stats.activeVoxels) * 1e-9, benchmark::Counter::kIsIterationInvariantRate |
-                                                                benchmark::Counter::kInvert);
+    state.counters["ns_per_active_voxel"] = benchmark::Counter(
+        double(stats.activeVoxels) * 1e-9,
+        benchmark::Counter::kIsIterationInvariantRate | benchmark::Counter::kInvert);
 }
 
 /// The default scene's frame (sdf mode: the blend of extended distances, its islands dropped,
 /// redistanced; issue 5).
-void morphFrame(benchmark::State& state) { frame(state, BlendMode::Sdf); }
+void morphFrame(benchmark::State& state)
+{
+    frame(state, BlendMode::Sdf);
+}
 /// The frame of issue 4: domain, warp, resample, and a linear blend of density and of
 /// density-weighted colour.
-void morphFrameDensity(benchmark::State& state) { frame(state, BlendMode::Density); }
+void morphFrameDensity(benchmark::State& state)
+{
+    frame(state, BlendMode::Density);
+}
 
 /// The lower bound of a frame: every output voxel of the same frame (in the given mode) resampled
 /// from source and target at its own position (identity warp) and blended, in parallel over leaves.
@@ -217,7 +237,7 @@ void lowerBound(benchmark::State& state, BlendMode mode)
     const VolumeSet& src = s.volumes.source;
     const VolumeSet& dst = s.volumes.target;
     for (auto _ : state) {
-        leaves.foreach([&](openvdb::FloatTree::LeafNodeType& leaf, size_t) {
+        leaves.foreach ([&](openvdb::FloatTree::LeafNodeType& leaf, size_t) {
             auto ds = src.density->getConstAccessor(), dt = dst.density->getConstAccessor();
             auto cs = src.color->getConstAccessor(), ct = dst.color->getConstAccessor();
             auto* color = colors->tree().probeLeaf(leaf.origin());
@@ -228,21 +248,55 @@ void lowerBound(benchmark::State& state, BlendMode mode)
                 it.setValue(0.5f * a + 0.5f * b);
                 if (color && a + b > 0.0f)
                     color->setValueOnly(it.pos(), (a * openvdb::tools::BoxSampler::sample(cs, p) +
-                                                   b * openvdb::tools::BoxSampler::sample(ct, p)) / (a + b));
+                                                   b * openvdb::tools::BoxSampler::sample(ct, p)) /
+                                                      (a + b));
             }
         });
     }
     state.counters["active_voxels"] = double(out.density->activeVoxelCount());
 }
 
-void identityResample(benchmark::State& state) { lowerBound(state, BlendMode::Sdf); }
-void identityResampleDensity(benchmark::State& state) { lowerBound(state, BlendMode::Density); }
+void identityResample(benchmark::State& state)
+{
+    lowerBound(state, BlendMode::Sdf);
+}
+void identityResampleDensity(benchmark::State& state)
+{
+    lowerBound(state, BlendMode::Density);
+}
 
 } // namespace
 
-BENCHMARK(exactWarp)->Arg(1)->Arg(4)->Arg(16)->Arg(64)->Unit(benchmark::kMillisecond)->UseRealTime();
-BENCHMARK(approximatedWarp)->Arg(1)->Arg(4)->Arg(16)->Arg(64)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(exactWarp)
+    ->Arg(1)
+    ->Arg(4)
+    ->Arg(16)
+    ->Arg(64)
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+BENCHMARK(approximatedWarp)
+    ->Arg(1)
+    ->Arg(4)
+    ->Arg(16)
+    ->Arg(64)
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
 BENCHMARK(morphFrame)->Arg(128)->Arg(256)->Arg(512)->Unit(benchmark::kMillisecond)->UseRealTime();
-BENCHMARK(morphFrameDensity)->Arg(128)->Arg(256)->Arg(512)->Unit(benchmark::kMillisecond)->UseRealTime();
-BENCHMARK(identityResample)->Arg(128)->Arg(256)->Arg(512)->Unit(benchmark::kMillisecond)->UseRealTime();
-BENCHMARK(identityResampleDensity)->Arg(128)->Arg(256)->Arg(512)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(morphFrameDensity)
+    ->Arg(128)
+    ->Arg(256)
+    ->Arg(512)
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+BENCHMARK(identityResample)
+    ->Arg(128)
+    ->Arg(256)
+    ->Arg(512)
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+BENCHMARK(identityResampleDensity)
+    ->Arg(128)
+    ->Arg(256)
+    ->Arg(512)
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();

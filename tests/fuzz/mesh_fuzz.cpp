@@ -18,7 +18,8 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size)
     static const char* const kExtensions[] = {".obj", ".ply", ".stl", ".off", ".gltf"};
     const std::string ext = kExtensions[data[0] % 5];
     static const std::filesystem::path dir = [] {
-        const std::filesystem::path d = std::filesystem::temp_directory_path() / ("volmorph-fuzz-" + std::to_string(getpid()));
+        const std::filesystem::path d =
+            std::filesystem::temp_directory_path() / ("volmorph-fuzz-" + std::to_string(getpid()));
         std::filesystem::create_directories(d);
         return d;
     }();

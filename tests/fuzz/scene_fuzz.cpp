@@ -11,7 +11,8 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size)
 {
     const std::string_view text(reinterpret_cast<const char*>(data), size);
     try {
-        // Relative mesh paths resolve against this (non-existent) folder: they are reported missing.
+        // Relative mesh paths resolve against this (non-existent) folder: they are reported
+        // missing.
         volmorph::parseScene(text, "/nonexistent/fuzz/scene.toml");
     } catch (const volmorph::UserError&) {
     }

@@ -20,8 +20,16 @@ struct Fnv {
         const auto* c = static_cast<const unsigned char*>(p);
         for (size_t i = 0; i < n; ++i) h = (h ^ c[i]) * 1099511628211ull;
     }
-    template <typename T> void value(const T& v) { bytes(&v, sizeof v); }
-    void text(const std::string& s) { bytes(s.data(), s.size()); value(uint8_t(0)); }
+    template <typename T>
+    void value(const T& v)
+    {
+        bytes(&v, sizeof v);
+    }
+    void text(const std::string& s)
+    {
+        bytes(s.data(), s.size());
+        value(uint8_t(0));
+    }
 };
 
 template <typename GridT>
@@ -32,7 +40,8 @@ void hashTree(const GridT& grid, Fnv& f, size_t& leaves, size_t& tiles)
     for (auto leaf = tree.cbeginLeaf(); leaf; ++leaf, ++leaves) {
         f.value(leaf->origin());
         const auto& mask = leaf->getValueMask();
-        for (openvdb::Index w = 0; w < mask.WORD_COUNT; ++w) f.value(mask.template getWord<openvdb::Index64>(w));
+        for (openvdb::Index w = 0; w < mask.WORD_COUNT; ++w)
+            f.value(mask.template getWord<openvdb::Index64>(w));
         f.bytes(leaf->buffer().data(), sizeof(typename GridT::ValueType) * leaf->SIZE);
     }
     auto it = tree.cbeginValueAll();
@@ -82,13 +91,13 @@ int main(int argc, char** argv)
                                    tryHash<openvdb::Int32Grid>(g, f, leaves, tiles) ||
                                    tryHash<openvdb::BoolGrid>(g, f, leaves, tiles);
                 if (!known) {
-                    std::fprintf(stderr, "vdb_hash: %s: grid %s has an unhandled type %s\n", argv[a],
-                                 g->getName().c_str(), g->type().c_str());
+                    std::fprintf(stderr, "vdb_hash: %s: grid %s has an unhandled type %s\n",
+                                 argv[a], g->getName().c_str(), g->type().c_str());
                     status = 1;
                     continue;
                 }
-                std::printf("%s %s %s %zu %zu %016llx\n", argv[a], g->getName().c_str(), g->type().c_str(), leaves,
-                            tiles, (unsigned long long)f.h);
+                std::printf("%s %s %s %zu %zu %016llx\n", argv[a], g->getName().c_str(),
+                            g->type().c_str(), leaves, tiles, (unsigned long long)f.h);
             }
         } catch (const std::exception& e) {
             std::fprintf(stderr, "vdb_hash: %s: %s\n", argv[a], e.what());

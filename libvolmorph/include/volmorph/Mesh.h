@@ -19,13 +19,13 @@ using Vec3I = openvdb::math::Vec3<uint32_t>;
 /// What import found and repaired. Nothing here is fatal: open and non-manifold meshes are common
 /// in the wild and the voxelizer handles them.
 struct MeshReport {
-    size_t inputTriangles = 0;           ///< after triangulation, before clean-up
-    size_t degenerateTriangles = 0;      ///< dropped: repeated vertex or zero area
-    size_t duplicateVertices = 0;        ///< welded: identical positions merged
-    size_t boundaryEdges = 0;            ///< edges used by one triangle (holes)
-    size_t nonManifoldEdges = 0;         ///< edges used by three or more triangles
-    size_t misorientedEdges = 0;         ///< edges whose two triangles traverse them the same way
-    size_t components = 0;               ///< connected shells (by shared vertices)
+    size_t inputTriangles = 0;      ///< after triangulation, before clean-up
+    size_t degenerateTriangles = 0; ///< dropped: repeated vertex or zero area
+    size_t duplicateVertices = 0;   ///< welded: identical positions merged
+    size_t boundaryEdges = 0;       ///< edges used by one triangle (holes)
+    size_t nonManifoldEdges = 0;    ///< edges used by three or more triangles
+    size_t misorientedEdges = 0;    ///< edges whose two triangles traverse them the same way
+    size_t components = 0;          ///< connected shells (by shared vertices)
 
     bool watertight() const { return boundaryEdges == 0 && nonManifoldEdges == 0; }
     bool consistentlyOriented() const { return misorientedEdges == 0; }
@@ -35,7 +35,7 @@ struct MeshReport {
 struct Mesh {
     std::vector<Vec3f> points;
     std::vector<Vec3I> triangles;
-    std::vector<Vec3f> colors;           ///< per vertex, linear RGB; empty when the file has none
+    std::vector<Vec3f> colors; ///< per vertex, linear RGB; empty when the file has none
     MeshReport report;
     std::filesystem::path file;
 
@@ -47,10 +47,9 @@ struct Mesh {
 /// Imports every triangle of a mesh file, applies `transform`, welds identical positions, drops and
 /// counts degenerate triangles, and fills the report.
 /// Throws UserError naming the file when it cannot be read, is not a mesh, has no triangles
-/// or has a non-finite coordinate. `where` is reported with the error (e.g. the scene's `mesh` key);
-/// when its file is empty the mesh file itself is named.
-Mesh importMesh(const std::filesystem::path& file,
-                const ObjectTransform& transform = {},
+/// or has a non-finite coordinate. `where` is reported with the error (e.g. the scene's `mesh`
+/// key); when its file is empty the mesh file itself is named.
+Mesh importMesh(const std::filesystem::path& file, const ObjectTransform& transform = {},
                 const SourceLocation& where = {});
 
 /// A scene's two meshes, imported with their transforms.

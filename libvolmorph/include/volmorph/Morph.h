@@ -6,11 +6,12 @@
 // by the colour schedule (so no colour leaks in from the side that is empty there).
 //
 // sdf mode blends signed distances. A narrow band clamps distances to +/- its width, and the blend
-// of two clamped values, (1 - tau)(-w) + tau(+w), changes sign at tau = 1/2 everywhere at once: every
-// voxel inside one object and a few voxels outside the other would flip in one frame (the shape
-// snaps instead of morphing). So the Morpher first extends both distance fields over the box of
-// source and target together, plus a margin, once: the band's own values near the surface, beyond
-// them a field at twice the voxel size filled in by OpenVDB's fast sweeping (tools::maskSdf).
+// of two clamped values, (1 - tau)(-w) + tau(+w), changes sign at tau = 1/2 everywhere at once:
+// every voxel inside one object and a few voxels outside the other would flip in one frame (the
+// shape snaps instead of morphing). So the Morpher first extends both distance fields over the box
+// of source and target together, plus a margin, once: the band's own values near the surface,
+// beyond them a field at twice the voxel size filled in by OpenVDB's fast sweeping
+// (tools::maskSdf).
 //
 // A frame evaluates the blend only where its band can be. The blend's gradient is at most the
 // warp's stretch G (distances change by at most one per unit), so a leaf or a quarter of a leaf
@@ -38,7 +39,7 @@ namespace detail {
 class Occupancy;
 class ExtendedDistance;
 class IdentityDistances;
-}
+} // namespace detail
 
 struct MorphOptions {
     enum class Sampling { Trilinear, Triquadratic };
@@ -53,12 +54,13 @@ struct MorphOptions {
 inline constexpr uint64_t kMorphBytesPerLeaf = 24 * 1024;
 
 struct MorphStats {
-    double maxWarpErrorVoxels = 0.0;   ///< largest error bound of a leaf where the warp was interpolated
-    uint64_t exactEvaluations = 0;     ///< exact warp evaluations (a pair of points each)
-    uint64_t candidateLeaves = 0;      ///< output leaves evaluated
-    uint64_t outputLeaves = 0;         ///< output leaves kept (non-empty)
-    uint64_t activeVoxels = 0;         ///< of the density grid, tiles included
-    uint64_t blendSamples = 0;         ///< sdf mode: points where the blend was evaluated
+    double maxWarpErrorVoxels =
+        0.0; ///< largest error bound of a leaf where the warp was interpolated
+    uint64_t exactEvaluations = 0; ///< exact warp evaluations (a pair of points each)
+    uint64_t candidateLeaves = 0;  ///< output leaves evaluated
+    uint64_t outputLeaves = 0;     ///< output leaves kept (non-empty)
+    uint64_t activeVoxels = 0;     ///< of the density grid, tiles included
+    uint64_t blendSamples = 0;     ///< sdf mode: points where the blend was evaluated
 };
 
 class Morpher {
@@ -68,7 +70,8 @@ public:
             BlendSpec blend, MorphOptions options = {});
 
     /// The in-between at t in [0, 1]: grids `density` and `Cd` on the shared transform.
-    VolumeSet frame(double t, MorphStats* stats = nullptr, Interrupter* interrupter = nullptr) const;
+    VolumeSet frame(double t, MorphStats* stats = nullptr,
+                    Interrupter* interrupter = nullptr) const;
 
     /// The same, evaluated at every voxel of `box` (output index space) with no domain pruning and
     /// the given tolerance: the reference that tests compare frame() against.
@@ -83,13 +86,13 @@ public:
     const VolumeSet& target() const { return mTarget; }
 
 private:
-    VolumeSet run(double t, const openvdb::CoordBBox& box, bool prune, double tolerance, MorphStats* stats,
-                  Interrupter* interrupter) const;
-    VolumeSet runSdf(double t, const openvdb::CoordBBox& box, bool prune, double tolerance, MorphStats* stats,
-                     Interrupter* interrupter) const;
+    VolumeSet run(double t, const openvdb::CoordBBox& box, bool prune, double tolerance,
+                  MorphStats* stats, Interrupter* interrupter) const;
+    VolumeSet runSdf(double t, const openvdb::CoordBBox& box, bool prune, double tolerance,
+                     MorphStats* stats, Interrupter* interrupter) const;
     template <typename Sampler>
-    VolumeSet runSdf(double t, const openvdb::CoordBBox& box, bool prune, double tolerance, MorphStats* stats,
-                     Interrupter* interrupter) const;
+    VolumeSet runSdf(double t, const openvdb::CoordBBox& box, bool prune, double tolerance,
+                     MorphStats* stats, Interrupter* interrupter) const;
 
     VolumeSet mSource, mTarget;
     /// sdf mode: the source's and target's distances extended over both objects' box (see above).

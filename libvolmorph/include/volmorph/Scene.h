@@ -21,9 +21,9 @@ namespace volmorph {
 
 /// Object-to-world placement of a mesh: scale, then rotate about X, then Y, then Z, then translate.
 struct ObjectTransform {
-    Vec3d translate{0.0, 0.0, 0.0};   ///< world units
+    Vec3d translate{0.0, 0.0, 0.0}; ///< world units
     Vec3d rotateRadians{0.0, 0.0, 0.0};
-    Vec3d scale{1.0, 1.0, 1.0};       ///< uniform or per axis; every component > 0
+    Vec3d scale{1.0, 1.0, 1.0}; ///< uniform or per axis; every component > 0
 
     /// Column-vector convention p' = M p (OpenVDB stores it transposed: use transform() to apply).
     Mat4d matrix() const;
@@ -33,16 +33,16 @@ struct ObjectTransform {
 
 /// One side of the morph: a mesh file and how it is placed.
 struct ObjectSpec {
-    std::filesystem::path mesh;          ///< resolved against the scene file's folder
-    SourceLocation meshWhere;            ///< where `mesh` was written, for errors found on import
+    std::filesystem::path mesh; ///< resolved against the scene file's folder
+    SourceLocation meshWhere;   ///< where `mesh` was written, for errors found on import
     ObjectTransform transform;
-    std::optional<Vec3d> color;          ///< linear RGB; when absent, the mesh's vertex colours or grey
+    std::optional<Vec3d> color; ///< linear RGB; when absent, the mesh's vertex colours or grey
 };
 
 /// Voxel grid settings: exactly one of voxelSize and resolution is set by the file.
 struct VolumeSpec {
-    std::optional<double> voxelSize;     ///< world units
-    std::optional<int> resolution;       ///< voxels across the longest side of the larger object
+    std::optional<double> voxelSize; ///< world units
+    std::optional<int> resolution;   ///< voxels across the longest side of the larger object
 };
 
 enum class FeatureType { Point, Segment, Rectangle, Box };
@@ -53,25 +53,25 @@ const char* toString(FeatureType type);
 /// scale.x by scale.y in the xAxis-yAxis plane, a box scale.x by scale.y by scale.z; all centred on
 /// origin.
 struct FeatureElement {
-    Vec3d origin{0.0, 0.0, 0.0};         ///< world units
-    Vec3d xAxis{1.0, 0.0, 0.0};          ///< unit length; the frame is orthonormal and right-handed
+    Vec3d origin{0.0, 0.0, 0.0}; ///< world units
+    Vec3d xAxis{1.0, 0.0, 0.0};  ///< unit length; the frame is orthonormal and right-handed
     Vec3d yAxis{0.0, 1.0, 0.0};
     Vec3d zAxis{0.0, 0.0, 1.0};
-    Vec3d scale{1.0, 1.0, 1.0};          ///< world units, every component > 0
+    Vec3d scale{1.0, 1.0, 1.0}; ///< world units, every component > 0
 };
 
 struct FeaturePairSpec {
     FeatureType type = FeatureType::Point;
     FeatureElement source;
     FeatureElement target;
-    SourceLocation where;                ///< the [[pair]] header
+    SourceLocation where; ///< the [[pair]] header
 };
 
 enum class Weighting { InverseSquare, BeierNeely };
 
 struct WarpSpec {
-    double epsilon = 0.01;               ///< world units; w = (d + epsilon)^-2
-    double toleranceVoxels = 0.25;       ///< approximation error bound; 0 = exact warp
+    double epsilon = 0.01;         ///< world units; w = (d + epsilon)^-2
+    double toleranceVoxels = 0.25; ///< approximation error bound; 0 = exact warp
     Weighting weighting = Weighting::InverseSquare;
     /// Beier-Neely weights w = (len^p / (a + d))^b, used only with Weighting::BeierNeely.
     double a = 0.01, b = 2.0, p = 0.0;
@@ -81,10 +81,10 @@ struct WarpSpec {
 struct ScheduleSpec {
     enum class Kind { Linear, Smoothstep, Sigmoid, Curve };
     Kind kind = Kind::Linear;
-    double k = 8.0;                      ///< sigmoid steepness
+    double k = 8.0; ///< sigmoid steepness
     std::vector<std::pair<double, double>> points;
 
-    double evaluate(double t) const;     ///< t in [0, 1]
+    double evaluate(double t) const; ///< t in [0, 1]
     std::string str() const;
 };
 
@@ -96,8 +96,8 @@ struct BlendSpec {
     ScheduleSpec color;
     ScheduleSpec sdf;
     /// sdf mode: pieces of an in-between smaller than this many voxels, apart from its largest
-    /// piece, are dropped (dust that a distance blend leaves where the blended field has an isolated
-    /// minimum); 0 keeps everything.
+    /// piece, are dropped (dust that a distance blend leaves where the blended field has an
+    /// isolated minimum); 0 keeps everything.
     int minIslandVoxels = 27;
 };
 
@@ -115,9 +115,9 @@ struct CameraSpec {
     Vec3d eye{0.0, 0.0, 5.0};
     Vec3d lookat{0.0, 0.0, 0.0};
     Vec3d up{0.0, 1.0, 0.0};
-    double fovDegrees = 40.0;            ///< horizontal, perspective only
-    double orthoWidth = 2.0;             ///< world units, orthographic only
-    std::vector<CameraKey> keys;         ///< animation, by increasing frame; empty: still
+    double fovDegrees = 40.0;    ///< horizontal, perspective only
+    double orthoWidth = 2.0;     ///< world units, orthographic only
+    std::vector<CameraKey> keys; ///< animation, by increasing frame; empty: still
 
     /// The camera at `frame`: values interpolated linearly between the keys around it (up
     /// renormalized), held before the first key and after the last.
@@ -135,11 +135,11 @@ struct LightKey {
 
 struct LightSpec {
     LightType type = LightType::Directional;
-    Vec3d direction{0.0, -1.0, 0.0};     ///< directional: the way light travels (unit length)
-    Vec3d position{0.0, 0.0, 0.0};       ///< point: world units
+    Vec3d direction{0.0, -1.0, 0.0}; ///< directional: the way light travels (unit length)
+    Vec3d position{0.0, 0.0, 0.0};   ///< point: world units
     Vec3d color{1.0, 1.0, 1.0};
     double intensity = 1.0;
-    std::vector<LightKey> keys;          ///< animation, by increasing frame; empty: still
+    std::vector<LightKey> keys; ///< animation, by increasing frame; empty: still
 
     /// The light at `frame`: values interpolated linearly between the keys around it (direction
     /// renormalized), held before the first key and after the last.
@@ -147,16 +147,16 @@ struct LightSpec {
 };
 
 struct RenderSpec {
-    int width = 960, height = 540;       ///< pixels
-    int samples = 4;                     ///< jittered samples per pixel
-    double stepVoxels = 0.5;             ///< ray-march step
-    double extinction = 40.0;            ///< per world unit at density 1
-    double albedo = 0.8;                 ///< single-scattering albedo, 0..1
-    double anisotropy = 0.0;             ///< Henyey-Greenstein g, -1 < g < 1
-    Vec3d emission{0.0, 0.0, 0.0};       ///< radiance emitted per unit optical depth, linear RGB
+    int width = 960, height = 540; ///< pixels
+    int samples = 4;               ///< jittered samples per pixel
+    double stepVoxels = 0.5;       ///< ray-march step
+    double extinction = 40.0;      ///< per world unit at density 1
+    double albedo = 0.8;           ///< single-scattering albedo, 0..1
+    double anisotropy = 0.0;       ///< Henyey-Greenstein g, -1 < g < 1
+    Vec3d emission{0.0, 0.0, 0.0}; ///< radiance emitted per unit optical depth, linear RGB
     unsigned seed = 0;
     CameraSpec camera;
-    std::vector<LightSpec> lights;       ///< default: one directional light from above-front
+    std::vector<LightSpec> lights; ///< default: one directional light from above-front
 };
 
 /// The frames of the sequence. Frame f has t = (f - first) / (last - first); a single-frame
@@ -171,8 +171,8 @@ struct FramesSpec {
 };
 
 struct Scene {
-    std::filesystem::path file;          ///< the scene file as given
-    std::filesystem::path folder;        ///< paths in the file are relative to this
+    std::filesystem::path file;   ///< the scene file as given
+    std::filesystem::path folder; ///< paths in the file are relative to this
     ObjectSpec source, target;
     VolumeSpec volume;
     std::vector<FeaturePairSpec> pairs;

@@ -3,12 +3,13 @@
 //
 // An entry is one .vdb file, <folder>/<key>.vdb, holding the six grids of both sides, and the SHA-1
 // of its bytes in <folder>/<key>.sha1, checked before OpenVDB reads the entry. The key is
-// the SHA-1 of everything the voxels depend on: the cache format, the volmorph version and the bytes
-// of the running program (another build never reads this build's entries), the bytes of both mesh
-// files (not of files they reference, such as an OBJ's .mtl), both object transforms and colours, and the scene's [volume] settings. A changed
-// mesh or setting therefore misses; an entry that does not read back whole, lacks a grid or carries
-// another key is reported and rebuilt, never trusted. Entries are written atomically (temporary name,
-// then rename), so chunks racing to fill the same entry are safe.
+// the SHA-1 of everything the voxels depend on: the cache format, the volmorph version and the
+// bytes of the running program (another build never reads this build's entries), the bytes of both
+// mesh files (not of files they reference, such as an OBJ's .mtl), both object transforms and
+// colours, and the scene's [volume] settings. A changed mesh or setting therefore misses; an entry
+// that does not read back whole, lacks a grid or carries another key is reported and rebuilt, never
+// trusted. Entries are written atomically (temporary name, then rename), so chunks racing to fill
+// the same entry are safe.
 #pragma once
 
 #include <volmorph/core/Interrupter.h>
@@ -25,16 +26,16 @@ namespace volmorph {
 /// $HOME/.cache/volmorph; empty (no cache) when none of them is set.
 std::filesystem::path defaultCacheFolder();
 
-/// The cache key of `scene`'s voxels (40 hex digits). Reads both mesh files; throws UserError naming
-/// a mesh that cannot be read.
+/// The cache key of `scene`'s voxels (40 hex digits). Reads both mesh files; throws UserError
+/// naming a mesh that cannot be read.
 std::string voxelCacheKey(const Scene& scene);
 
 struct CacheReport {
     enum class Outcome { Disabled, Hit, Stored, Rebuilt };
     Outcome outcome = Outcome::Disabled;
-    std::filesystem::path entry;   ///< the entry's file, when the cache is enabled
-    std::string problem;           ///< why an existing entry was rebuilt
-    std::string storeProblem;      ///< why the new entry could not be stored (the run goes on)
+    std::filesystem::path entry; ///< the entry's file, when the cache is enabled
+    std::string problem;         ///< why an existing entry was rebuilt
+    std::string storeProblem;    ///< why the new entry could not be stored (the run goes on)
 };
 
 /// voxelizeScene() through the cache in `folder` (empty: no cache). On a hit the meshes are not

@@ -52,11 +52,11 @@ struct VoxelizeOptions {
 
 /// What voxelize() did, for logs and tests.
 struct VoxelizeStats {
-    double voxelSize = 0.0;             ///< world units
+    double voxelSize = 0.0; ///< world units
     bool usedWindingNumber = false;
     uint64_t estimatedBytes = 0;
     uint64_t sdfActiveVoxels = 0;
-    uint64_t densityActiveVoxels = 0;   ///< including voxels of active tiles
+    uint64_t densityActiveVoxels = 0; ///< including voxels of active tiles
 };
 
 /// The fog of a signed distance d (world units): smoothstep of -d across [-ramp, +ramp], 0.5 on

@@ -1,10 +1,10 @@
 // The inverse warp of feature-based volume morphing.
 //
-// For an output point p' and pair i with interpolated element e'_i: u = R'^T (p' - c') / s', and the
-// pair maps p' to p_i = c + R (u * s) on each side (an affine map). The warped point is
-// sum w_i p_i / sum w_i with w_i = (d(p', e'_i) + epsilon)^-2, or Beier-Neely's
-// (length^p / (a + d))^b. With no pairs the warp is the identity; at t = 0 the source side is the
-// identity, at t = 1 the target side.
+// For an output point p' and pair i with interpolated element e'_i: u = R'^T (p' - c') / s', and
+// the pair maps p' to p_i = c + R (u * s) on each side (an affine map). The warped point is sum w_i
+// p_i / sum w_i with w_i = (d(p', e'_i) + epsilon)^-2, or Beier-Neely's (length^p / (a + d))^b.
+// With no pairs the warp is the identity; at t = 0 the source side is the identity, at t = 1 the
+// target side.
 #pragma once
 
 #include <volmorph/Feature.h>
@@ -17,7 +17,8 @@ class InverseWarp {
 public:
     /// Pairs at time t. `unit` scales lengths: 1 for world units, 1 / voxel size for index space
     /// (the normalized weights do not depend on it; epsilon and a are scaled with it).
-    InverseWarp(const std::vector<FeaturePairSpec>& pairs, const WarpSpec& spec, double t, double unit = 1.0);
+    InverseWarp(const std::vector<FeaturePairSpec>& pairs, const WarpSpec& spec, double t,
+                double unit = 1.0);
 
     /// Below this, d + offset counts as zero: the point lies on an element and that pair alone
     /// decides (with several such pairs, their mean). Keeps every weight finite when epsilon = 0.
@@ -41,17 +42,20 @@ public:
 
     /// The affine map of pair i on each side, as p -> M p + b, for bounding the output domain.
     struct Affine {
-        Vec3d col[3];  ///< columns of M
-        Vec3d offset;  ///< b
-        Vec3d apply(const Vec3d& p) const { return col[0] * p.x() + col[1] * p.y() + col[2] * p.z() + offset; }
+        Vec3d col[3]; ///< columns of M
+        Vec3d offset; ///< b
+        Vec3d apply(const Vec3d& p) const
+        {
+            return col[0] * p.x() + col[1] * p.y() + col[2] * p.z() + offset;
+        }
     };
     Affine sourceAffine(size_t i) const;
     Affine targetAffine(size_t i) const;
 
 private:
     struct Pair {
-        Feature element;      ///< interpolated at t
-        Vec3d toSource[3];    ///< R_S diag(s_S / s') as columns: p_S = c_S + toSource * q
+        Feature element;   ///< interpolated at t
+        Vec3d toSource[3]; ///< R_S diag(s_S / s') as columns: p_S = c_S + toSource * q
         Vec3d toTarget[3];
         Vec3d sourceOrigin, targetOrigin;
         double lengthPow = 1; ///< length^p, Beier-Neely only
@@ -60,8 +64,10 @@ private:
     /// Pair's affine images on both sides of the point with frame coordinates q.
     static void images(const Pair& pair, const Vec3d& q, Vec3d& source, Vec3d& target)
     {
-        source = pair.sourceOrigin + pair.toSource[0] * q.x() + pair.toSource[1] * q.y() + pair.toSource[2] * q.z();
-        target = pair.targetOrigin + pair.toTarget[0] * q.x() + pair.toTarget[1] * q.y() + pair.toTarget[2] * q.z();
+        source = pair.sourceOrigin + pair.toSource[0] * q.x() + pair.toSource[1] * q.y() +
+                 pair.toSource[2] * q.z();
+        target = pair.targetOrigin + pair.toTarget[0] * q.x() + pair.toTarget[1] * q.y() +
+                 pair.toTarget[2] * q.z();
     }
 
     std::vector<Pair> mPairs;

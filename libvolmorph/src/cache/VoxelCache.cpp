@@ -55,12 +55,16 @@ const std::string& programDigest()
 void describe(std::ostream& s, const char* side, const ObjectSpec& o)
 {
     const ObjectTransform& x = o.transform;
-    s << side << " translate " << x.translate << " rotate " << x.rotateRadians << " scale " << x.scale;
+    s << side << " translate " << x.translate << " rotate " << x.rotateRadians << " scale "
+      << x.scale;
     if (o.color) s << " color " << *o.color;
     s << '\n';
 }
 
-std::string gridName(const char* side, const char* grid) { return std::string(side) + "." + grid; }
+std::string gridName(const char* side, const char* grid)
+{
+    return std::string(side) + "." + grid;
+}
 
 std::filesystem::path checksumFile(const std::filesystem::path& entry)
 {
@@ -94,15 +98,21 @@ std::string readEntry(const std::filesystem::path& path, const std::string& key,
                 if (!file.hasGrid(name)) return "grid " + name + " is missing";
                 openvdb::GridBase::Ptr g = file.readGrid(name);
                 g->setName(grid);
-                if (grid == kColorGridName) v.color = openvdb::gridPtrCast<openvdb::Vec3SGrid>(g);
-                else if (grid == kSdfGridName) v.sdf = openvdb::gridPtrCast<openvdb::FloatGrid>(g);
-                else v.density = openvdb::gridPtrCast<openvdb::FloatGrid>(g);
+                if (grid == kColorGridName)
+                    v.color = openvdb::gridPtrCast<openvdb::Vec3SGrid>(g);
+                else if (grid == kSdfGridName)
+                    v.sdf = openvdb::gridPtrCast<openvdb::FloatGrid>(g);
+                else
+                    v.density = openvdb::gridPtrCast<openvdb::FloatGrid>(g);
             }
-            if (!v.sdf || !v.density || !v.color) return "a grid of the " + std::string(side) + " has the wrong type";
-            if (v.sdf->getGridClass() != openvdb::GRID_LEVEL_SET) return "the " + std::string(side) + " sdf is not a level set";
+            if (!v.sdf || !v.density || !v.color)
+                return "a grid of the " + std::string(side) + " has the wrong type";
+            if (v.sdf->getGridClass() != openvdb::GRID_LEVEL_SET)
+                return "the " + std::string(side) + " sdf is not a level set";
         }
         file.close();
-        if (out.source.sdf->transform() != out.target.sdf->transform()) return "source and target grids disagree";
+        if (out.source.sdf->transform() != out.target.sdf->transform())
+            return "source and target grids disagree";
     } catch (const std::exception& e) {
         return std::string("it does not read back (") + e.what() + ")";
     }
@@ -131,12 +141,13 @@ void writeEntry(const std::filesystem::path& path, const std::string& key, const
     });
     // The checksum last: a reader that finds it can trust the entry it names.
     const std::string digest = fileDigest(path, SourceLocation{path.string()});
-    writeAtomically(checksumFile(path), "voxel cache checksum", [&](const std::filesystem::path& temporary) {
-        std::ofstream out(temporary);
-        out << digest << '\n';
-        out.close();
-        if (!out) throw std::runtime_error("write failed");
-    });
+    writeAtomically(checksumFile(path), "voxel cache checksum",
+                    [&](const std::filesystem::path& temporary) {
+                        std::ofstream out(temporary);
+                        out << digest << '\n';
+                        out.close();
+                        if (!out) throw std::runtime_error("write failed");
+                    });
 }
 
 } // namespace
@@ -144,8 +155,10 @@ void writeEntry(const std::filesystem::path& path, const std::string& key, const
 std::filesystem::path defaultCacheFolder()
 {
     if (const char* v = std::getenv("VOLMORPH_CACHE"); v && *v) return v;
-    if (const char* v = std::getenv("XDG_CACHE_HOME"); v && *v) return std::filesystem::path(v) / "volmorph";
-    if (const char* v = std::getenv("HOME"); v && *v) return std::filesystem::path(v) / ".cache" / "volmorph";
+    if (const char* v = std::getenv("XDG_CACHE_HOME"); v && *v)
+        return std::filesystem::path(v) / "volmorph";
+    if (const char* v = std::getenv("HOME"); v && *v)
+        return std::filesystem::path(v) / ".cache" / "volmorph";
     return {};
 }
 
@@ -164,8 +177,9 @@ std::string voxelCacheKey(const Scene& scene)
     return OIIO::SHA1::digest(s.str().data(), s.str().size());
 }
 
-SceneVolumes voxelizeSceneCached(const Scene& scene, const std::filesystem::path& folder, Interrupter* interrupter,
-                                 uint64_t memoryLimitBytes, CacheReport* report)
+SceneVolumes voxelizeSceneCached(const Scene& scene, const std::filesystem::path& folder,
+                                 Interrupter* interrupter, uint64_t memoryLimitBytes,
+                                 CacheReport* report)
 {
     CacheReport local;
     CacheReport& r = report ? *report : local;

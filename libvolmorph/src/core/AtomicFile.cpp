@@ -10,8 +10,8 @@ namespace volmorph {
 
 std::filesystem::path temporaryPathFor(const std::filesystem::path& path)
 {
-    return path.parent_path() /
-           (path.stem().string() + ".partial-" + std::to_string(long(getpid())) + path.extension().string());
+    return path.parent_path() / (path.stem().string() + ".partial-" +
+                                 std::to_string(long(getpid())) + path.extension().string());
 }
 
 void writeAtomically(const std::filesystem::path& path,
@@ -23,7 +23,9 @@ void writeAtomically(const std::filesystem::path& path,
         write(temporary);
         std::error_code ec;
         std::filesystem::rename(temporary, path, ec);
-        if (ec) failure = "cannot rename " + temporary.string() + " to " + path.string() + ": " + ec.message();
+        if (ec)
+            failure = "cannot rename " + temporary.string() + " to " + path.string() + ": " +
+                      ec.message();
     } catch (const std::exception& e) {
         failure = e.what();
         if (failure.empty()) failure = "write failed";
@@ -40,7 +42,8 @@ void writeAtomically(const std::filesystem::path& path, const std::string& what,
     try {
         writeAtomically(path, write);
     } catch (const std::runtime_error& e) {
-        throw UserError(SourceLocation{path.string()}, "cannot write " + what + " (" + e.what() + ")");
+        throw UserError(SourceLocation{path.string()},
+                        "cannot write " + what + " (" + e.what() + ")");
     }
 }
 

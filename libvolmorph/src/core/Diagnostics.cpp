@@ -15,7 +15,10 @@ std::string SourceLocation::str() const
     return s;
 }
 
-std::string Diagnostic::str() const { return where.str() + ": " + message; }
+std::string Diagnostic::str() const
+{
+    return where.str() + ": " + message;
+}
 
 namespace {
 std::string joined(const std::vector<Diagnostic>& diagnostics)

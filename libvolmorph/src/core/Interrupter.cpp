@@ -9,7 +9,8 @@ void Interrupter::start(const char* name)
     mName = name ? name : "";
     mLastPercent = -1;
     if (mLogStages && !mName.empty()) {
-        const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - mCreated).count();
+        const double seconds =
+            std::chrono::duration<double>(std::chrono::steady_clock::now() - mCreated).count();
         std::fprintf(stderr, "volmorph: %7.2f s  %s\n", seconds, mName.c_str());
         std::fflush(stderr);
     }

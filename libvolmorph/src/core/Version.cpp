@@ -2,6 +2,9 @@
 
 namespace volmorph {
 
-const char* versionString() { return VOLMORPH_VERSION_STRING; }
+const char* versionString()
+{
+    return VOLMORPH_VERSION_STRING;
+}
 
 } // namespace volmorph

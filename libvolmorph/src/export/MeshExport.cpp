@@ -31,14 +31,16 @@ Mesh surfaceMesh(const VolumeSet& volumes, double adaptivity)
     // other way from a level set's zero set, so check rather than assume.)
     double volume = 0.0;
     for (const Vec3I& t : mesh.triangles)
-        volume += Vec3d(mesh.points[t[0]]).dot(Vec3d(mesh.points[t[1]]).cross(Vec3d(mesh.points[t[2]])));
+        volume +=
+            Vec3d(mesh.points[t[0]]).dot(Vec3d(mesh.points[t[1]]).cross(Vec3d(mesh.points[t[2]])));
     if (volume < 0.0)
         for (Vec3I& t : mesh.triangles) std::swap(t[1], t[2]);
     if (volumes.color) {
         auto acc = volumes.color->getConstAccessor();
         mesh.colors.reserve(mesh.points.size());
         for (const Vec3f& p : mesh.points)
-            mesh.colors.push_back(openvdb::tools::BoxSampler::sample(acc, volumes.color->worldToIndex(Vec3d(p))));
+            mesh.colors.push_back(
+                openvdb::tools::BoxSampler::sample(acc, volumes.color->worldToIndex(Vec3d(p))));
     }
     mesh.report.inputTriangles = mesh.triangles.size();
     analyzeTopology(mesh);
@@ -52,7 +54,9 @@ void writeMesh(const Mesh& mesh, const std::filesystem::path& path)
     // indices out of range; measured). OBJ without a .mtl: a material file would be named after the
     // temporary file, and volmorph writes no materials.
     const char* format = ext == ".ply" ? "ply" : ext == ".obj" ? "objnomtl" : nullptr;
-    if (!format) throw UserError(SourceLocation{path.string()}, "expected a mesh file name ending in .ply or .obj");
+    if (!format)
+        throw UserError(SourceLocation{path.string()},
+                        "expected a mesh file name ending in .ply or .obj");
 
     // Assimp's scene owns its arrays and frees them with delete[].
     auto scene = std::make_unique<aiScene>();
@@ -60,9 +64,9 @@ void writeMesh(const Mesh& mesh, const std::filesystem::path& path)
     scene->mRootNode->mNumMeshes = 1;
     scene->mRootNode->mMeshes = new unsigned[1]{0};
     scene->mNumMaterials = 1;
-    scene->mMaterials = new aiMaterial*[1]{new aiMaterial()};
+    scene->mMaterials = new aiMaterial* [1] { new aiMaterial() };
     scene->mNumMeshes = 1;
-    scene->mMeshes = new aiMesh*[1]{new aiMesh()};
+    scene->mMeshes = new aiMesh* [1] { new aiMesh() };
     aiMesh& m = *scene->mMeshes[0];
     m.mMaterialIndex = 0;
     m.mPrimitiveTypes = aiPrimitiveType_TRIANGLE;
@@ -73,13 +77,15 @@ void writeMesh(const Mesh& mesh, const std::filesystem::path& path)
     if (mesh.hasColors()) {
         m.mColors[0] = new aiColor4D[m.mNumVertices];
         for (unsigned i = 0; i < m.mNumVertices; ++i)
-            m.mColors[0][i] = aiColor4D(mesh.colors[i].x(), mesh.colors[i].y(), mesh.colors[i].z(), 1.0f);
+            m.mColors[0][i] =
+                aiColor4D(mesh.colors[i].x(), mesh.colors[i].y(), mesh.colors[i].z(), 1.0f);
     }
     m.mNumFaces = unsigned(mesh.triangles.size());
     m.mFaces = new aiFace[m.mNumFaces];
     for (unsigned f = 0; f < m.mNumFaces; ++f) {
         m.mFaces[f].mNumIndices = 3;
-        m.mFaces[f].mIndices = new unsigned[3]{mesh.triangles[f][0], mesh.triangles[f][1], mesh.triangles[f][2]};
+        m.mFaces[f].mIndices =
+            new unsigned[3]{mesh.triangles[f][0], mesh.triangles[f][1], mesh.triangles[f][2]};
     }
 
     writeAtomically(path, "mesh", [&](const std::filesystem::path& temporary) {

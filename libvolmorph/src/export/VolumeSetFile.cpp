@@ -30,20 +30,24 @@ void writeVolumeSet(const VolumeSet& volumes, const std::filesystem::path& path,
 {
     initializeOpenVdb();
     openvdb::GridPtrVec grids;
-    for (openvdb::GridBase::Ptr g : {openvdb::GridBase::Ptr(volumes.sdf), openvdb::GridBase::Ptr(volumes.density),
-                                     openvdb::GridBase::Ptr(volumes.color)}) {
+    for (openvdb::GridBase::Ptr g :
+         {openvdb::GridBase::Ptr(volumes.sdf), openvdb::GridBase::Ptr(volumes.density),
+          openvdb::GridBase::Ptr(volumes.color)}) {
         if (!g) continue;
-        for (const auto& [key, value] : metadata) g->insertMeta(key, openvdb::StringMetadata(value));
+        for (const auto& [key, value] : metadata)
+            g->insertMeta(key, openvdb::StringMetadata(value));
         grids.push_back(g);
     }
     writeAtomically(path, "volume file", [&grids](const std::filesystem::path& temporary) {
-        detail::writeVdbChecked(temporary, openvdb::GridCPtrVec(grids.begin(), grids.end()), openvdb::MetaMap());
+        detail::writeVdbChecked(temporary, openvdb::GridCPtrVec(grids.begin(), grids.end()),
+                                openvdb::MetaMap());
     });
 }
 
 namespace detail {
 
-void writeVdbChecked(const std::filesystem::path& path, const openvdb::GridCPtrVec& grids, const openvdb::MetaMap& meta)
+void writeVdbChecked(const std::filesystem::path& path, const openvdb::GridCPtrVec& grids,
+                     const openvdb::MetaMap& meta)
 {
     std::ofstream out(path, std::ios::binary | std::ios::trunc);
     if (!out) throw std::runtime_error(std::strerror(errno));
@@ -55,7 +59,8 @@ void writeVdbChecked(const std::filesystem::path& path, const openvdb::GridCPtrV
     const int error = errno;
     out.close();
     if (!written || out.fail())
-        throw std::runtime_error(std::string("write failed: ") + (error ? std::strerror(error) : "unknown reason"));
+        throw std::runtime_error(std::string("write failed: ") +
+                                 (error ? std::strerror(error) : "unknown reason"));
 }
 
 } // namespace detail
@@ -69,13 +74,17 @@ VolumeSet readVolumeSet(const std::filesystem::path& path)
         file.open();
         for (auto it = file.beginName(); it != file.endName(); ++it) {
             const std::string name = it.gridName();
-            if (name == kSdfGridName) out.sdf = openvdb::gridPtrCast<openvdb::FloatGrid>(file.readGrid(name));
-            else if (name == kDensityGridName) out.density = openvdb::gridPtrCast<openvdb::FloatGrid>(file.readGrid(name));
-            else if (name == kColorGridName) out.color = openvdb::gridPtrCast<openvdb::Vec3SGrid>(file.readGrid(name));
+            if (name == kSdfGridName)
+                out.sdf = openvdb::gridPtrCast<openvdb::FloatGrid>(file.readGrid(name));
+            else if (name == kDensityGridName)
+                out.density = openvdb::gridPtrCast<openvdb::FloatGrid>(file.readGrid(name));
+            else if (name == kColorGridName)
+                out.color = openvdb::gridPtrCast<openvdb::Vec3SGrid>(file.readGrid(name));
         }
         file.close();
     } catch (const std::exception& e) {
-        throw UserError(SourceLocation{path.string()}, std::string("cannot read volume file (") + e.what() + ")");
+        throw UserError(SourceLocation{path.string()},
+                        std::string("cannot read volume file (") + e.what() + ")");
     }
     return out;
 }

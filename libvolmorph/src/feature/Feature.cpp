@@ -24,13 +24,17 @@ double Feature::distanceInFrame(const Vec3d& q) const
 {
     auto outside = [](double v, double half) { return std::max(std::abs(v) - half, 0.0); };
     switch (type) {
-    case FeatureType::Point: return q.length();
-    case FeatureType::Segment: return Vec3d(outside(q.x(), 0.5 * scale.x()), q.y(), q.z()).length();
+    case FeatureType::Point:
+        return q.length();
+    case FeatureType::Segment:
+        return Vec3d(outside(q.x(), 0.5 * scale.x()), q.y(), q.z()).length();
     case FeatureType::Rectangle:
-        return Vec3d(outside(q.x(), 0.5 * scale.x()), outside(q.y(), 0.5 * scale.y()), q.z()).length();
+        return Vec3d(outside(q.x(), 0.5 * scale.x()), outside(q.y(), 0.5 * scale.y()), q.z())
+            .length();
     case FeatureType::Box:
         return Vec3d(outside(q.x(), 0.5 * scale.x()), outside(q.y(), 0.5 * scale.y()),
-                     outside(q.z(), 0.5 * scale.z())).length();
+                     outside(q.z(), 0.5 * scale.z()))
+            .length();
     }
     return q.length();
 }
@@ -41,13 +45,17 @@ Vec3d Feature::gradientInFrame(const Vec3d& q, double d) const
     auto beyond = [](double v, double half) { return v - std::clamp(v, -half, half); };
     Vec3d v = q;
     switch (type) {
-    case FeatureType::Point: break;
-    case FeatureType::Segment: v = Vec3d(beyond(q.x(), 0.5 * scale.x()), q.y(), q.z()); break;
+    case FeatureType::Point:
+        break;
+    case FeatureType::Segment:
+        v = Vec3d(beyond(q.x(), 0.5 * scale.x()), q.y(), q.z());
+        break;
     case FeatureType::Rectangle:
         v = Vec3d(beyond(q.x(), 0.5 * scale.x()), beyond(q.y(), 0.5 * scale.y()), q.z());
         break;
     case FeatureType::Box:
-        v = Vec3d(beyond(q.x(), 0.5 * scale.x()), beyond(q.y(), 0.5 * scale.y()), beyond(q.z(), 0.5 * scale.z()));
+        v = Vec3d(beyond(q.x(), 0.5 * scale.x()), beyond(q.y(), 0.5 * scale.y()),
+                  beyond(q.z(), 0.5 * scale.z()));
         break;
     }
     v /= d;
@@ -57,10 +65,14 @@ Vec3d Feature::gradientInFrame(const Vec3d& q, double d) const
 double Feature::length() const
 {
     switch (type) {
-    case FeatureType::Point: return 1.0;
-    case FeatureType::Segment: return scale.x();
-    case FeatureType::Rectangle: return std::hypot(scale.x(), scale.y());
-    case FeatureType::Box: return scale.length();
+    case FeatureType::Point:
+        return 1.0;
+    case FeatureType::Segment:
+        return scale.x();
+    case FeatureType::Rectangle:
+        return std::hypot(scale.x(), scale.y());
+    case FeatureType::Box:
+        return scale.length();
     }
     return 1.0;
 }
@@ -69,10 +81,15 @@ std::vector<std::array<Vec3d, 2>> Feature::outline() const
 {
     // Corners in local coordinates u in {-1/2, 1/2}^3 (z = 0 for a rectangle), mapped by fromLocal.
     std::vector<std::array<Vec3d, 2>> edges;
-    auto edge = [this, &edges](const Vec3d& u0, const Vec3d& u1) { edges.push_back({fromLocal(u0), fromLocal(u1)}); };
+    auto edge = [this, &edges](const Vec3d& u0, const Vec3d& u1) {
+        edges.push_back({fromLocal(u0), fromLocal(u1)});
+    };
     switch (type) {
-    case FeatureType::Point: break;
-    case FeatureType::Segment: edge(Vec3d(-0.5, 0, 0), Vec3d(0.5, 0, 0)); break;
+    case FeatureType::Point:
+        break;
+    case FeatureType::Segment:
+        edge(Vec3d(-0.5, 0, 0), Vec3d(0.5, 0, 0));
+        break;
     case FeatureType::Rectangle:
         for (int i = 0; i < 4; ++i) {
             const double a[4][2] = {{-0.5, -0.5}, {0.5, -0.5}, {0.5, 0.5}, {-0.5, 0.5}};
@@ -80,7 +97,8 @@ std::vector<std::array<Vec3d, 2>> Feature::outline() const
         }
         break;
     case FeatureType::Box:
-        // The 12 edges: along each axis, the 4 parallel edges at the other two coordinates' corners.
+        // The 12 edges: along each axis, the 4 parallel edges at the other two coordinates'
+        // corners.
         for (int axis = 0; axis < 3; ++axis)
             for (int corner = 0; corner < 4; ++corner) {
                 Vec3d u0, u1;
@@ -123,7 +141,8 @@ openvdb::math::Quatd rotationQuaternion(const Vec3d& x, const Vec3d& y, const Ve
         // The largest diagonal entry i gives the component along axis i.
         const int i = m(0, 0) > m(1, 1) && m(0, 0) > m(2, 2) ? 0 : m(1, 1) > m(2, 2) ? 1 : 2;
         const int j = (i + 1) % 3, k = (i + 2) % 3;
-        const double v = 0.5 * std::sqrt(std::max(0.0, m(i, i) - m(j, j) - m(k, k) + 1.0)), f = 0.25 / v;
+        const double v = 0.5 * std::sqrt(std::max(0.0, m(i, i) - m(j, j) - m(k, k) + 1.0)),
+                     f = 0.25 / v;
         q[i] = v;
         q[j] = f * (m(i, j) + m(j, i));
         q[k] = f * (m(k, i) + m(i, k));

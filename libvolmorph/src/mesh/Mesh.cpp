@@ -105,9 +105,12 @@ void analyzeTopology(Mesh& mesh)
     }
     r.boundaryEdges = r.nonManifoldEdges = r.misorientedEdges = 0;
     for (const auto& [key, use] : edges) {
-        if (use.count == 1) ++r.boundaryEdges;
-        else if (use.count > 2) ++r.nonManifoldEdges;
-        else if (use.forward != 1) ++r.misorientedEdges;
+        if (use.count == 1)
+            ++r.boundaryEdges;
+        else if (use.count > 2)
+            ++r.nonManifoldEdges;
+        else if (use.forward != 1)
+            ++r.misorientedEdges;
     }
     std::vector<char> used(mesh.points.size(), 0);
     for (const Vec3I& tri : mesh.triangles)
@@ -146,7 +149,8 @@ RawMesh readWithAssimp(const std::filesystem::path& file)
             }
             why += (c >= 32 && c < 127) ? c : ' ';
         }
-        raw.error = "cannot read mesh (" + (why.empty() ? std::string("unknown reason") : why) + ")";
+        raw.error =
+            "cannot read mesh (" + (why.empty() ? std::string("unknown reason") : why) + ")";
         return raw;
     }
     if (scene->mFlags & AI_SCENE_FLAGS_INCOMPLETE) {
@@ -160,12 +164,15 @@ RawMesh readWithAssimp(const std::filesystem::path& file)
         const uint32_t base = uint32_t(raw.positions.size() / 3);
         for (unsigned v = 0; v < am->mNumVertices; ++v) {
             const aiVector3D& a = am->mVertices[v];
-            // A non-finite input stays non-finite (the transform could hide a NaN behind a 0 scale).
+            // A non-finite input stays non-finite (the transform could hide a NaN behind a 0
+            // scale).
             const bool finite = std::isfinite(a.x) && std::isfinite(a.y) && std::isfinite(a.z);
-            const aiVector3D w = finite ? node * a : aiVector3D(std::numeric_limits<float>::quiet_NaN());
+            const aiVector3D w =
+                finite ? node * a : aiVector3D(std::numeric_limits<float>::quiet_NaN());
             raw.positions.insert(raw.positions.end(), {w.x, w.y, w.z});
             if (anyColors) {
-                const aiColor4D c = am->HasVertexColors(0) ? am->mColors[0][v] : aiColor4D(0.8f, 0.8f, 0.8f, 1.0f);
+                const aiColor4D c =
+                    am->HasVertexColors(0) ? am->mColors[0][v] : aiColor4D(0.8f, 0.8f, 0.8f, 1.0f);
                 raw.colors.insert(raw.colors.end(), {c.r, c.g, c.b});
             }
         }
@@ -174,14 +181,16 @@ RawMesh readWithAssimp(const std::filesystem::path& file)
             const aiFace& face = am->mFaces[f];
             if (face.mNumIndices < 3) continue;
             bool inRange = true;
-            for (unsigned k = 0; k < face.mNumIndices; ++k) inRange = inRange && face.mIndices[k] < am->mNumVertices;
+            for (unsigned k = 0; k < face.mNumIndices; ++k)
+                inRange = inRange && face.mIndices[k] < am->mNumVertices;
             if (!inRange) {
                 raw.error = "face " + std::to_string(f + 1) + " names a vertex that does not exist";
                 return;
             }
             for (unsigned k = 1; k + 1 < face.mNumIndices; ++k)
-                raw.triangles.insert(raw.triangles.end(), {base + face.mIndices[0], base + face.mIndices[k],
-                                                           base + face.mIndices[k + 1]});
+                raw.triangles.insert(raw.triangles.end(),
+                                     {base + face.mIndices[0], base + face.mIndices[k],
+                                      base + face.mIndices[k + 1]});
         }
     };
     // Every mesh as often as the node hierarchy places it (what PreTransformVertices would do).
@@ -204,7 +213,8 @@ RawMesh readWithAssimp(const std::filesystem::path& file)
             stack.emplace_back(node->mChildren[c], xf * node->mChildren[c]->mTransformation);
     }
     if (placed == 0 && raw.error.empty()) // no node hierarchy: the meshes as stored
-        for (unsigned mi = 0; mi < scene->mNumMeshes; ++mi) addMesh(scene->mMeshes[mi], aiMatrix4x4());
+        for (unsigned mi = 0; mi < scene->mNumMeshes; ++mi)
+            addMesh(scene->mMeshes[mi], aiMatrix4x4());
     return raw;
 }
 
@@ -229,11 +239,13 @@ bool writeVector(int fd, const std::vector<T>& v)
 }
 
 /// Reads exactly `size` bytes before `deadline`; false on EOF, error or timeout.
-bool readAll(int fd, void* data, size_t size, std::chrono::steady_clock::time_point deadline, bool& timedOut)
+bool readAll(int fd, void* data, size_t size, std::chrono::steady_clock::time_point deadline,
+             bool& timedOut)
 {
     char* p = static_cast<char*>(data);
     while (size > 0) {
-        const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(deadline - std::chrono::steady_clock::now());
+        const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(
+            deadline - std::chrono::steady_clock::now());
         if (left.count() <= 0) {
             timedOut = true;
             return false;
@@ -253,10 +265,12 @@ bool readAll(int fd, void* data, size_t size, std::chrono::steady_clock::time_po
 }
 
 template <typename T>
-bool readVector(int fd, std::vector<T>& v, std::chrono::steady_clock::time_point deadline, bool& timedOut)
+bool readVector(int fd, std::vector<T>& v, std::chrono::steady_clock::time_point deadline,
+                bool& timedOut)
 {
     uint64_t n = 0;
-    if (!readAll(fd, &n, sizeof n, deadline, timedOut) || n > (uint64_t(1) << 34) / sizeof(T)) return false;
+    if (!readAll(fd, &n, sizeof n, deadline, timedOut) || n > (uint64_t(1) << 34) / sizeof(T))
+        return false;
     v.resize(size_t(n));
     return readAll(fd, v.data(), v.size() * sizeof(T), deadline, timedOut);
 }
@@ -286,16 +300,18 @@ RawMesh readIsolated(const std::filesystem::path& file, uintmax_t bytes)
     }
     ::close(fds[1]);
     const double limit = 5.0 + 2.0 * double(bytes) / 1e6;
-    const auto deadline = std::chrono::steady_clock::now() + std::chrono::milliseconds(long(limit * 1000.0));
+    const auto deadline =
+        std::chrono::steady_clock::now() + std::chrono::milliseconds(long(limit * 1000.0));
     bool timedOut = false;
     std::vector<char> error;
-    const bool ok = readVector(fds[0], error, deadline, timedOut) && readVector(fds[0], raw.positions, deadline, timedOut) &&
-                    readVector(fds[0], raw.colors, deadline, timedOut) && readVector(fds[0], raw.triangles, deadline, timedOut);
+    const bool ok = readVector(fds[0], error, deadline, timedOut) &&
+                    readVector(fds[0], raw.positions, deadline, timedOut) &&
+                    readVector(fds[0], raw.colors, deadline, timedOut) &&
+                    readVector(fds[0], raw.triangles, deadline, timedOut);
     ::close(fds[0]);
     if (!ok) ::kill(child, SIGKILL);
     int status = 0;
-    while (::waitpid(child, &status, 0) < 0 && errno == EINTR) {
-    }
+    while (::waitpid(child, &status, 0) < 0 && errno == EINTR) {}
     if (ok) {
         raw.error.assign(error.begin(), error.end());
         return raw;
@@ -303,12 +319,13 @@ RawMesh readIsolated(const std::filesystem::path& file, uintmax_t bytes)
     raw = RawMesh{};
     if (timedOut) {
         char text[160];
-        std::snprintf(text, sizeof text, "the mesh reader did not finish within %.0f s; the file is probably malformed",
-                      limit);
+        std::snprintf(
+            text, sizeof text,
+            "the mesh reader did not finish within %.0f s; the file is probably malformed", limit);
         raw.error = text;
     } else if (WIFSIGNALED(status)) {
-        raw.error = "the mesh reader (Assimp) crashed on this file (signal " + std::to_string(WTERMSIG(status)) +
-                    "); the file is probably malformed";
+        raw.error = "the mesh reader (Assimp) crashed on this file (signal " +
+                    std::to_string(WTERMSIG(status)) + "); the file is probably malformed";
     } else {
         raw.error = "the mesh reader (Assimp) failed on this file; it is probably malformed";
     }
@@ -326,8 +343,7 @@ Mesh importMesh(const std::filesystem::path& file, const ObjectTransform& transf
     if (!std::filesystem::is_regular_file(file, ec))
         throw UserError(place, pre + "mesh file not found or not a regular file");
     const uintmax_t bytes = std::filesystem::file_size(file, ec);
-    if (bytes == 0)
-        throw UserError(place, pre + "mesh file is empty");
+    if (bytes == 0) throw UserError(place, pre + "mesh file is empty");
 
     const RawMesh raw = readIsolated(file, bytes);
     if (!raw.error.empty()) throw UserError(place, pre + raw.error);
@@ -342,15 +358,19 @@ Mesh importMesh(const std::filesystem::path& file, const ObjectTransform& transf
     for (size_t v = 0; v < vertices; ++v) {
         const float* a = &raw.positions[3 * v];
         if (!std::isfinite(a[0]) || !std::isfinite(a[1]) || !std::isfinite(a[2]))
-            throw UserError(place, pre + "vertex " + std::to_string(v + 1) + " has a non-finite coordinate (NaN or inf)");
+            throw UserError(place, pre + "vertex " + std::to_string(v + 1) +
+                                       " has a non-finite coordinate (NaN or inf)");
         const Vec3d w = m.transform(Vec3d(a[0], a[1], a[2]));
         Vec3f p(float(w.x()) + 0.0f, float(w.y()) + 0.0f, float(w.z()) + 0.0f); // -0 -> +0
         if (!std::isfinite(p.x()) || !std::isfinite(p.y()) || !std::isfinite(p.z()))
-            throw UserError(place, pre + "vertex " + std::to_string(v + 1) + " is out of range after the transform");
+            throw UserError(place, pre + "vertex " + std::to_string(v + 1) +
+                                       " is out of range after the transform");
         const auto [it, inserted] = index.try_emplace(p, uint32_t(mesh.points.size()));
         if (inserted) {
             mesh.points.push_back(p);
-            if (anyColors) mesh.colors.emplace_back(raw.colors[3 * v], raw.colors[3 * v + 1], raw.colors[3 * v + 2]);
+            if (anyColors)
+                mesh.colors.emplace_back(raw.colors[3 * v], raw.colors[3 * v + 1],
+                                         raw.colors[3 * v + 2]);
         } else {
             ++mesh.report.duplicateVertices;
         }
@@ -358,9 +378,11 @@ Mesh importMesh(const std::filesystem::path& file, const ObjectTransform& transf
     }
     for (size_t t = 0; t + 2 < raw.triangles.size(); t += 3) {
         ++mesh.report.inputTriangles;
-        if (raw.triangles[t] >= vertices || raw.triangles[t + 1] >= vertices || raw.triangles[t + 2] >= vertices)
+        if (raw.triangles[t] >= vertices || raw.triangles[t + 1] >= vertices ||
+            raw.triangles[t + 2] >= vertices)
             throw UserError(place, pre + "a face names a vertex that does not exist");
-        const Vec3I tri(remap[raw.triangles[t]], remap[raw.triangles[t + 1]], remap[raw.triangles[t + 2]]);
+        const Vec3I tri(remap[raw.triangles[t]], remap[raw.triangles[t + 1]],
+                        remap[raw.triangles[t + 2]]);
         if (tri[0] == tri[1] || tri[1] == tri[2] || tri[0] == tri[2]) {
             ++mesh.report.degenerateTriangles;
             continue;
@@ -372,8 +394,7 @@ Mesh importMesh(const std::filesystem::path& file, const ObjectTransform& transf
         }
         mesh.triangles.push_back(tri);
     }
-    if (mesh.report.inputTriangles == 0)
-        throw UserError(place, pre + "the mesh has no triangles");
+    if (mesh.report.inputTriangles == 0) throw UserError(place, pre + "the mesh has no triangles");
     if (mesh.triangles.empty())
         throw UserError(place, pre + "every one of the mesh's " +
                                    std::to_string(mesh.report.inputTriangles) +

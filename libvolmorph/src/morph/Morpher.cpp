@@ -53,7 +53,8 @@ CoordBBox inverseImage(const InverseWarp::Affine& a, const CoordBBox& box)
     const openvdb::math::Mat3d inv = m.inverse();
     Vec3d lo(std::numeric_limits<double>::max()), hi(-std::numeric_limits<double>::max());
     for (int k = 0; k < 8; ++k) {
-        const Vec3d p((k & 1) ? box.max().x() : box.min().x(), (k & 2) ? box.max().y() : box.min().y(),
+        const Vec3d p((k & 1) ? box.max().x() : box.min().x(),
+                      (k & 2) ? box.max().y() : box.min().y(),
                       (k & 4) ? box.max().z() : box.min().z());
         const Vec3d d = p - a.offset;
         const Vec3d q(inv(0, 0) * d.x() + inv(0, 1) * d.y() + inv(0, 2) * d.z(),
@@ -63,8 +64,10 @@ CoordBBox inverseImage(const InverseWarp::Affine& a, const CoordBBox& box)
         hi = maxComponent(hi, q);
     }
     auto clampInt = [](double v) { return int(std::clamp(v, -1.0e8, 1.0e8)); };
-    return CoordBBox(Coord(clampInt(std::floor(lo.x())), clampInt(std::floor(lo.y())), clampInt(std::floor(lo.z()))),
-                     Coord(clampInt(std::ceil(hi.x())), clampInt(std::ceil(hi.y())), clampInt(std::ceil(hi.z()))));
+    return CoordBBox(Coord(clampInt(std::floor(lo.x())), clampInt(std::floor(lo.y())),
+                           clampInt(std::floor(lo.z()))),
+                     Coord(clampInt(std::ceil(hi.x())), clampInt(std::ceil(hi.y())),
+                           clampInt(std::ceil(hi.z()))));
 }
 
 /// Removes dust from the blended field before its band is rebuilt: face-connected pieces of the
@@ -93,9 +96,10 @@ size_t dropIslands(openvdb::FloatGrid& values, int minVoxels, float outside, int
         if (negative && !deepIsLarge) {
             mask = openvdb::tools::sdfInteriorMask(values, 0.0f)->treePtr();
         } else {
-            mask = std::make_shared<openvdb::BoolTree>(values.tree(), false, openvdb::TopologyCopy());
+            mask =
+                std::make_shared<openvdb::BoolTree>(values.tree(), false, openvdb::TopologyCopy());
             openvdb::tree::LeafManager<openvdb::BoolTree> leaves(*mask);
-            leaves.foreach([&values, negative](openvdb::BoolTree::LeafNodeType& leaf, size_t) {
+            leaves.foreach ([&values, negative](openvdb::BoolTree::LeafNodeType& leaf, size_t) {
                 const auto* source = values.tree().probeConstLeaf(leaf.origin());
                 if (!source) return;
                 const float* v = source->buffer().data();
@@ -105,7 +109,8 @@ size_t dropIslands(openvdb::FloatGrid& values, int minVoxels, float outside, int
                 leaf.setValueMask(leaf.getValueMask() & (negative ? sign : !sign));
             });
             if (negative)
-                for (auto it = values.tree().cbeginValueOff(); it && !anyDeep; ++it) anyDeep = *it < 0.0f;
+                for (auto it = values.tree().cbeginValueOff(); it && !anyDeep; ++it)
+                    anyDeep = *it < 0.0f;
         }
         std::vector<openvdb::BoolTree::Ptr> out;
         openvdb::tools::segmentActiveVoxels(*mask, out); // largest first
@@ -130,7 +135,8 @@ size_t dropIslands(openvdb::FloatGrid& values, int minVoxels, float outside, int
     std::vector<openvdb::BoolTree::Ptr> islands, gaps;
     tbb::parallel_invoke([&] { islands = pieces(true); }, [&] { gaps = pieces(false); });
     for (size_t i = anyDeep ? 0 : 1; i < islands.size(); ++i)
-        if (islands[i]->activeVoxelCount() < openvdb::Index64(minVoxels) && !(anyDeep && touchesDeep(*islands[i]))) {
+        if (islands[i]->activeVoxelCount() < openvdb::Index64(minVoxels) &&
+            !(anyDeep && touchesDeep(*islands[i]))) {
             set(*islands[i], outside);
             ++changed;
         }
@@ -169,7 +175,8 @@ typename Accessor::ValueType sample(Accessor& acc, const openvdb::Vec3R& p)
                 const openvdb::Index o = leaf->coordToOffset(ijk);
                 for (openvdb::Index i = 0; i < 2; ++i)
                     for (openvdb::Index j = 0; j < 2; ++j)
-                        for (openvdb::Index k = 0; k < 2; ++k) data[i][j][k] = leaf->getValue(o + (i << 6) + (j << 3) + k);
+                        for (openvdb::Index k = 0; k < 2; ++k)
+                            data[i][j][k] = leaf->getValue(o + (i << 6) + (j << 3) + k);
             } else {
                 const Value v = acc.getValue(ijk); // a tile or the background: one value for all 8
                 for (auto& plane : data)
@@ -189,13 +196,16 @@ struct ColorBlend {
     Vec3f background;
 
     ColorBlend(const VolumeSet& source, const VolumeSet& target, float tauColor, const Vec3f& bg)
-        : cs(source.color->getConstAccessor()), ct(target.color->getConstAccessor()), tau(tauColor), background(bg)
+        : cs(source.color->getConstAccessor()), ct(target.color->getConstAccessor()), tau(tauColor),
+          background(bg)
     {
     }
     /// ps, pt: the warped points; a, b: the densities there.
     Vec3f operator()(const openvdb::Vec3R& ps, const openvdb::Vec3R& pt, float a, float b)
     {
-        return mix(a, b, [&] { return Vec3f(sample<Sampler>(cs, ps)); }, [&] { return Vec3f(sample<Sampler>(ct, pt)); });
+        return mix(
+            a, b, [&] { return Vec3f(sample<Sampler>(cs, ps)); },
+            [&] { return Vec3f(sample<Sampler>(ct, pt)); });
     }
     /// The same at voxel ijk of both sides (the identity warp). Trilinear weights there are 1 and
     /// 0, so BoxSampler's value is the voxel's own: read it directly.
@@ -205,7 +215,8 @@ struct ColorBlend {
             const openvdb::Vec3R p(Vec3f(float(ijk.x()), float(ijk.y()), float(ijk.z())));
             return (*this)(p, p, a, b);
         } else {
-            return mix(a, b, [&] { return cs.getValue(ijk); }, [&] { return ct.getValue(ijk); });
+            return mix(
+                a, b, [&] { return cs.getValue(ijk); }, [&] { return ct.getValue(ijk); });
         }
     }
 
@@ -231,7 +242,8 @@ struct Resampler {
 
     /// Fills one output leaf pair with the blended density and colour. Returns false when the
     /// leaf holds nothing.
-    bool operator()(const detail::WarpLeaf& w, FloatTree::LeafNodeType& value, Vec3STree::LeafNodeType& color) const
+    bool operator()(const detail::WarpLeaf& w, FloatTree::LeafNodeType& value,
+                    Vec3STree::LeafNodeType& color) const
     {
         auto ds = source.density->getConstAccessor();
         auto dt = target.density->getConstAccessor();
@@ -273,57 +285,71 @@ public:
     static constexpr int kCoarse = 2;
     static constexpr float kNear = 2.0f, kFar = 2.9f; // voxels
 
-    ExtendedDistance(openvdb::FloatGrid::ConstPtr band, const CoordBBox& box) : mBand(std::move(band))
+    ExtendedDistance(openvdb::FloatGrid::ConstPtr band, const CoordBBox& box)
+        : mBand(std::move(band))
     {
         mVoxel = float(mBand->voxelSize()[0]);
         const float background = mBand->background();
         if (box.empty()) return;
         openvdb::FloatGrid::Ptr seeds = openvdb::FloatGrid::create(background);
-        seeds->setTransform(openvdb::math::Transform::createLinearTransform(kCoarse * double(mVoxel)));
+        seeds->setTransform(
+            openvdb::math::Transform::createLinearTransform(kCoarse * double(mVoxel)));
         seeds->setGridClass(openvdb::GRID_LEVEL_SET);
-        auto floorDiv = [](int v) { return v >= 0 ? v / kCoarse : -((-v + kCoarse - 1) / kCoarse); };
-        const CoordBBox coarse(Coord(floorDiv(box.min().x()), floorDiv(box.min().y()), floorDiv(box.min().z())),
-                               Coord(floorDiv(box.max().x()) + 1, floorDiv(box.max().y()) + 1,
-                                     floorDiv(box.max().z()) + 1));
+        auto floorDiv = [](int v) {
+            return v >= 0 ? v / kCoarse : -((-v + kCoarse - 1) / kCoarse);
+        };
+        const CoordBBox coarse(
+            Coord(floorDiv(box.min().x()), floorDiv(box.min().y()), floorDiv(box.min().z())),
+            Coord(floorDiv(box.max().x()) + 1, floorDiv(box.max().y()) + 1,
+                  floorDiv(box.max().z()) + 1));
         // Lattice values, in parallel over slabs of x one leaf thick; each slab fills its own tree,
         // and the slabs' leaves are disjoint, so merging moves nodes.
         const int x0 = coarse.min().x() & ~7, slabCount = (coarse.max().x() - x0) / 8 + 1;
         std::vector<openvdb::FloatTree::Ptr> slabs(static_cast<size_t>(slabCount));
-        tbb::parallel_for(tbb::blocked_range<int>(0, slabCount), [&](const tbb::blocked_range<int>& r) {
-            auto fine = mBand->getConstAccessor();
-            for (int i = r.begin(); i != r.end(); ++i) {
-                auto tree = std::make_shared<openvdb::FloatTree>(background);
-                openvdb::tree::ValueAccessor<openvdb::FloatTree> acc(*tree);
-                for (int x = std::max(x0 + 8 * i, coarse.min().x()); x <= std::min(x0 + 8 * i + 7, coarse.max().x()); ++x)
-                    for (int y = coarse.min().y(); y <= coarse.max().y(); ++y)
-                        for (int z = coarse.min().z(); z <= coarse.max().z(); ++z) {
-                            const Coord fineXyz(x * kCoarse, y * kCoarse, z * kCoarse);
-                            float value;
-                            if (fine.probeValue(fineXyz, value)) acc.setValueOn(Coord(x, y, z), value);
-                            else if (value < 0.0f) acc.setValueOff(Coord(x, y, z), -background);
-                        }
-                slabs[size_t(i)] = tree;
-            }
-        });
+        tbb::parallel_for(
+            tbb::blocked_range<int>(0, slabCount), [&](const tbb::blocked_range<int>& r) {
+                auto fine = mBand->getConstAccessor();
+                for (int i = r.begin(); i != r.end(); ++i) {
+                    auto tree = std::make_shared<openvdb::FloatTree>(background);
+                    openvdb::tree::ValueAccessor<openvdb::FloatTree> acc(*tree);
+                    for (int x = std::max(x0 + 8 * i, coarse.min().x());
+                         x <= std::min(x0 + 8 * i + 7, coarse.max().x()); ++x)
+                        for (int y = coarse.min().y(); y <= coarse.max().y(); ++y)
+                            for (int z = coarse.min().z(); z <= coarse.max().z(); ++z) {
+                                const Coord fineXyz(x * kCoarse, y * kCoarse, z * kCoarse);
+                                float value;
+                                if (fine.probeValue(fineXyz, value))
+                                    acc.setValueOn(Coord(x, y, z), value);
+                                else if (value < 0.0f)
+                                    acc.setValueOff(Coord(x, y, z), -background);
+                            }
+                    slabs[size_t(i)] = tree;
+                }
+            });
         for (const auto& slab : slabs) seeds->tree().merge(*slab, openvdb::MERGE_NODES);
         openvdb::tools::pruneLevelSet(seeds->tree());
         openvdb::BoolGrid mask(false);
         mask.setTransform(seeds->transform().copy());
         mask.sparseFill(coarse, true, true);
-        openvdb::FloatGrid::Ptr wide = openvdb::tools::maskSdf(*seeds, mask, /*ignoreActiveTiles*/ false, /*nIter*/ 1);
-        if (!wide) throw std::runtime_error("Morpher: fast sweeping could not extend a signed distance field");
+        openvdb::FloatGrid::Ptr wide =
+            openvdb::tools::maskSdf(*seeds, mask, /*ignoreActiveTiles*/ false, /*nIter*/ 1);
+        if (!wide)
+            throw std::runtime_error(
+                "Morpher: fast sweeping could not extend a signed distance field");
 
         // The coarse field, dense over its box for fast reads.
         DenseField& d = mCoarse;
         d.origin = coarse.min();
         d.dim = coarse.dim();
         d.values.resize(size_t(d.dim.x()) * d.dim.y() * d.dim.z());
-        tbb::parallel_for(tbb::blocked_range<int>(0, d.dim.x()), [&](const tbb::blocked_range<int>& r) {
-            auto acc = wide->getConstAccessor();
-            for (int x = r.begin(); x != r.end(); ++x)
-                for (int y = 0; y < d.dim.y(); ++y)
-                    for (int z = 0; z < d.dim.z(); ++z) d.values[d.index(x, y, z)] = acc.getValue(d.origin.offsetBy(x, y, z));
-        });
+        tbb::parallel_for(
+            tbb::blocked_range<int>(0, d.dim.x()), [&](const tbb::blocked_range<int>& r) {
+                auto acc = wide->getConstAccessor();
+                for (int x = r.begin(); x != r.end(); ++x)
+                    for (int y = 0; y < d.dim.y(); ++y)
+                        for (int z = 0; z < d.dim.z(); ++z)
+                            d.values[d.index(x, y, z)] = acc.getValue(d.origin.offsetBy(x, y, z));
+            });
 
         // How far the coarse field strays from the band where both are defined (voxels): over
         // the whole band, so that a point whose coarse value is beyond kFar + that needs no fine
@@ -339,11 +365,14 @@ public:
                     for (auto it = leaves[i]->cbeginValueOn(); it; ++it) {
                         const float e = std::abs(coarseAt(it.getCoord().asVec3d()) - *it);
                         worst.first = std::max(worst.first, e);
-                        if (std::abs(*it) >= kNear * mVoxel) worst.second = std::max(worst.second, e);
+                        if (std::abs(*it) >= kNear * mVoxel)
+                            worst.second = std::max(worst.second, e);
                     }
                 return worst;
             },
-            [](Errors a, Errors b) { return Errors(std::max(a.first, b.first), std::max(a.second, b.second)); });
+            [](Errors a, Errors b) {
+                return Errors(std::max(a.first, b.first), std::max(a.second, b.second));
+            });
         mCoarseError = errors.first / mVoxel;
         mTransitionError = errors.second / mVoxel;
     }
@@ -362,7 +391,8 @@ public:
         int i[3];
         float f[3];
         for (int k = 0; k < 3; ++k) {
-            const double c = std::clamp(p[k] * (1.0 / kCoarse) - d.origin[k], 0.0, double(d.dim[k] - 1));
+            const double c =
+                std::clamp(p[k] * (1.0 / kCoarse) - d.origin[k], 0.0, double(d.dim[k] - 1));
             i[k] = std::min(int(c), std::max(d.dim[k] - 2, 0));
             f[k] = float(c - i[k]);
         }
@@ -371,7 +401,8 @@ public:
         const float* v = d.values.data() + d.index(i[0], i[1], i[2]);
         auto lerp = [](float a, float b, float t) { return a + t * (b - a); };
         const float x00 = lerp(v[0], v[sx], f[0]), x10 = lerp(v[sy], v[sx + sy], f[0]);
-        const float x01 = lerp(v[sz], v[sx + sz], f[0]), x11 = lerp(v[sy + sz], v[sx + sy + sz], f[0]);
+        const float x01 = lerp(v[sz], v[sx + sz], f[0]),
+                    x11 = lerp(v[sy + sz], v[sx + sy + sz], f[0]);
         return lerp(lerp(x00, x10, f[1]), lerp(x01, x11, f[1]), f[2]);
     }
 
@@ -380,7 +411,8 @@ public:
     class Reader {
     public:
         explicit Reader(const ExtendedDistance& d)
-            : mD(d), mFine(d.mBand->getConstAccessor()), mSkipFine((kFar + d.mCoarseError + 0.5f) * d.mVoxel)
+            : mD(d), mFine(d.mBand->getConstAccessor()),
+              mSkipFine((kFar + d.mCoarseError + 0.5f) * d.mVoxel)
         {
         }
         /// The distance at p (fine index space), world units.
@@ -415,8 +447,8 @@ private:
     };
 
     openvdb::FloatGrid::ConstPtr mBand;
-    DenseField mCoarse;        ///< the extended coarse field over its box
-    float mCoarseError = 0.0f; ///< max |coarse - band| over the band's voxels, voxels
+    DenseField mCoarse;            ///< the extended coarse field over its box
+    float mCoarseError = 0.0f;     ///< max |coarse - band| over the band's voxels, voxels
     float mTransitionError = 0.0f; ///< the same where |band| >= kNear
     float mVoxel = 1.0f;
 };
@@ -455,8 +487,8 @@ public:
     /// The distances at the voxels of the leaf at `origin`: the kept ones, or computed with `a`
     /// and `b` (into `scratch` when they are not to be kept). `computed` counts the samples taken.
     template <typename Sampler>
-    const Leaf& get(const Coord& origin, ExtendedDistance::Reader<Sampler>& a, ExtendedDistance::Reader<Sampler>& b,
-                    Leaf& scratch, uint64_t& computed)
+    const Leaf& get(const Coord& origin, ExtendedDistance::Reader<Sampler>& a,
+                    ExtendedDistance::Reader<Sampler>& b, Leaf& scratch, uint64_t& computed)
     {
         const Coord leaf = origin >> 3;
         std::atomic<Leaf*>* slot = nullptr;
@@ -471,8 +503,10 @@ public:
         for (int i = 0; i < 8; ++i)
             for (int j = 0; j < 8; ++j)
                 for (int k = 0; k < 8; ++k) {
-                    // The point as the identity warp gives it (single precision, as WarpLeaf holds it).
-                    const openvdb::Vec3R p(Vec3f(float(origin.x() + i), float(origin.y() + j), float(origin.z() + k)));
+                    // The point as the identity warp gives it (single precision, as WarpLeaf holds
+                    // it).
+                    const openvdb::Vec3R p(
+                        Vec3f(float(origin.x() + i), float(origin.y() + j), float(origin.z() + k)));
                     const int n = (i * 8 + j) * 8 + k;
                     out.source[n] = a(p);
                     out.target[n] = b(p);
@@ -514,7 +548,8 @@ public:
                 for (int y = 0; y < n.y(); ++y)
                     for (int z = 0; z < n.z(); ++z) {
                         const Coord leaf = leaves.min().offsetBy(x, y, z);
-                        const openvdb::Vec3R centre(leaf.x() * 8 + 3.5, leaf.y() * 8 + 3.5, leaf.z() * 8 + 3.5);
+                        const openvdb::Vec3R centre(leaf.x() * 8 + 3.5, leaf.y() * 8 + 3.5,
+                                                    leaf.z() * 8 + 3.5);
                         const size_t i = (size_t(x) * n.y() + y) * n.z() + z;
                         c->source[i] = a(centre);
                         c->target[i] = b(centre);
@@ -547,8 +582,8 @@ struct BlockClasses {
     CoordBBox leaves;           ///< in leaf coordinates (index >> 3)
     std::vector<int8_t> kind;   ///< per leaf: 0 evaluate, +1 outside, -1 inside
     std::vector<float> stretch; ///< per leaf: G there
-    std::vector<float> band;    ///< per leaf: the compute band there (world units; SdfFrame::classify)
-    double maxStretch = 1.0;    ///< G over the box
+    std::vector<float> band; ///< per leaf: the compute band there (world units; SdfFrame::classify)
+    double maxStretch = 1.0; ///< G over the box
 
     size_t index(const Coord& leaf) const
     {
@@ -596,11 +631,13 @@ std::vector<float> neighbourhoodMax(const std::vector<float>& values, const Coor
 template <typename Sampler>
 class SdfFrame {
 public:
-    SdfFrame(const VolumeSet& source, const VolumeSet& target, const detail::ExtendedDistance& farSource,
-             const detail::ExtendedDistance& farTarget, const InverseWarp& warp, float tauSdf, float tauColor,
-             Vec3f background, double toleranceVoxels)
-        : mSource(source), mTarget(target), mFarSource(farSource), mFarTarget(farTarget), mWarp(warp), mTau(tauSdf),
-          mTauColor(tauColor), mBackground(background), mVoxel(float(source.voxelSize())),
+    SdfFrame(const VolumeSet& source, const VolumeSet& target,
+             const detail::ExtendedDistance& farSource, const detail::ExtendedDistance& farTarget,
+             const InverseWarp& warp, float tauSdf, float tauColor, Vec3f background,
+             double toleranceVoxels)
+        : mSource(source), mTarget(target), mFarSource(farSource), mFarTarget(farTarget),
+          mWarp(warp), mTau(tauSdf), mTauColor(tauColor), mBackground(background),
+          mVoxel(float(source.voxelSize())),
           mWidth(std::min(source.sdf->background(), target.sdf->background()) / mVoxel),
           // The extended fields' slack, and the approximated warp's error: leaves are judged with
           // the exact warp at their centres, their voxels evaluated with the approximated one
@@ -623,22 +660,26 @@ public:
         std::vector<Vec3d> ps, pt;
         if (identity) {
             const auto centres = identity->centres<Sampler>(box, mFarSource, mFarTarget);
-            for (size_t i = 0; i < count; ++i) blend[i] = (1.0f - mTau) * centres->source[i] + mTau * centres->target[i];
+            for (size_t i = 0; i < count; ++i)
+                blend[i] = (1.0f - mTau) * centres->source[i] + mTau * centres->target[i];
         } else {
             ps.resize(count);
             pt.resize(count);
-            tbb::parallel_for(tbb::blocked_range<int>(0, n.x()), [&](const tbb::blocked_range<int>& r) {
-                typename detail::ExtendedDistance::template Reader<Sampler> a(mFarSource), b(mFarTarget);
-                for (int x = r.begin(); x != r.end(); ++x)
-                    for (int y = 0; y < n.y(); ++y)
-                        for (int z = 0; z < n.z(); ++z) {
-                            const size_t i = index(x, y, z);
-                            const Coord leaf = c.leaves.min().offsetBy(x, y, z);
-                            const Vec3d centre(leaf.x() * 8 + 3.5, leaf.y() * 8 + 3.5, leaf.z() * 8 + 3.5);
-                            mWarp.map(centre, ps[i], pt[i]);
-                            blend[i] = (1.0f - mTau) * a(ps[i]) + mTau * b(pt[i]);
-                        }
-            });
+            tbb::parallel_for(
+                tbb::blocked_range<int>(0, n.x()), [&](const tbb::blocked_range<int>& r) {
+                    typename detail::ExtendedDistance::template Reader<Sampler> a(mFarSource),
+                        b(mFarTarget);
+                    for (int x = r.begin(); x != r.end(); ++x)
+                        for (int y = 0; y < n.y(); ++y)
+                            for (int z = 0; z < n.z(); ++z) {
+                                const size_t i = index(x, y, z);
+                                const Coord leaf = c.leaves.min().offsetBy(x, y, z);
+                                const Vec3d centre(leaf.x() * 8 + 3.5, leaf.y() * 8 + 3.5,
+                                                   leaf.z() * 8 + 3.5);
+                                mWarp.map(centre, ps[i], pt[i]);
+                                blend[i] = (1.0f - mTau) * a(ps[i]) + mTau * b(pt[i]);
+                            }
+                });
         }
         // The warp's stretch per leaf: the spectral norm of its Jacobian by differences between
         // neighbouring centres, the largest over the 3^3 neighbourhood, with a margin of 1.25 for
@@ -646,23 +687,31 @@ public:
         std::vector<float> stretch(count, 1.0f);
         if (mWarp.pairCount() > 0) {
             std::vector<float> own(count, 1.0f);
-            auto norm = [](const Vec3d& dx, const Vec3d& dy, const Vec3d& dz) { return detail::spectralNorm(dx, dy, dz) / 8.0; };
+            auto norm = [](const Vec3d& dx, const Vec3d& dy, const Vec3d& dz) {
+                return detail::spectralNorm(dx, dy, dz) / 8.0;
+            };
             auto diff = [&](const std::vector<Vec3d>& p, int x, int y, int z, int axis) {
                 Coord a(x, y, z), b(x, y, z);
-                if (b[axis] + 1 < n[axis]) b[axis] += 1;
-                else if (a[axis] > 0) a[axis] -= 1;
-                else return Vec3d(0.0);
+                if (b[axis] + 1 < n[axis])
+                    b[axis] += 1;
+                else if (a[axis] > 0)
+                    a[axis] -= 1;
+                else
+                    return Vec3d(0.0);
                 return p[index(b.x(), b.y(), b.z())] - p[index(a.x(), a.y(), a.z())];
             };
-            tbb::parallel_for(tbb::blocked_range<int>(0, n.x()), [&](const tbb::blocked_range<int>& r) {
-                for (int x = r.begin(); x != r.end(); ++x)
-                    for (int y = 0; y < n.y(); ++y)
-                        for (int z = 0; z < n.z(); ++z) {
-                            const double s = norm(diff(ps, x, y, z, 0), diff(ps, x, y, z, 1), diff(ps, x, y, z, 2));
-                            const double t = norm(diff(pt, x, y, z, 0), diff(pt, x, y, z, 1), diff(pt, x, y, z, 2));
-                            own[index(x, y, z)] = float((1.0 - mTau) * s + mTau * t);
-                        }
-            });
+            tbb::parallel_for(
+                tbb::blocked_range<int>(0, n.x()), [&](const tbb::blocked_range<int>& r) {
+                    for (int x = r.begin(); x != r.end(); ++x)
+                        for (int y = 0; y < n.y(); ++y)
+                            for (int z = 0; z < n.z(); ++z) {
+                                const double s = norm(diff(ps, x, y, z, 0), diff(ps, x, y, z, 1),
+                                                      diff(ps, x, y, z, 2));
+                                const double t = norm(diff(pt, x, y, z, 0), diff(pt, x, y, z, 1),
+                                                      diff(pt, x, y, z, 2));
+                                own[index(x, y, z)] = float((1.0 - mTau) * s + mTau * t);
+                            }
+                });
             stretch = neighbourhoodMax(own, n);
             for (float& g : stretch) g = std::max(1.0f, 1.25f * g);
         }
@@ -684,14 +733,18 @@ public:
         mPrune = prune;
         if (!prune) return;
         for (size_t i = 0; i < count; ++i)
-            if (!(std::abs(blend[i]) < limit(c.stretch[i], 3.5f * kSqrt3, c.band[i]))) c.kind[i] = blend[i] < 0.0f ? -1 : 1;
+            if (!(std::abs(blend[i]) < limit(c.stretch[i], 3.5f * kSqrt3, c.band[i])))
+                c.kind[i] = blend[i] < 0.0f ? -1 : 1;
     }
 
     /// Beyond this blend (world units) at a point, no voxel within `reach` voxels of it is in the
     /// compute band `band` (of the leaf that holds them): G reach, plus the slack of the extended
     /// fields' transition (where they pass from the band to the coarse field, they may change by
     /// up to the coarse error more than a distance does).
-    float limit(float stretch, float reach, float band) const { return (stretch * reach + mSlack) * mVoxel + band; }
+    float limit(float stretch, float reach, float band) const
+    {
+        return (stretch * reach + mSlack) * mVoxel + band;
+    }
 
     const BlockClasses& classes() const { return mClasses; }
     /// The widest compute band of the box (world units): beyond it, a value is outside every one.
@@ -706,7 +759,10 @@ public:
         bool on = false, inside = false, outside = false;
         /// -1 when every value is inside and none active, +1 when every value is outside and
         /// none active, 0 otherwise (keep the leaf).
-        int whole() const { return on ? 0 : (inside && !outside ? -1 : (outside && !inside ? 1 : 0)); }
+        int whole() const
+        {
+            return on ? 0 : (inside && !outside ? -1 : (outside && !inside ? 1 : 0));
+        }
     };
 
     /// The leaf's bands (world units): its compute band, and the band that is kept.
@@ -722,8 +778,9 @@ public:
     /// Blends voxel n from its two distances: active within the compute band, +/- the band
     /// (inactive) beyond it; its colour, colorAt(), within the band that is kept.
     template <typename ColorAt>
-    void blendVoxel(openvdb::Index n, float da, float db, const Bands& bands, FloatTree::LeafNodeType& value,
-                    Vec3STree::LeafNodeType& color, Seen& seen, const ColorAt& colorAt) const
+    void blendVoxel(openvdb::Index n, float da, float db, const Bands& bands,
+                    FloatTree::LeafNodeType& value, Vec3STree::LeafNodeType& color, Seen& seen,
+                    const ColorAt& colorAt) const
     {
         const float d = (1.0f - mTau) * da + mTau * db;
         seen.inside = seen.inside || d < 0.0f;
@@ -740,7 +797,8 @@ public:
     /// Fills one leaf: the blend within the compute band (active), +/- the compute band beyond
     /// (inactive); colour where the band may be. Returns -1 when every value is inside and none
     /// active, +1 when every value is outside and none active, 0 otherwise (keep the leaf).
-    int operator()(const detail::WarpLeaf& w, FloatTree::LeafNodeType& value, Vec3STree::LeafNodeType& color) const
+    int operator()(const detail::WarpLeaf& w, FloatTree::LeafNodeType& value,
+                   Vec3STree::LeafNodeType& color) const
     {
         typename detail::ExtendedDistance::template Reader<Sampler> a(mFarSource), b(mFarTarget);
         ColorBlend<Sampler> colors(mSource, mTarget, mTauColor, mBackground);
@@ -762,14 +820,16 @@ public:
             const float v = d < 0.0f ? -bands.compute : bands.compute;
             for (int i = x0; i < x0 + size; ++i)
                 for (int j = y0; j < y0 + size; ++j)
-                    for (int k = z0; k < z0 + size; ++k) value.setValueOff(openvdb::Index((i * 8 + j) * 8 + k), v);
+                    for (int k = z0; k < z0 + size; ++k)
+                        value.setValueOff(openvdb::Index((i * 8 + j) * 8 + k), v);
             (d < 0.0f ? seen.inside : seen.outside) = true;
         };
         for (int q = 0; q < 8; ++q) {
             const int qx = (q & 1) * 4, qy = ((q >> 1) & 1) * 4, qz = ((q >> 2) & 1) * 4;
             if (mPrune) {
                 const openvdb::Index c = ((qx + 2) * 8 + qy + 2) * 8 + qz + 2;
-                const float d = (1.0f - mTau) * a(openvdb::Vec3R(w.source(c))) + mTau * b(openvdb::Vec3R(w.target(c)));
+                const float d = (1.0f - mTau) * a(openvdb::Vec3R(w.source(c))) +
+                                mTau * b(openvdb::Vec3R(w.target(c)));
                 ++samples;
                 if (!(std::abs(d) < quarterLimit)) {
                     fill(qx, qy, qz, 4, d);
@@ -777,15 +837,18 @@ public:
                 }
             }
             for (int bq = 0; bq < 8; ++bq) {
-                const int bx = qx + (bq & 1) * 2, by = qy + ((bq >> 1) & 1) * 2, bz = qz + ((bq >> 2) & 1) * 2;
+                const int bx = qx + (bq & 1) * 2, by = qy + ((bq >> 1) & 1) * 2,
+                          bz = qz + ((bq >> 2) & 1) * 2;
                 if (mPrune) {
                     Vec3f ms(0.0f), mt(0.0f);
                     for (int v = 0; v < 8; ++v) {
-                        const openvdb::Index n = openvdb::Index(((bx + (v & 1)) * 8 + by + ((v >> 1) & 1)) * 8 + bz + (v >> 2));
+                        const openvdb::Index n = openvdb::Index(
+                            ((bx + (v & 1)) * 8 + by + ((v >> 1) & 1)) * 8 + bz + (v >> 2));
                         ms += w.source(n);
                         mt += w.target(n);
                     }
-                    const float d = (1.0f - mTau) * a(openvdb::Vec3R(ms * 0.125f)) + mTau * b(openvdb::Vec3R(mt * 0.125f));
+                    const float d = (1.0f - mTau) * a(openvdb::Vec3R(ms * 0.125f)) +
+                                    mTau * b(openvdb::Vec3R(mt * 0.125f));
                     ++samples;
                     if (!(std::abs(d) < blockLimit)) {
                         fill(bx, by, bz, 2, d);
@@ -823,7 +886,8 @@ public:
         for (openvdb::Index n = 0; n < 512; ++n) {
             const float da = distances.source[n], db = distances.target[n];
             blendVoxel(n, da, db, bands, value, color, seen, [&] {
-                return colors.atVoxel(origin + value.offsetToLocalCoord(n), fogRamp(da, ramp), fogRamp(db, ramp));
+                return colors.atVoxel(origin + value.offsetToLocalCoord(n), fogRamp(da, ramp),
+                                      fogRamp(db, ramp));
             });
         }
         return seen.whole();
@@ -850,13 +914,14 @@ public:
         // where there is none (a tile), through an accessor. Only the aux buffers are written
         // here, so every read sees the blend.
         const float inv2dx = float(0.5 / values.voxelSize()[0]);
-        leaves.foreach([&](Leaf& leaf, size_t index) {
+        leaves.foreach ([&](Leaf& leaf, size_t index) {
             auto acc = values.getConstAccessor();
             const Coord origin = leaf.origin();
             // Per face (+x, -x, +y, -y, +z, -z): the neighbouring leaf's values, and the step of
             // the voxel index inside a leaf and across the face.
             const float* across[6];
-            constexpr int kStep[6] = {64, -64, 8, -8, 1, -1}, kWrap[6] = {-448, 448, -56, 56, -7, 7};
+            constexpr int kStep[6] = {64, -64, 8, -8, 1, -1},
+                          kWrap[6] = {-448, 448, -56, 56, -7, 7};
             for (int f = 0; f < 6; ++f) {
                 const int axis = f / 2, sign = f % 2 ? -1 : 1;
                 Coord o = origin;
@@ -865,8 +930,9 @@ public:
                 across[f] = next ? next->buffer().data() : nullptr;
             }
             // Only voxels within the leaf's kept band can come within the width of the zero set.
-            const float keep = mClasses.leaves.isInside(origin >> size_t(3)) ? bandsAt(origin).keep
-                                                                             : float(mClasses.maxStretch) * width;
+            const float keep = mClasses.leaves.isInside(origin >> size_t(3))
+                                   ? bandsAt(origin).keep
+                                   : float(mClasses.maxStretch) * width;
             const float* in = leaf.buffer().data();
             float* out = leaves.getBuffer(index, 1).data();
             auto fog = std::make_unique<Leaf>(origin, 0.0f, false);
@@ -879,8 +945,10 @@ public:
                     float e[6]; // +x, -x, +y, -y, +z, -z
                     for (int f = 0; f < 6; ++f) {
                         const int c = ijk[f / 2];
-                        if (f % 2 ? c > 0 : c < 7) e[f] = in[int(n) + kStep[f]];
-                        else if (across[f]) e[f] = across[f][int(n) + kWrap[f]];
+                        if (f % 2 ? c > 0 : c < 7)
+                            e[f] = in[int(n) + kStep[f]];
+                        else if (across[f])
+                            e[f] = across[f][int(n) + kWrap[f]];
                         else {
                             Coord q = origin.offsetBy(ijk[0], ijk[1], ijk[2]);
                             q[f / 2] += f % 2 ? -1 : 1;
@@ -891,7 +959,9 @@ public:
                     const float g = gradient.length(); // world-space, 1 for a distance
                     if (g > 1e-6f) dist = std::abs(b) / g;
                     for (float v : e)
-                        if ((v < 0.0f) != (b < 0.0f)) dist = std::min(dist, mVoxel * std::abs(b) / (std::abs(b) + std::abs(v)));
+                        if ((v < 0.0f) != (b < 0.0f))
+                            dist =
+                                std::min(dist, mVoxel * std::abs(b) / (std::abs(b) + std::abs(v)));
                     dist = std::min(dist, width);
                 }
                 const float d = b < 0.0f ? -dist : dist;
@@ -904,7 +974,7 @@ public:
             fogs[index] = std::move(fog);
         });
         leaves.swapLeafBuffer(1);
-        leaves.foreach([&bands](Leaf& leaf, size_t index) { leaf.setValueMask(bands[index]); });
+        leaves.foreach ([&bands](Leaf& leaf, size_t index) { leaf.setValueMask(bands[index]); });
         // Every leaf value is now in the band or +/- the width. Inactive tiles hold +/- the width
         // already (the grid was made so); active ones, if any, are deep inside or outside and
         // become so too. The tiles inside are the fog's interior tiles: they are looked for in
@@ -914,7 +984,8 @@ public:
         for (auto& leaf : fogs) fog.addLeaf(leaf.release());
         FloatTree& tree = values.tree();
         if (!openvdb::math::isExactlyEqual(tree.background(), width))
-            throw std::logic_error("SdfFrame::redistance: the grid's background must be the band's width");
+            throw std::logic_error(
+                "SdfFrame::redistance: the grid's background must be the band's width");
         auto active = tree.beginValueOn();
         active.setMaxDepth(active.getLeafDepth() - 1);
         for (; active; ++active) {
@@ -947,9 +1018,9 @@ private:
     const InverseWarp& mWarp;
     float mTau, mTauColor;
     Vec3f mBackground;
-    float mVoxel;  ///< world units
-    float mWidth;  ///< the output band's half width, voxels
-    float mSlack;  ///< voxels
+    float mVoxel;              ///< world units
+    float mWidth;              ///< the output band's half width, voxels
+    float mSlack;              ///< voxels
     float mComputeBand = 0.0f; ///< the widest compute band (world units)
     bool mPrune = true;
     BlockClasses mClasses;
@@ -958,9 +1029,8 @@ private:
 
 } // namespace
 
-
-Morpher::Morpher(VolumeSet source, VolumeSet target, std::vector<FeaturePairSpec> pairs, WarpSpec warp,
-                 BlendSpec blend, MorphOptions options)
+Morpher::Morpher(VolumeSet source, VolumeSet target, std::vector<FeaturePairSpec> pairs,
+                 WarpSpec warp, BlendSpec blend, MorphOptions options)
     : mSource(std::move(source)), mTarget(std::move(target)), mPairs(std::move(pairs)), mWarp(warp),
       mBlend(std::move(blend)), mOptions(options)
 {
@@ -983,14 +1053,21 @@ Morpher::Morpher(VolumeSet source, VolumeSet target, std::vector<FeaturePairSpec
             // underestimates a distance outside: leaves there are judged, if anything, too near
             // (4 voxels: 15% more leaves evaluated, for a setup hardly cheaper).
             const Coord dim = box.dim();
-            const int margin = mPairs.empty() ? 8 : std::max(8, std::max({dim.x(), dim.y(), dim.z()}) / 8);
+            const int margin =
+                mPairs.empty() ? 8 : std::max(8, std::max({dim.x(), dim.y(), dim.z()}) / 8);
             box.expand(margin);
         }
         // Both at once: fast sweeping is partly serial.
-        tbb::parallel_invoke([&] { mFarSource = std::make_shared<const detail::ExtendedDistance>(mSource.sdf, box); },
-                             [&] { mFarTarget = std::make_shared<const detail::ExtendedDistance>(mTarget.sdf, box); });
+        tbb::parallel_invoke(
+            [&] {
+                mFarSource = std::make_shared<const detail::ExtendedDistance>(mSource.sdf, box);
+            },
+            [&] {
+                mFarTarget = std::make_shared<const detail::ExtendedDistance>(mTarget.sdf, box);
+            });
         if (mPairs.empty()) {
-            const uint64_t limit = mOptions.memoryLimitBytes ? mOptions.memoryLimitBytes : defaultMemoryLimitBytes();
+            const uint64_t limit =
+                mOptions.memoryLimitBytes ? mOptions.memoryLimitBytes : defaultMemoryLimitBytes();
             mIdentity = std::make_shared<detail::IdentityDistances>(
                 candidateBounds(0.0), size_t(limit / 4 / sizeof(detail::IdentityDistances::Leaf)));
         }
@@ -1023,7 +1100,8 @@ VolumeSet Morpher::frame(double t, MorphStats* stats, Interrupter* interrupter) 
     return run(t, candidateBounds(t), true, mWarp.toleranceVoxels, stats, interrupter);
 }
 
-VolumeSet Morpher::frameOverBox(double t, const CoordBBox& box, double tolerance, MorphStats* stats) const
+VolumeSet Morpher::frameOverBox(double t, const CoordBBox& box, double tolerance,
+                                MorphStats* stats) const
 {
     return run(t, box, false, tolerance, stats, nullptr);
 }
@@ -1037,7 +1115,8 @@ class LeafCollector {
 public:
     LeafCollector(double t, uint64_t limitBytes, Vec3f background)
         : mT(t), mLimit(limitBytes ? limitBytes : defaultMemoryLimitBytes()),
-          mMaxLeaves(size_t(std::max<uint64_t>(1, mLimit / kMorphBytesPerLeaf))), mBackground(background)
+          mMaxLeaves(size_t(std::max<uint64_t>(1, mLimit / kMorphBytesPerLeaf))),
+          mBackground(background)
     {
     }
     ~LeafCollector()
@@ -1058,16 +1137,19 @@ public:
                 std::make_unique<Vec3STree::LeafNodeType>(origin, mBackground, false)};
     }
 
-    void keep(std::unique_ptr<FloatTree::LeafNodeType> value, std::unique_ptr<Vec3STree::LeafNodeType> color)
+    void keep(std::unique_ptr<FloatTree::LeafNodeType> value,
+              std::unique_ptr<Vec3STree::LeafNodeType> color)
     {
         std::lock_guard<std::mutex> lock(mMutex);
         if (mLeaves.size() >= mMaxLeaves) {
             char text[300];
-            std::snprintf(text, sizeof text,
-                          "the in-between at t = %.4f needs more than the memory limit of %.1f GiB (over %zu "
-                          "blocks of 8^3 voxels); use a larger voxel size, check the feature pairs' scales, or "
-                          "raise --memory-limit (default: half the machine's memory)",
-                          mT, double(mLimit) / double(1ull << 30), mMaxLeaves);
+            std::snprintf(
+                text, sizeof text,
+                "the in-between at t = %.4f needs more than the memory limit of %.1f GiB (over %zu "
+                "blocks of 8^3 voxels); use a larger voxel size, check the feature pairs' scales, "
+                "or "
+                "raise --memory-limit (default: half the machine's memory)",
+                mT, double(mLimit) / double(1ull << 30), mMaxLeaves);
             throw UserError(SourceLocation{"morph"}, text);
         }
         mLeaves.emplace_back(value.release(), color.release());
@@ -1124,8 +1206,8 @@ void finish(VolumeSet& out, const openvdb::math::Transform& xform, MorphStats* s
 
 } // namespace
 
-VolumeSet Morpher::run(double t, const CoordBBox& box, bool prune, double tolerance, MorphStats* stats,
-                       Interrupter* interrupter) const
+VolumeSet Morpher::run(double t, const CoordBBox& box, bool prune, double tolerance,
+                       MorphStats* stats, Interrupter* interrupter) const
 {
     if (mBlend.mode == BlendMode::Sdf) return runSdf(t, box, prune, tolerance, stats, interrupter);
     const double voxel = mSource.voxelSize();
@@ -1134,7 +1216,8 @@ VolumeSet Morpher::run(double t, const CoordBBox& box, bool prune, double tolera
     const detail::Occupancy* occS = prune ? mSourceBlocks.get() : nullptr;
     const detail::Occupancy* occT = prune ? mTargetBlocks.get() : nullptr;
     const float tauD = float(mBlend.density.evaluate(t)), tauC = float(mBlend.color.evaluate(t));
-    const Vec3f background = (1.0f - tauC) * mSource.color->background() + tauC * mTarget.color->background();
+    const Vec3f background =
+        (1.0f - tauC) * mSource.color->background() + tauC * mTarget.color->background();
 
     LeafCollector leaves(t, mOptions.memoryLimitBytes, background);
     auto each = [&](auto resampler) {
@@ -1145,14 +1228,15 @@ VolumeSet Morpher::run(double t, const CoordBBox& box, bool prune, double tolera
     };
     detail::AdaptiveWarpStats warpStats;
     if (mOptions.sampling == MorphOptions::Sampling::Triquadratic)
+        adaptive.forEachLeaf(box, occS, occT,
+                             each(Resampler<openvdb::tools::QuadraticSampler>{
+                                 mSource, mTarget, tauD, tauC, background}),
+                             &warpStats, interrupter);
+    else
         adaptive.forEachLeaf(
             box, occS, occT,
-            each(Resampler<openvdb::tools::QuadraticSampler>{mSource, mTarget, tauD, tauC, background}), &warpStats,
-            interrupter);
-    else
-        adaptive.forEachLeaf(box, occS, occT,
-                             each(Resampler<openvdb::tools::BoxSampler>{mSource, mTarget, tauD, tauC, background}),
-                             &warpStats, interrupter);
+            each(Resampler<openvdb::tools::BoxSampler>{mSource, mTarget, tauD, tauC, background}),
+            &warpStats, interrupter);
 
     VolumeSet out;
     out.density = openvdb::FloatGrid::create(0.0f);
@@ -1164,17 +1248,18 @@ VolumeSet Morpher::run(double t, const CoordBBox& box, bool prune, double tolera
     return out;
 }
 
-VolumeSet Morpher::runSdf(double t, const CoordBBox& box, bool prune, double tolerance, MorphStats* stats,
-                          Interrupter* interrupter) const
+VolumeSet Morpher::runSdf(double t, const CoordBBox& box, bool prune, double tolerance,
+                          MorphStats* stats, Interrupter* interrupter) const
 {
     if (mOptions.sampling == MorphOptions::Sampling::Triquadratic)
-        return runSdf<openvdb::tools::QuadraticSampler>(t, box, prune, tolerance, stats, interrupter);
+        return runSdf<openvdb::tools::QuadraticSampler>(t, box, prune, tolerance, stats,
+                                                        interrupter);
     return runSdf<openvdb::tools::BoxSampler>(t, box, prune, tolerance, stats, interrupter);
 }
 
 template <typename Sampler>
-VolumeSet Morpher::runSdf(double t, const CoordBBox& box, bool prune, double tolerance, MorphStats* stats,
-                          Interrupter* interrupter) const
+VolumeSet Morpher::runSdf(double t, const CoordBBox& box, bool prune, double tolerance,
+                          MorphStats* stats, Interrupter* interrupter) const
 {
     // The blend of two warped, extended distances has the right zero set but is no distance
     // field. It is evaluated only in the leaves that can hold its band (SdfFrame::classify; the
@@ -1184,11 +1269,14 @@ VolumeSet Morpher::runSdf(double t, const CoordBBox& box, bool prune, double tol
     const InverseWarp warp(mPairs, mWarp, t, 1.0 / voxel);
     const detail::AdaptiveWarp adaptive(warp, tolerance);
     const float tauC = float(mBlend.color.evaluate(t)), tauS = float(mBlend.sdf.evaluate(t));
-    const Vec3f background = (1.0f - tauC) * mSource.color->background() + tauC * mTarget.color->background();
+    const Vec3f background =
+        (1.0f - tauC) * mSource.color->background() + tauC * mTarget.color->background();
 
-    SdfFrame<Sampler> blend(mSource, mTarget, *mFarSource, *mFarTarget, warp, tauS, tauC, background, tolerance);
+    SdfFrame<Sampler> blend(mSource, mTarget, *mFarSource, *mFarTarget, warp, tauS, tauC,
+                            background, tolerance);
     // With no pairs (and pruning), distances are read from those kept across frames.
-    detail::IdentityDistances* const keptDistances = prune && warp.pairCount() == 0 ? mIdentity.get() : nullptr;
+    detail::IdentityDistances* const keptDistances =
+        prune && warp.pairCount() == 0 ? mIdentity.get() : nullptr;
     blend.classify(box, prune, keptDistances);
     const float band = blend.computeBand();
     LeafCollector leaves(t, mOptions.memoryLimitBytes, background);
@@ -1198,8 +1286,10 @@ VolumeSet Morpher::runSdf(double t, const CoordBBox& box, bool prune, double tol
         for (int y = classes.leaves.min().y(); y <= classes.leaves.max().y(); ++y)
             for (int z = classes.leaves.min().z(); z <= classes.leaves.max().z(); ++z) {
                 const int8_t kind = classes.at(Coord(x, y, z));
-                if (kind < 0) leaves.insideTile(Coord(x * 8, y * 8, z * 8));
-                else if (kind == 0 && keptDistances) evaluate.emplace_back(x * 8, y * 8, z * 8);
+                if (kind < 0)
+                    leaves.insideTile(Coord(x * 8, y * 8, z * 8));
+                else if (kind == 0 && keptDistances)
+                    evaluate.emplace_back(x * 8, y * 8, z * 8);
             }
     const detail::AdaptiveWarp::CellFilter wanted = [&classes](const CoordBBox& cells) {
         return classes.anyToEvaluate(cells);
@@ -1207,23 +1297,30 @@ VolumeSet Morpher::runSdf(double t, const CoordBBox& box, bool prune, double tol
     detail::AdaptiveWarpStats warpStats;
     if (keptDistances) {
         std::atomic<bool> stopped{false};
-        tbb::parallel_for(tbb::blocked_range<size_t>(0, evaluate.size(), 8), [&](const tbb::blocked_range<size_t>& r) {
-            if (stopped || (interrupter && interrupter->wasInterrupted(int(100 * r.begin() / evaluate.size())))) {
-                stopped = true;
-                return;
-            }
-            typename detail::ExtendedDistance::template Reader<Sampler> a(*mFarSource), b(*mFarTarget);
-            auto scratch = std::make_unique<detail::IdentityDistances::Leaf>();
-            uint64_t computed = 0;
-            for (size_t i = r.begin(); i != r.end(); ++i) {
-                const auto& distances = keptDistances->get<Sampler>(evaluate[i], a, b, *scratch, computed);
-                auto [value, color] = leaves.make(evaluate[i], band);
-                const int whole = blend(evaluate[i], distances, *value, *color);
-                if (whole == 0) leaves.keep(std::move(value), std::move(color));
-                else if (whole < 0) leaves.insideTile(evaluate[i]);
-            }
-            blend.addSamples(computed);
-        });
+        tbb::parallel_for(
+            tbb::blocked_range<size_t>(0, evaluate.size(), 8),
+            [&](const tbb::blocked_range<size_t>& r) {
+                if (stopped || (interrupter && interrupter->wasInterrupted(
+                                                   int(100 * r.begin() / evaluate.size())))) {
+                    stopped = true;
+                    return;
+                }
+                typename detail::ExtendedDistance::template Reader<Sampler> a(*mFarSource),
+                    b(*mFarTarget);
+                auto scratch = std::make_unique<detail::IdentityDistances::Leaf>();
+                uint64_t computed = 0;
+                for (size_t i = r.begin(); i != r.end(); ++i) {
+                    const auto& distances =
+                        keptDistances->get<Sampler>(evaluate[i], a, b, *scratch, computed);
+                    auto [value, color] = leaves.make(evaluate[i], band);
+                    const int whole = blend(evaluate[i], distances, *value, *color);
+                    if (whole == 0)
+                        leaves.keep(std::move(value), std::move(color));
+                    else if (whole < 0)
+                        leaves.insideTile(evaluate[i]);
+                }
+                blend.addSamples(computed);
+            });
         if (stopped) throw Interrupted();
         warpStats.leaves = evaluate.size();
     } else {
@@ -1232,8 +1329,10 @@ VolumeSet Morpher::runSdf(double t, const CoordBBox& box, bool prune, double tol
             [&](const detail::WarpLeaf& w) {
                 auto [value, color] = leaves.make(w.origin, band);
                 const int whole = blend(w, *value, *color);
-                if (whole == 0) leaves.keep(std::move(value), std::move(color));
-                else if (whole < 0) leaves.insideTile(w.origin);
+                if (whole == 0)
+                    leaves.keep(std::move(value), std::move(color));
+                else if (whole < 0)
+                    leaves.insideTile(w.origin);
             },
             &warpStats, interrupter, prune ? &wanted : nullptr);
     }

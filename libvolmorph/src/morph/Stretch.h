@@ -19,8 +19,10 @@ inline double largestSymmetricEigenvalue(double a, double b, double c, double d,
     const double p2 = (a - q) * (a - q) + (b - q) * (b - q) + (c - q) * (c - q) + 2.0 * offDiagonal;
     const double p = std::sqrt(p2 / 6.0);
     // B = (A - q I) / p; r = det(B) / 2 lies in [-1, 1] but for rounding.
-    const double ba = (a - q) / p, bb = (b - q) / p, bc = (c - q) / p, bd = d / p, be = e / p, bf = f / p;
-    const double det = ba * (bb * bc - bf * bf) - bd * (bd * bc - bf * be) + be * (bd * bf - bb * be);
+    const double ba = (a - q) / p, bb = (b - q) / p, bc = (c - q) / p, bd = d / p, be = e / p,
+                 bf = f / p;
+    const double det =
+        ba * (bb * bc - bf * bf) - bd * (bd * bc - bf * be) + be * (bd * bf - bb * be);
     const double r = std::clamp(det / 2.0, -1.0, 1.0);
     return q + 2.0 * p * std::cos(std::acos(r) / 3.0);
 }
@@ -29,7 +31,8 @@ inline double largestSymmetricEigenvalue(double a, double b, double c, double d,
 /// eigenvalue.
 inline double spectralNorm(const Vec3d& dx, const Vec3d& dy, const Vec3d& dz)
 {
-    const double l = largestSymmetricEigenvalue(dx.dot(dx), dy.dot(dy), dz.dot(dz), dx.dot(dy), dx.dot(dz), dy.dot(dz));
+    const double l = largestSymmetricEigenvalue(dx.dot(dx), dy.dot(dy), dz.dot(dz), dx.dot(dy),
+                                                dx.dot(dz), dy.dot(dz));
     return std::sqrt(std::max(l, 0.0));
 }
 

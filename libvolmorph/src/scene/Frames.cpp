@@ -24,7 +24,8 @@ std::string normalized(const std::string& pattern)
 std::string checkFramePattern(const std::string& pattern)
 {
     const std::string p = normalized(pattern);
-    if (p.find('#') != std::string::npos) return "only one run of '#' may stand for the frame number";
+    if (p.find('#') != std::string::npos)
+        return "only one run of '#' may stand for the frame number";
     int directives = 0;
     for (size_t i = 0; i < p.size(); ++i) {
         if (p[i] != '%') continue;
@@ -34,7 +35,8 @@ std::string checkFramePattern(const std::string& pattern)
         }
         size_t j = i + 1;
         while (j < p.size() && std::isdigit(static_cast<unsigned char>(p[j]))) ++j;
-        if (j >= p.size() || p[j] != 'd') return "'%' must be followed by d or 0Nd (the frame number)";
+        if (j >= p.size() || p[j] != 'd')
+            return "'%' must be followed by d or 0Nd (the frame number)";
         ++directives;
         i = j;
     }
@@ -49,7 +51,8 @@ std::string frameFileName(const std::string& pattern, int frame)
     return names.empty() ? pattern : names.front();
 }
 
-std::vector<int> selectFrames(const FramesSpec& frames, const std::string& spec, const std::string& what)
+std::vector<int> selectFrames(const FramesSpec& frames, const std::string& spec,
+                              const std::string& what)
 {
     std::vector<int> picked;
     if (spec.empty()) {
@@ -63,8 +66,9 @@ std::vector<int> selectFrames(const FramesSpec& frames, const std::string& spec,
     std::set<int> seen;
     for (int f : numbers) {
         if (f < frames.first || f > frames.last)
-            throw UserError(SourceLocation{what}, "frame " + std::to_string(f) + " is outside the scene's range " +
-                                                      std::to_string(frames.first) + "-" + std::to_string(frames.last));
+            throw UserError(SourceLocation{what},
+                            "frame " + std::to_string(f) + " is outside the scene's range " +
+                                std::to_string(frames.first) + "-" + std::to_string(frames.last));
         if (seen.insert(f).second) picked.push_back(f);
     }
     return picked;

@@ -13,7 +13,7 @@ Mat4d ObjectTransform::matrix() const
     // OpenVDB matrices act on row vectors (p' = p M), so the chain below reads left to right in
     // the order the operations apply: scale, rotate X, Y, Z, translate.
     Mat4d m = Mat4d::identity();
-    m.preScale(scale);  // identity scaled; order of pre/post only matters once m is non-trivial
+    m.preScale(scale); // identity scaled; order of pre/post only matters once m is non-trivial
     m.postRotate(openvdb::math::X_AXIS, rotateRadians.x());
     m.postRotate(openvdb::math::Y_AXIS, rotateRadians.y());
     m.postRotate(openvdb::math::Z_AXIS, rotateRadians.z());
@@ -21,7 +21,10 @@ Mat4d ObjectTransform::matrix() const
     return m;
 }
 
-Vec3d ObjectTransform::apply(const Vec3d& p) const { return matrix().transform(p); }
+Vec3d ObjectTransform::apply(const Vec3d& p) const
+{
+    return matrix().transform(p);
+}
 
 bool ObjectTransform::isIdentity() const
 {
@@ -31,10 +34,14 @@ bool ObjectTransform::isIdentity() const
 const char* toString(FeatureType type)
 {
     switch (type) {
-    case FeatureType::Point: return "point";
-    case FeatureType::Segment: return "segment";
-    case FeatureType::Rectangle: return "rectangle";
-    case FeatureType::Box: return "box";
+    case FeatureType::Point:
+        return "point";
+    case FeatureType::Segment:
+        return "segment";
+    case FeatureType::Rectangle:
+        return "rectangle";
+    case FeatureType::Box:
+        return "box";
     }
     return "?";
 }
@@ -43,8 +50,10 @@ double ScheduleSpec::evaluate(double t) const
 {
     t = std::clamp(t, 0.0, 1.0);
     switch (kind) {
-    case Kind::Linear: return t;
-    case Kind::Smoothstep: return t * t * (3.0 - 2.0 * t);
+    case Kind::Linear:
+        return t;
+    case Kind::Smoothstep:
+        return t * t * (3.0 - 2.0 * t);
     case Kind::Sigmoid: {
         // Logistic curve centred on t = 0.5, rescaled so that tau(0) = 0 and tau(1) = 1 exactly.
         auto s = [this](double x) { return 1.0 / (1.0 + std::exp(-k * (x - 0.5))); };
@@ -55,7 +64,8 @@ double ScheduleSpec::evaluate(double t) const
         assert(points.size() >= 2);
         if (t <= points.front().first) return points.front().second;
         if (t >= points.back().first) return points.back().second;
-        const auto hi = std::upper_bound(points.begin(), points.end(), t,
+        const auto hi = std::upper_bound(
+            points.begin(), points.end(), t,
             [](double v, const std::pair<double, double>& p) { return v < p.first; });
         const auto lo = hi - 1;
         const double span = hi->first - lo->first;
@@ -70,9 +80,15 @@ std::string ScheduleSpec::str() const
 {
     std::ostringstream s;
     switch (kind) {
-    case Kind::Linear: s << "linear"; break;
-    case Kind::Smoothstep: s << "smoothstep"; break;
-    case Kind::Sigmoid: s << "sigmoid(" << k << ")"; break;
+    case Kind::Linear:
+        s << "linear";
+        break;
+    case Kind::Smoothstep:
+        s << "smoothstep";
+        break;
+    case Kind::Sigmoid:
+        s << "sigmoid(" << k << ")";
+        break;
     case Kind::Curve:
         s << "curve of " << points.size() << " points";
         break;
@@ -101,7 +117,10 @@ void around(const std::vector<Key>& keys, int frame, const Key*& a, const Key*& 
     }
 }
 
-Vec3d lerp(const Vec3d& a, const Vec3d& b, double u) { return a + (b - a) * u; }
+Vec3d lerp(const Vec3d& a, const Vec3d& b, double u)
+{
+    return a + (b - a) * u;
+}
 
 /// Linear interpolation of two directions, renormalized (keys may not be opposite: the parser
 /// refuses that).

@@ -20,15 +20,15 @@
 namespace volmorph {
 namespace {
 
+using detail::formatNumber;
 using detail::Reader;
 using detail::typeName;
-using detail::formatNumber;
 
 constexpr double kDegreesToRadians = 3.14159265358979323846 / 180.0;
 
 // Keys allowed in each table; anything else is reported with a "did you mean" for near misses.
-const std::vector<std::string> kRootKeys = {"source", "target", "volume", "pair", "warp", "blend",
-                                            "render", "frames"};
+const std::vector<std::string> kRootKeys = {"source", "target", "volume", "pair",
+                                            "warp",   "blend",  "render", "frames"};
 const std::vector<std::string> kObjectKeys = {"mesh", "transform", "color"};
 const std::vector<std::string> kTransformKeys = {"translate", "rotate", "scale"};
 const std::vector<std::string> kVolumeKeys = {"voxel_size", "resolution"};
@@ -36,13 +36,16 @@ const std::vector<std::string> kPairKeys = {"type", "source", "target"};
 const std::vector<std::string> kElementKeys = {"origin", "axes", "scale"};
 const std::vector<std::string> kWarpKeys = {"epsilon", "tolerance", "weighting", "a", "b", "p"};
 const std::vector<std::string> kBlendKeys = {"mode", "density", "color", "sdf", "min_island"};
-const std::vector<std::string> kRenderKeys = {"resolution", "samples", "step", "extinction",
-                                              "albedo", "anisotropy", "seed", "camera", "lights",
-                                              "emission"};
-const std::vector<std::string> kCameraKeys = {"projection", "eye", "lookat", "up", "fov", "width", "keys"};
+const std::vector<std::string> kRenderKeys = {"resolution", "samples",    "step", "extinction",
+                                              "albedo",     "anisotropy", "seed", "camera",
+                                              "lights",     "emission"};
+const std::vector<std::string> kCameraKeys = {"projection", "eye",   "lookat", "up",
+                                              "fov",        "width", "keys"};
 const std::vector<std::string> kCameraKeyKeys = {"frame", "eye", "lookat", "up", "fov", "width"};
-const std::vector<std::string> kLightKeys = {"type", "direction", "position", "color", "intensity", "keys"};
-const std::vector<std::string> kLightKeyKeys = {"frame", "direction", "position", "color", "intensity"};
+const std::vector<std::string> kLightKeys = {"type",  "direction", "position",
+                                             "color", "intensity", "keys"};
+const std::vector<std::string> kLightKeyKeys = {"frame", "direction", "position", "color",
+                                                "intensity"};
 const std::vector<std::string> kFramesKeys = {"range", "output"};
 
 // ------------------------------------------------------------------------------------------------
@@ -55,13 +58,19 @@ public:
     {
         r.checkKeys(root, "", kRootKeys);
 
-        if (const toml::node* n = root.get("source")) parseObject(*n, "source", mScene.source);
-        else r.missingTable("source", "the mesh the morph starts from");
-        if (const toml::node* n = root.get("target")) parseObject(*n, "target", mScene.target);
-        else r.missingTable("target", "the mesh the morph ends at");
+        if (const toml::node* n = root.get("source"))
+            parseObject(*n, "source", mScene.source);
+        else
+            r.missingTable("source", "the mesh the morph starts from");
+        if (const toml::node* n = root.get("target"))
+            parseObject(*n, "target", mScene.target);
+        else
+            r.missingTable("target", "the mesh the morph ends at");
 
-        if (const toml::node* n = root.get("volume")) parseVolume(*n);
-        else r.missingTable("volume", "voxel_size in world units, or resolution");
+        if (const toml::node* n = root.get("volume"))
+            parseVolume(*n);
+        else
+            r.missingTable("volume", "voxel_size in world units, or resolution");
 
         if (const toml::node* n = root.get("pair")) parsePairs(*n);
         if (const toml::node* n = root.get("warp")) parseWarp(*n);
@@ -89,7 +98,8 @@ private:
                 std::filesystem::path p(*s);
                 object.mesh = p.is_absolute() ? p : mScene.folder / p;
                 std::error_code ec;
-                if (s->empty()) r.error(r.at(*n), path + ".mesh: expected a file name");
+                if (s->empty())
+                    r.error(r.at(*n), path + ".mesh: expected a file name");
                 else if (!std::filesystem::is_regular_file(object.mesh, ec))
                     r.error(r.at(*n), path + ".mesh: file not found: '" + *s + "' (looked for " +
                                           object.mesh.string() + ")");
@@ -97,7 +107,8 @@ private:
         } else {
             r.missing(node, path + ".mesh", "a mesh file name, relative to the scene file");
         }
-        if (const toml::node* n = t->get("transform")) parseTransform(*n, path + ".transform", object.transform);
+        if (const toml::node* n = t->get("transform"))
+            parseTransform(*n, path + ".transform", object.transform);
         if (const toml::node* n = t->get("color"))
             if (auto c = r.nonNegativeVec3(*n, path + ".color")) object.color = *c;
     }
@@ -132,8 +143,9 @@ private:
         if (size && res) {
             r.error(r.at(*res), "volume: give either voxel_size or resolution, not both");
         } else if (size) {
-            mScene.volume.voxelSize = r.numberIn(*size, "volume.voxel_size", 0.0, false,
-                std::numeric_limits<double>::max(), "a positive length in world units");
+            mScene.volume.voxelSize =
+                r.numberIn(*size, "volume.voxel_size", 0.0, false,
+                           std::numeric_limits<double>::max(), "a positive length in world units");
         } else if (res) {
             if (auto v = r.integerIn(*res, "volume.resolution", 8, 16384))
                 mScene.volume.resolution = int(*v);
@@ -147,7 +159,8 @@ private:
     {
         const toml::array* pairs = node.as_array();
         if (!pairs) {
-            r.error(r.at(node), "pair: expected [[pair]] tables, got " + std::string(typeName(node)));
+            r.error(r.at(node),
+                    "pair: expected [[pair]] tables, got " + std::string(typeName(node)));
             return;
         }
         for (size_t i = 0; i < pairs->size(); ++i) {
@@ -164,11 +177,16 @@ private:
         bool ok = true;
         if (const toml::node* n = t.get("type")) {
             const auto s = r.choice(*n, path + ".type", {"point", "segment", "rectangle", "box"});
-            if (!s) ok = false;
-            else if (*s == "point") pair.type = FeatureType::Point;
-            else if (*s == "segment") pair.type = FeatureType::Segment;
-            else if (*s == "rectangle") pair.type = FeatureType::Rectangle;
-            else pair.type = FeatureType::Box;
+            if (!s)
+                ok = false;
+            else if (*s == "point")
+                pair.type = FeatureType::Point;
+            else if (*s == "segment")
+                pair.type = FeatureType::Segment;
+            else if (*s == "rectangle")
+                pair.type = FeatureType::Rectangle;
+            else
+                pair.type = FeatureType::Box;
         } else {
             r.missing(t, path + ".type", "point, segment, rectangle or box");
             ok = false;
@@ -198,7 +216,8 @@ private:
             r.missing(node, path + ".origin", "[x, y, z] in world units");
         }
         const bool isPoint = type == FeatureType::Point;
-        if (const toml::node* n = t->get("axes")) parseAxes(*n, path + ".axes", e);
+        if (const toml::node* n = t->get("axes"))
+            parseAxes(*n, path + ".axes", e);
         else if (!isPoint)
             r.missing(node, path + ".axes", "[[x axis], [y axis]]; z is x cross y");
         if (const toml::node* n = t->get("scale")) {
@@ -213,8 +232,9 @@ private:
     {
         const toml::array* a = node.as_array();
         if (!a || a->size() != 2) {
-            r.error(r.at(node), path + ": expected two axes [[x], [y]], got " +
-                                    (a ? "an array of " + std::to_string(a->size()) : typeName(node)));
+            r.error(r.at(node),
+                    path + ": expected two axes [[x], [y]], got " +
+                        (a ? "an array of " + std::to_string(a->size()) : typeName(node)));
             return;
         }
         const std::optional<Vec3d> x = r.vec3(*a->get(0), path + "[0]");
@@ -231,14 +251,19 @@ private:
         // Gram-Schmidt (x kept, y adjusted), more than that is almost certainly a mistake.
         const double kMaxCosine = std::sin(5.0 * kDegreesToRadians);
         if (cosine > 1.0 - 1e-9) {
-            r.error(r.at(node), path + ": the x and y axes are parallel; they must be perpendicular");
+            r.error(r.at(node),
+                    path + ": the x and y axes are parallel; they must be perpendicular");
             return;
         }
         if (cosine > kMaxCosine) {
             // Tenths of a degree: hand-typed axes are not more precise than that.
-            const double angle = std::round(10.0 * std::acos(std::clamp(xu.dot(yu), -1.0, 1.0)) / kDegreesToRadians) / 10.0;
-            r.error(r.at(node), path + ": the x and y axes must be perpendicular (within 5 degrees); "
-                                       "they are " + formatNumber(angle) + " degrees apart");
+            const double angle = std::round(10.0 * std::acos(std::clamp(xu.dot(yu), -1.0, 1.0)) /
+                                            kDegreesToRadians) /
+                                 10.0;
+            r.error(r.at(node), path +
+                                    ": the x and y axes must be perpendicular (within 5 degrees); "
+                                    "they are " +
+                                    formatNumber(angle) + " degrees apart");
             return;
         }
         e.xAxis = xu;
@@ -254,7 +279,8 @@ private:
         WarpSpec& w = mScene.warp;
         const double big = std::numeric_limits<double>::max();
         if (const toml::node* n = t->get("epsilon"))
-            if (auto v = r.numberIn(*n, "warp.epsilon", 0.0, true, big, "a length >= 0 in world units"))
+            if (auto v =
+                    r.numberIn(*n, "warp.epsilon", 0.0, true, big, "a length >= 0 in world units"))
                 w.epsilon = *v;
         if (const toml::node* n = t->get("tolerance"))
             if (auto v = r.numberIn(*n, "warp.tolerance", 0.0, true, 64.0,
@@ -262,13 +288,17 @@ private:
                 w.toleranceVoxels = *v;
         if (const toml::node* n = t->get("weighting"))
             if (auto s = r.choice(*n, "warp.weighting", {"inverse-square", "beier-neely"}))
-                w.weighting = *s == "beier-neely" ? Weighting::BeierNeely : Weighting::InverseSquare;
+                w.weighting =
+                    *s == "beier-neely" ? Weighting::BeierNeely : Weighting::InverseSquare;
         if (const toml::node* n = t->get("a"))
-            if (auto v = r.numberIn(*n, "warp.a", 0.0, false, big, "a length > 0 in world units")) w.a = *v;
+            if (auto v = r.numberIn(*n, "warp.a", 0.0, false, big, "a length > 0 in world units"))
+                w.a = *v;
         if (const toml::node* n = t->get("b"))
-            if (auto v = r.numberIn(*n, "warp.b", 0.0, true, 16.0, "an exponent from 0 to 16")) w.b = *v;
+            if (auto v = r.numberIn(*n, "warp.b", 0.0, true, 16.0, "an exponent from 0 to 16"))
+                w.b = *v;
         if (const toml::node* n = t->get("p"))
-            if (auto v = r.numberIn(*n, "warp.p", 0.0, true, 1.0, "an exponent from 0 to 1")) w.p = *v;
+            if (auto v = r.numberIn(*n, "warp.p", 0.0, true, 1.0, "an exponent from 0 to 1"))
+                w.p = *v;
         if (w.weighting == Weighting::InverseSquare)
             for (const char* k : {"a", "b", "p"})
                 if (const toml::node* n = t->get(k))
@@ -280,14 +310,17 @@ private:
     {
         if (const auto* str = node.as_string()) {
             const std::string& text = str->get();
-            if (text == "linear") s.kind = ScheduleSpec::Kind::Linear;
-            else if (text == "smoothstep") s.kind = ScheduleSpec::Kind::Smoothstep;
+            if (text == "linear")
+                s.kind = ScheduleSpec::Kind::Linear;
+            else if (text == "smoothstep")
+                s.kind = ScheduleSpec::Kind::Smoothstep;
             else if (text.rfind("sigmoid(", 0) == 0 && text.back() == ')') {
                 const std::string arg = text.substr(8, text.size() - 9);
                 char* end = nullptr;
                 const double k = std::strtod(arg.c_str(), &end);
                 if (arg.empty() || *end != '\0' || !std::isfinite(k) || k <= 0.0 || k > 1000.0)
-                    r.error(r.at(node), path + ": sigmoid(k) needs a steepness 0 < k <= 1000, got \"" +
+                    r.error(r.at(node), path +
+                                            ": sigmoid(k) needs a steepness 0 < k <= 1000, got \"" +
                                             text + "\"");
                 s.kind = ScheduleSpec::Kind::Sigmoid;
                 s.k = k;
@@ -300,8 +333,9 @@ private:
         }
         const toml::array* a = node.as_array();
         if (!a) {
-            r.error(r.at(node), path + ": expected a schedule name or an array of [t, tau] points, got " +
-                                    typeName(node));
+            r.error(r.at(node),
+                    path + ": expected a schedule name or an array of [t, tau] points, got " +
+                        typeName(node));
             return;
         }
         std::vector<std::pair<double, double>> points;
@@ -314,7 +348,8 @@ private:
                 return;
             }
             const auto t = r.numberIn(*pt->get(0), ppath + " t", 0.0, true, 1.0, "t from 0 to 1");
-            const auto tau = r.numberIn(*pt->get(1), ppath + " tau", 0.0, true, 1.0, "tau from 0 to 1");
+            const auto tau =
+                r.numberIn(*pt->get(1), ppath + " tau", 0.0, true, 1.0, "tau from 0 to 1");
             if (!t || !tau) return;
             if (!points.empty() && *t <= points.back().first) {
                 r.error(r.at(p), ppath + ": t must increase from point to point");
@@ -328,8 +363,9 @@ private:
         }
         if (points.size() < 2 || points.front() != std::make_pair(0.0, 0.0) ||
             points.back() != std::make_pair(1.0, 1.0)) {
-            r.error(r.at(node), path + ": a curve needs at least two points, starting at [0, 0] and "
-                                       "ending at [1, 1]");
+            r.error(r.at(node), path +
+                                    ": a curve needs at least two points, starting at [0, 0] and "
+                                    "ending at [1, 1]");
             return;
         }
         s.kind = ScheduleSpec::Kind::Curve;
@@ -349,7 +385,8 @@ private:
         if (const toml::node* n = t->get("color")) parseSchedule(*n, "blend.color", b.color);
         if (const toml::node* n = t->get("sdf")) parseSchedule(*n, "blend.sdf", b.sdf);
         if (const toml::node* n = t->get("min_island"))
-            if (auto v = r.integerIn(*n, "blend.min_island", 0, 1000000000)) b.minIslandVoxels = int(*v);
+            if (auto v = r.integerIn(*n, "blend.min_island", 0, 1000000000))
+                b.minIslandVoxels = int(*v);
     }
 
     void parseCamera(const toml::node& node)
@@ -360,7 +397,8 @@ private:
         CameraSpec& c = mScene.render.camera;
         if (const toml::node* n = t->get("projection"))
             if (auto s = r.choice(*n, "render.camera.projection", {"perspective", "orthographic"}))
-                c.projection = *s == "orthographic" ? Projection::Orthographic : Projection::Perspective;
+                c.projection =
+                    *s == "orthographic" ? Projection::Orthographic : Projection::Perspective;
         if (const toml::node* n = t->get("eye"))
             if (auto v = r.vec3(*n, "render.camera.eye")) c.eye = *v;
         if (const toml::node* n = t->get("lookat"))
@@ -378,33 +416,39 @@ private:
                 c.orthoWidth = *v;
         checkView(node, "render.camera", c.eye, c.lookat, c.up);
         if (const toml::node* n = t->get("keys")) {
-            forEachKey(*n, "render.camera.keys", [&](const toml::table& k, const toml::node& where, const std::string& path,
-                                                     int frame) {
-                r.checkKeys(k, path, kCameraKeyKeys);
-                CameraKey key{frame, c.eye, c.lookat, c.up, c.fovDegrees, c.orthoWidth};
-                if (const toml::node* e = k.get("eye"))
-                    if (auto v = r.vec3(*e, path + ".eye")) key.eye = *v;
-                if (const toml::node* e = k.get("lookat"))
-                    if (auto v = r.vec3(*e, path + ".lookat")) key.lookat = *v;
-                if (const toml::node* e = k.get("up"))
-                    if (auto v = r.direction(*e, path + ".up")) key.up = *v;
-                if (const toml::node* e = k.get("fov"))
-                    if (auto v = r.numberIn(*e, path + ".fov", 0.0, false, 179.0,
-                                            "a horizontal field of view in degrees, 0 < fov <= 179"))
-                        key.fovDegrees = *v;
-                if (const toml::node* e = k.get("width"))
-                    if (auto v = r.numberIn(*e, path + ".width", 0.0, false, std::numeric_limits<double>::max(),
-                                            "an orthographic width > 0 in world units"))
-                        key.orthoWidth = *v;
-                checkView(where, path, key.eye, key.lookat, key.up);
-                if (!c.keys.empty() && key.up.unit().dot(c.keys.back().up.unit()) < -1.0 + 1e-9)
-                    r.error(r.at(where), path + ".up: opposite to the previous key's up (the turn between them is undefined)");
-                c.keys.push_back(key);
-            });
+            forEachKey(
+                *n, "render.camera.keys",
+                [&](const toml::table& k, const toml::node& where, const std::string& path,
+                    int frame) {
+                    r.checkKeys(k, path, kCameraKeyKeys);
+                    CameraKey key{frame, c.eye, c.lookat, c.up, c.fovDegrees, c.orthoWidth};
+                    if (const toml::node* e = k.get("eye"))
+                        if (auto v = r.vec3(*e, path + ".eye")) key.eye = *v;
+                    if (const toml::node* e = k.get("lookat"))
+                        if (auto v = r.vec3(*e, path + ".lookat")) key.lookat = *v;
+                    if (const toml::node* e = k.get("up"))
+                        if (auto v = r.direction(*e, path + ".up")) key.up = *v;
+                    if (const toml::node* e = k.get("fov"))
+                        if (auto v =
+                                r.numberIn(*e, path + ".fov", 0.0, false, 179.0,
+                                           "a horizontal field of view in degrees, 0 < fov <= 179"))
+                            key.fovDegrees = *v;
+                    if (const toml::node* e = k.get("width"))
+                        if (auto v = r.numberIn(*e, path + ".width", 0.0, false,
+                                                std::numeric_limits<double>::max(),
+                                                "an orthographic width > 0 in world units"))
+                            key.orthoWidth = *v;
+                    checkView(where, path, key.eye, key.lookat, key.up);
+                    if (!c.keys.empty() && key.up.unit().dot(c.keys.back().up.unit()) < -1.0 + 1e-9)
+                        r.error(r.at(where), path + ".up: opposite to the previous key's up (the "
+                                                    "turn between them is undefined)");
+                    c.keys.push_back(key);
+                });
         }
     }
 
-    void checkView(const toml::node& where, const std::string& path, const Vec3d& eye, const Vec3d& lookat, const Vec3d& up)
+    void checkView(const toml::node& where, const std::string& path, const Vec3d& eye,
+                   const Vec3d& lookat, const Vec3d& up)
     {
         const Vec3d view = lookat - eye;
         if (view.length() < 1e-12) {
@@ -438,8 +482,11 @@ private:
             const auto frame = r.integerIn(*frameNode, keyPath + ".frame", -100000000, 100000000);
             if (!frame) continue;
             if (previous && *frame <= *previous) {
-                r.error(r.at(*frameNode), keyPath + ".frame: frames must increase from key to key (the key before is frame " +
-                                              std::to_string(*previous) + ")");
+                r.error(
+                    r.at(*frameNode),
+                    keyPath +
+                        ".frame: frames must increase from key to key (the key before is frame " +
+                        std::to_string(*previous) + ")");
                 continue;
             }
             previous = int(*frame);
@@ -466,7 +513,8 @@ private:
                 r.missing(node, path + ".direction", "the way the light travels, [x, y, z]");
             }
             if (const toml::node* n = t->get("position"))
-                r.error(r.at(*n), path + ".position: a directional light has a direction, not a position");
+                r.error(r.at(*n),
+                        path + ".position: a directional light has a direction, not a position");
         } else {
             if (const toml::node* n = t->get("position")) {
                 if (auto v = r.vec3(*n, path + ".position")) light.position = *v;
@@ -474,7 +522,8 @@ private:
                 r.missing(node, path + ".position", "[x, y, z] in world units");
             }
             if (const toml::node* n = t->get("direction"))
-                r.error(r.at(*n), path + ".direction: a point light has a position, not a direction");
+                r.error(r.at(*n),
+                        path + ".direction: a point light has a position, not a direction");
         }
         if (const toml::node* n = t->get("color"))
             if (auto v = r.nonNegativeVec3(*n, path + ".color")) light.color = *v;
@@ -483,32 +532,43 @@ private:
                                     std::numeric_limits<double>::max(), "an intensity >= 0"))
                 light.intensity = *v;
         if (const toml::node* n = t->get("keys")) {
-            forEachKey(*n, path + ".keys", [&](const toml::table& k, const toml::node& where, const std::string& keyPath,
-                                               int frame) {
-                r.checkKeys(k, keyPath, kLightKeyKeys);
-                LightKey key{frame, light.direction, light.position, light.color, light.intensity};
-                if (const toml::node* e = k.get("direction")) {
-                    if (light.type != LightType::Directional)
-                        r.error(r.at(*e), keyPath + ".direction: a point light has a position, not a direction");
-                    else if (auto v = r.direction(*e, keyPath + ".direction"))
-                        key.direction = *v;
-                }
-                if (const toml::node* e = k.get("position")) {
-                    if (light.type != LightType::Point)
-                        r.error(r.at(*e), keyPath + ".position: a directional light has a direction, not a position");
-                    else if (auto v = r.vec3(*e, keyPath + ".position"))
-                        key.position = *v;
-                }
-                if (const toml::node* e = k.get("color"))
-                    if (auto v = r.nonNegativeVec3(*e, keyPath + ".color")) key.color = *v;
-                if (const toml::node* e = k.get("intensity"))
-                    if (auto v = r.numberIn(*e, keyPath + ".intensity", 0.0, true, std::numeric_limits<double>::max(),
-                                            "an intensity >= 0"))
-                        key.intensity = *v;
-                if (!light.keys.empty() && key.direction.unit().dot(light.keys.back().direction.unit()) < -1.0 + 1e-9)
-                    r.error(r.at(where), keyPath + ".direction: opposite to the previous key's direction (the turn between them is undefined)");
-                light.keys.push_back(key);
-            });
+            forEachKey(
+                *n, path + ".keys",
+                [&](const toml::table& k, const toml::node& where, const std::string& keyPath,
+                    int frame) {
+                    r.checkKeys(k, keyPath, kLightKeyKeys);
+                    LightKey key{frame, light.direction, light.position, light.color,
+                                 light.intensity};
+                    if (const toml::node* e = k.get("direction")) {
+                        if (light.type != LightType::Directional)
+                            r.error(
+                                r.at(*e),
+                                keyPath +
+                                    ".direction: a point light has a position, not a direction");
+                        else if (auto v = r.direction(*e, keyPath + ".direction"))
+                            key.direction = *v;
+                    }
+                    if (const toml::node* e = k.get("position")) {
+                        if (light.type != LightType::Point)
+                            r.error(r.at(*e), keyPath + ".position: a directional light has a "
+                                                        "direction, not a position");
+                        else if (auto v = r.vec3(*e, keyPath + ".position"))
+                            key.position = *v;
+                    }
+                    if (const toml::node* e = k.get("color"))
+                        if (auto v = r.nonNegativeVec3(*e, keyPath + ".color")) key.color = *v;
+                    if (const toml::node* e = k.get("intensity"))
+                        if (auto v =
+                                r.numberIn(*e, keyPath + ".intensity", 0.0, true,
+                                           std::numeric_limits<double>::max(), "an intensity >= 0"))
+                            key.intensity = *v;
+                    if (!light.keys.empty() &&
+                        key.direction.unit().dot(light.keys.back().direction.unit()) < -1.0 + 1e-9)
+                        r.error(r.at(where),
+                                keyPath + ".direction: opposite to the previous key's direction "
+                                          "(the turn between them is undefined)");
+                    light.keys.push_back(key);
+                });
         }
         mScene.render.lights.push_back(light);
     }
@@ -577,7 +637,8 @@ private:
             if (auto s = r.string(*n, "frames.range"))
                 if (!parseFrameRange(*s, f.first, f.last))
                     r.error(r.at(*n), "frames.range: expected \"FIRST-LAST\" with FIRST <= LAST "
-                                      "(e.g. \"1-48\") or one frame \"N\", got \"" + *s + "\"");
+                                      "(e.g. \"1-48\") or one frame \"N\", got \"" +
+                                          *s + "\"");
         }
         if (const toml::node* n = t->get("output")) {
             if (auto s = r.string(*n, "frames.output")) {
@@ -585,16 +646,19 @@ private:
                 f.outputWhere = r.at(*n);
             }
         }
-        const bool hasPlaceholder = f.output.find('#') != std::string::npos ||
-                                    f.output.find('%') != std::string::npos;
+        const bool hasPlaceholder =
+            f.output.find('#') != std::string::npos || f.output.find('%') != std::string::npos;
         const SourceLocation where = f.outputWhere.line > 0 ? f.outputWhere : r.at(node);
         if (f.count() > 1 && !hasPlaceholder)
-            r.error(where, "frames.output: \"" + f.output + "\" has no frame number placeholder "
-                           "(#### or %04d) for a range of " + std::to_string(f.count()) + " frames");
+            r.error(where, "frames.output: \"" + f.output +
+                               "\" has no frame number placeholder "
+                               "(#### or %04d) for a range of " +
+                               std::to_string(f.count()) + " frames");
         if (const std::string why = checkFramePattern(f.output); !why.empty())
             r.error(where, "frames.output: \"" + f.output + "\": " + why);
         if (std::filesystem::path(f.output).extension() != ".exr")
-            r.error(where, "frames.output: expected a file name ending in .exr, got \"" + f.output + "\"");
+            r.error(where,
+                    "frames.output: expected a file name ending in .exr, got \"" + f.output + "\"");
     }
 
     Reader& r;
@@ -647,7 +711,8 @@ Scene parseScene(std::string_view text, const std::filesystem::path& file)
     try {
         root = toml::parse(text, file.string());
     } catch (const toml::parse_error& e) {
-        throw UserError(reader.at(e.source()), "TOML syntax error: " + std::string(e.description()));
+        throw UserError(reader.at(e.source()),
+                        "TOML syntax error: " + std::string(e.description()));
     }
     SceneParser(reader, scene).parse(root);
     reader.diagnostics().throwIfAny();
@@ -659,7 +724,8 @@ Scene loadScene(const std::filesystem::path& file)
     std::ifstream in(file, std::ios::binary);
     std::error_code ec;
     if (std::filesystem::is_directory(file, ec) || !in)
-        throw UserError(SourceLocation{file.string()}, "cannot read scene file (expected a readable TOML file)");
+        throw UserError(SourceLocation{file.string()},
+                        "cannot read scene file (expected a readable TOML file)");
     std::ostringstream text;
     text << in.rdbuf();
     return parseScene(text.str(), file);

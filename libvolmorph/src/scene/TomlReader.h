@@ -19,16 +19,26 @@ namespace volmorph::detail {
 inline const char* typeName(const toml::node& n)
 {
     switch (n.type()) {
-    case toml::node_type::table: return "a table";
-    case toml::node_type::array: return "an array";
-    case toml::node_type::string: return "a string";
-    case toml::node_type::integer: return "an integer";
-    case toml::node_type::floating_point: return "a number";
-    case toml::node_type::boolean: return "a boolean";
-    case toml::node_type::date: return "a date";
-    case toml::node_type::time: return "a time";
-    case toml::node_type::date_time: return "a date-time";
-    default: return "nothing";
+    case toml::node_type::table:
+        return "a table";
+    case toml::node_type::array:
+        return "an array";
+    case toml::node_type::string:
+        return "a string";
+    case toml::node_type::integer:
+        return "an integer";
+    case toml::node_type::floating_point:
+        return "a number";
+    case toml::node_type::boolean:
+        return "a boolean";
+    case toml::node_type::date:
+        return "a date";
+    case toml::node_type::time:
+        return "a time";
+    case toml::node_type::date_time:
+        return "a date-time";
+    default:
+        return "nothing";
     }
 }
 
@@ -65,11 +75,14 @@ public:
         for (auto&& [key, node] : table) {
             const std::string name(key.str());
             if (std::find(allowed.begin(), allowed.end(), name) != allowed.end()) continue;
-            std::string message = "unknown key '" + name + "'" +
+            std::string message =
+                "unknown key '" + name + "'" +
                 (path.empty() ? std::string(" at the top level") : " in [" + path + "]");
             const std::string suggestion = closestMatch(name, allowed);
-            if (!suggestion.empty()) message += "; did you mean '" + suggestion + "'?";
-            else message += "; expected one of: " + joinKeys(allowed);
+            if (!suggestion.empty())
+                message += "; did you mean '" + suggestion + "'?";
+            else
+                message += "; expected one of: " + joinKeys(allowed);
             error(at(key.source()), message);
         }
     }
@@ -84,8 +97,10 @@ public:
     std::optional<double> number(const toml::node& n, const std::string& path)
     {
         std::optional<double> v;
-        if (const auto* i = n.as_integer()) v = double(i->get());
-        else if (const auto* f = n.as_floating_point()) v = f->get();
+        if (const auto* i = n.as_integer())
+            v = double(i->get());
+        else if (const auto* f = n.as_floating_point())
+            v = f->get();
         else {
             error(at(n), path + ": expected a number, got " + typeName(n));
             return std::nullopt;
@@ -141,8 +156,8 @@ public:
         const std::optional<std::string> s = string(n, path);
         if (!s) return std::nullopt;
         if (std::find(choices.begin(), choices.end(), *s) != choices.end()) return s;
-        std::string message = path + ": unknown value \"" + *s + "\"; expected one of: " +
-                              joinKeys(choices);
+        std::string message =
+            path + ": unknown value \"" + *s + "\"; expected one of: " + joinKeys(choices);
         const std::string suggestion = closestMatch(*s, choices);
         if (!suggestion.empty()) message += " (did you mean \"" + suggestion + "\"?)";
         error(at(n), message);
@@ -160,7 +175,8 @@ public:
         }
         Vec3d v;
         for (int i = 0; i < 3; ++i) {
-            const std::optional<double> c = number(*a->get(size_t(i)), path + "[" + std::to_string(i) + "]");
+            const std::optional<double> c =
+                number(*a->get(size_t(i)), path + "[" + std::to_string(i) + "]");
             if (!c) return std::nullopt;
             v[i] = *c;
         }

@@ -51,7 +51,7 @@ void refineUnsignedDistance(FloatGrid& grid, const Int32Grid& index, const Mesh&
 {
     const openvdb::math::Transform& xform = grid.transform();
     openvdb::tree::LeafManager<FloatTree> leaves(grid.tree());
-    leaves.foreach([&](FloatTree::LeafNodeType& leaf, size_t) {
+    leaves.foreach ([&](FloatTree::LeafNodeType& leaf, size_t) {
         auto indices = index.getConstAccessor();
         int32_t candidates[27];
         for (auto it = leaf.beginValueOn(); it; ++it) {
@@ -71,7 +71,8 @@ void refineUnsignedDistance(FloatGrid& grid, const Int32Grid& index, const Mesh&
                 const Vec3I& tri = mesh.triangles[size_t(candidates[c])];
                 Vec3d uvw;
                 const Vec3d q = openvdb::math::closestPointOnTriangleToPoint(
-                    Vec3d(mesh.points[tri[0]]), Vec3d(mesh.points[tri[1]]), Vec3d(mesh.points[tri[2]]), p, uvw);
+                    Vec3d(mesh.points[tri[0]]), Vec3d(mesh.points[tri[1]]),
+                    Vec3d(mesh.points[tri[2]]), p, uvw);
                 best = std::min(best, (q - p).length());
             }
             it.setValue(float(best));
@@ -90,7 +91,7 @@ void signByWindingNumber(FloatGrid& grid, const Mesh& mesh, Interrupter* interru
     auto inside = [&](const Coord& ijk) { return winding(xform.indexToWorld(ijk)) > 0.5; };
 
     openvdb::tree::LeafManager<FloatTree> leaves(grid.tree());
-    leaves.foreach([&](FloatTree::LeafNodeType& leaf, size_t) {
+    leaves.foreach ([&](FloatTree::LeafNodeType& leaf, size_t) {
         for (auto it = leaf.beginValueOn(); it; ++it)
             if (inside(it.getCoord())) it.setValue(-std::abs(*it));
     });
@@ -100,7 +101,7 @@ void signByWindingNumber(FloatGrid& grid, const Mesh& mesh, Interrupter* interru
     checkInterrupt(interrupter, 75);
 
     const float background = grid.background();
-    leaves.foreach([&](FloatTree::LeafNodeType& leaf, size_t) {
+    leaves.foreach ([&](FloatTree::LeafNodeType& leaf, size_t) {
         bool agrees = true;
         const Coord o = leaf.origin();
         for (int c = 0; c < 8 && agrees; ++c) {
@@ -113,7 +114,8 @@ void signByWindingNumber(FloatGrid& grid, const Mesh& mesh, Interrupter* interru
     });
     checkInterrupt(interrupter, 80);
 
-    // A tile holds no band voxel, so no surface passes through it: one query at its centre decides it.
+    // A tile holds no band voxel, so no surface passes through it: one query at its centre decides
+    // it.
     for (auto it = grid.tree().beginValueOff(); it; ++it) {
         if (it.isVoxelValue()) continue;
         const openvdb::CoordBBox box = it.getBoundingBox();
@@ -128,7 +130,8 @@ Vec3SGrid::Ptr colorFromIndex(const Mesh& mesh, const Int32Grid* index, const Fl
                               const std::optional<Vec3f>& constant)
 {
     Vec3f mean(0.8f); // grey, when neither the scene nor the file gives a colour
-    if (constant) mean = *constant;
+    if (constant)
+        mean = *constant;
     else if (mesh.hasColors()) {
         Vec3d sum(0.0);
         for (const Vec3f& c : mesh.colors) sum += Vec3d(c);
@@ -144,7 +147,7 @@ Vec3SGrid::Ptr colorFromIndex(const Mesh& mesh, const Int32Grid* index, const Fl
     openvdb::tree::LeafManager<ColorTree> leaves(color->tree());
     const bool interpolate = !constant && mesh.hasColors() && index;
     const openvdb::math::Transform& xform = sdf.transform();
-    leaves.foreach([&](ColorTree::LeafNodeType& leaf, size_t) {
+    leaves.foreach ([&](ColorTree::LeafNodeType& leaf, size_t) {
         const auto* indexLeaf = interpolate ? index->tree().probeConstLeaf(leaf.origin()) : nullptr;
         for (auto it = leaf.beginValueOn(); it; ++it) {
             Vec3f c = mean;
@@ -154,9 +157,10 @@ Vec3SGrid::Ptr colorFromIndex(const Mesh& mesh, const Int32Grid* index, const Fl
                     const Vec3I& tri = mesh.triangles[size_t(t)];
                     Vec3d uvw;
                     openvdb::math::closestPointOnTriangleToPoint(
-                        Vec3d(mesh.points[tri[0]]), Vec3d(mesh.points[tri[1]]), Vec3d(mesh.points[tri[2]]),
-                        xform.indexToWorld(it.getCoord()), uvw);
-                    c = Vec3f(uvw[0] * Vec3d(mesh.colors[tri[0]]) + uvw[1] * Vec3d(mesh.colors[tri[1]]) +
+                        Vec3d(mesh.points[tri[0]]), Vec3d(mesh.points[tri[1]]),
+                        Vec3d(mesh.points[tri[2]]), xform.indexToWorld(it.getCoord()), uvw);
+                    c = Vec3f(uvw[0] * Vec3d(mesh.colors[tri[0]]) +
+                              uvw[1] * Vec3d(mesh.colors[tri[1]]) +
                               uvw[2] * Vec3d(mesh.colors[tri[2]]));
                 }
             }
@@ -175,7 +179,7 @@ FloatGrid::Ptr fogFromLevelSet(const FloatGrid& sdf, float rampWorld)
     FloatGrid::Ptr density = sdf.deepCopy();
     FloatTree& tree = density->tree();
     openvdb::tree::LeafManager<FloatTree> leaves(tree);
-    leaves.foreach([&](FloatTree::LeafNodeType& leaf, size_t) {
+    leaves.foreach ([&](FloatTree::LeafNodeType& leaf, size_t) {
         for (auto it = leaf.beginValueAll(); it; ++it) {
             const float d = *it;
             const float value = fogOfLevelSet(d, it.isValueOn(), rampWorld);
@@ -260,13 +264,15 @@ VolumeSet voxelize(const Mesh& input, const VoxelizeOptions& options, Interrupte
     const auto [lo, hi] = input.bounds();
     const Vec3d extent = hi - lo;
     const double cells = std::max({extent.x(), extent.y(), extent.z()}) / voxelSize;
-    const uint64_t limit = options.memoryLimitBytes ? options.memoryLimitBytes : defaultMemoryLimitBytes();
+    const uint64_t limit =
+        options.memoryLimitBytes ? options.memoryLimitBytes : defaultMemoryLimitBytes();
     const uint64_t estimate = estimateVoxelizeBytes(input, voxelSize, halfWidth);
     if (cells > 1e6 || estimate > limit) {
         std::ostringstream s;
         s << "voxel size " << voxelSize << " world units gives " << std::ceil(cells)
-          << " voxels across the mesh and needs about " << gib(estimate) << ", more than the limit of "
-          << gib(limit) << "; use a larger voxel size (or fewer voxels across), or raise the limit "
+          << " voxels across the mesh and needs about " << gib(estimate)
+          << ", more than the limit of " << gib(limit)
+          << "; use a larger voxel size (or fewer voxels across), or raise the limit "
           << "with --memory-limit (default: half the machine's memory)";
         throw UserError(where, s.str());
     }
@@ -274,8 +280,12 @@ VolumeSet voxelize(const Mesh& input, const VoxelizeOptions& options, Interrupte
     if (interrupter) interrupter->start("voxelize");
     bool useWinding = false;
     switch (options.sign) {
-    case VoxelizeOptions::Sign::FloodFill: useWinding = false; break;
-    case VoxelizeOptions::Sign::WindingNumber: useWinding = true; break;
+    case VoxelizeOptions::Sign::FloodFill:
+        useWinding = false;
+        break;
+    case VoxelizeOptions::Sign::WindingNumber:
+        useWinding = true;
+        break;
     case VoxelizeOptions::Sign::Auto:
         useWinding = !(input.report.watertight() && input.report.components == 1);
         break;
@@ -287,11 +297,13 @@ VolumeSet voxelize(const Mesh& input, const VoxelizeOptions& options, Interrupte
     }
     const Mesh& mesh = useWinding ? repaired : input;
 
-    const openvdb::math::Transform::Ptr xform = openvdb::math::Transform::createLinearTransform(voxelSize);
+    const openvdb::math::Transform::Ptr xform =
+        openvdb::math::Transform::createLinearTransform(voxelSize);
     std::vector<Vec3f> indexPoints(mesh.points.size());
     for (size_t i = 0; i < mesh.points.size(); ++i)
         indexPoints[i] = Vec3f(xform->worldToIndex(Vec3d(mesh.points[i])));
-    const openvdb::tools::QuadAndTriangleDataAdapter<Vec3f, Vec3I> adapter(indexPoints, mesh.triangles);
+    const openvdb::tools::QuadAndTriangleDataAdapter<Vec3f, Vec3I> adapter(indexPoints,
+                                                                           mesh.triangles);
 
     // The winding-number path refines OpenVDB's unsigned distances with the closest triangles.
     const bool needIndex = useWinding || (!options.color && mesh.hasColors());

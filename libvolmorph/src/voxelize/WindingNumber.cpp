@@ -14,7 +14,10 @@ constexpr uint32_t kLeafSize = 8;
 /// term's relative error then falls like (1 / kBeta)^2 (Barill et al. use 2).
 constexpr double kBeta = 2.0;
 
-Vec3d corner(const std::vector<Vec3f>& points, uint32_t i) { return Vec3d(points[i]); }
+Vec3d corner(const std::vector<Vec3f>& points, uint32_t i)
+{
+    return Vec3d(points[i]);
+}
 
 } // namespace
 
@@ -39,7 +42,8 @@ uint32_t WindingNumber::build(uint32_t first, uint32_t count)
     double area = 0.0;
     for (uint32_t i = first; i < first + count; ++i) {
         const Vec3I& t = mTriangles[i];
-        const Vec3d a = corner(*mPoints, t[0]), b = corner(*mPoints, t[1]), c = corner(*mPoints, t[2]);
+        const Vec3d a = corner(*mPoints, t[0]), b = corner(*mPoints, t[1]),
+                    c = corner(*mPoints, t[2]);
         const Vec3d n = 0.5 * (b - a).cross(c - a);
         const double A = n.length();
         node.areaNormal += n;
@@ -52,12 +56,14 @@ uint32_t WindingNumber::build(uint32_t first, uint32_t count)
     node.center = area > 0.0 ? weighted / area : 0.5 * (lo + hi);
     for (uint32_t i = first; i < first + count; ++i)
         for (int k = 0; k < 3; ++k)
-            node.radius = std::max(node.radius, (corner(*mPoints, mTriangles[i][k]) - node.center).length());
+            node.radius =
+                std::max(node.radius, (corner(*mPoints, mTriangles[i][k]) - node.center).length());
 
     if (count > kLeafSize) {
         // Median split of the triangle centroids along the longest axis of their bounds.
         const Vec3d extent = hi - lo;
-        const int axis = extent[0] > extent[1] ? (extent[0] > extent[2] ? 0 : 2) : (extent[1] > extent[2] ? 1 : 2);
+        const int axis = extent[0] > extent[1] ? (extent[0] > extent[2] ? 0 : 2)
+                                               : (extent[1] > extent[2] ? 1 : 2);
         auto key = [this, axis](const Vec3I& t) {
             return double((*mPoints)[t[0]][axis]) + (*mPoints)[t[1]][axis] + (*mPoints)[t[2]][axis];
         };
@@ -76,7 +82,8 @@ uint32_t WindingNumber::build(uint32_t first, uint32_t count)
 double WindingNumber::solidAngle(const Vec3I& tri, const Vec3d& p) const
 {
     // Van Oosterom and Strackee (1983): tan(omega / 2) = det[a b c] / (|a||b||c| + (a.b)|c| + ...).
-    const Vec3d a = corner(*mPoints, tri[0]) - p, b = corner(*mPoints, tri[1]) - p, c = corner(*mPoints, tri[2]) - p;
+    const Vec3d a = corner(*mPoints, tri[0]) - p, b = corner(*mPoints, tri[1]) - p,
+                c = corner(*mPoints, tri[2]) - p;
     const double la = a.length(), lb = b.length(), lc = c.length();
     const double det = a.dot(b.cross(c));
     const double den = la * lb * lc + a.dot(b) * lc + a.dot(c) * lb + b.dot(c) * la;
@@ -97,7 +104,8 @@ double WindingNumber::operator()(const Vec3d& p) const
         if (d > kBeta * n.radius) {
             sum += n.areaNormal.dot(r) / (d * d * d); // dipole: the cluster as one oriented area
         } else if (n.count > 0) {
-            for (uint32_t i = n.first; i < n.first + n.count; ++i) sum += solidAngle(mTriangles[i], p);
+            for (uint32_t i = n.first; i < n.first + n.count; ++i)
+                sum += solidAngle(mTriangles[i], p);
         } else {
             stack[top++] = n.left;
             stack[top++] = n.right;
@@ -119,9 +127,12 @@ size_t repairOrientation(Mesh& mesh)
     // Directed edge (a -> b) to the triangles that use it, to find each triangle's neighbours.
     std::unordered_map<uint64_t, std::vector<uint32_t>> byEdge;
     byEdge.reserve(3 * n);
-    auto key = [](uint32_t a, uint32_t b) { return (uint64_t(std::min(a, b)) << 32) | std::max(a, b); };
+    auto key = [](uint32_t a, uint32_t b) {
+        return (uint64_t(std::min(a, b)) << 32) | std::max(a, b);
+    };
     for (uint32_t t = 0; t < n; ++t)
-        for (int k = 0; k < 3; ++k) byEdge[key(mesh.triangles[t][k], mesh.triangles[t][(k + 1) % 3])].push_back(t);
+        for (int k = 0; k < 3; ++k)
+            byEdge[key(mesh.triangles[t][k], mesh.triangles[t][(k + 1) % 3])].push_back(t);
 
     auto traverses = [&mesh](uint32_t t, uint32_t a, uint32_t b) {
         const Vec3I& tri = mesh.triangles[t];
@@ -178,7 +189,9 @@ size_t repairOrientation(Mesh& mesh)
     for (size_t s = 0; s < shells.size(); ++s)
         for (uint32_t t : shells[s]) {
             const Vec3I& tri = mesh.triangles[t];
-            volume[s] += Vec3d(mesh.points[tri[0]]).dot(Vec3d(mesh.points[tri[1]]).cross(Vec3d(mesh.points[tri[2]]))) / 6.0;
+            volume[s] += Vec3d(mesh.points[tri[0]])
+                             .dot(Vec3d(mesh.points[tri[1]]).cross(Vec3d(mesh.points[tri[2]]))) /
+                         6.0;
         }
     // Nesting is checked pairwise; beyond this many shells (debris, particles) it is skipped and
     // every negative shell is turned outward.

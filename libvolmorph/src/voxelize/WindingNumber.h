@@ -22,9 +22,10 @@ public:
 
 private:
     struct Node {
-        Vec3d center{0.0};     ///< area-weighted centroid of the node's triangles
-        Vec3d areaNormal{0.0}; ///< sum of the triangles' area-weighted normals (half cross products)
-        double radius = 0;     ///< every vertex of the node lies within radius of center
+        Vec3d center{0.0}; ///< area-weighted centroid of the node's triangles
+        Vec3d areaNormal{
+            0.0};          ///< sum of the triangles' area-weighted normals (half cross products)
+        double radius = 0; ///< every vertex of the node lies within radius of center
         uint32_t first = 0, count = 0; ///< triangle range, for leaves
         uint32_t left = 0, right = 0;  ///< children, for inner nodes (count == 0)
     };

@@ -53,16 +53,16 @@ struct PairBounds {
 /// Left uninitialized until evaluated (only the wanted points are, and only they are read): the
 /// whole lattice is allocated per call, and zeroing it cost about 1 ms, serially.
 struct alignas(64) AdaptiveWarp::LatticePoint { // one cache line each
-    double w;           ///< sum w_i
-    Vec3d s, t;         ///< sum w_i A_i, source and target side
-    bool ok;            ///< false: on an element with a zero offset
+    double w;                                   ///< sum w_i
+    Vec3d s, t;                                 ///< sum w_i A_i, source and target side
+    bool ok;                                    ///< false: on an element with a zero offset
 };
 
 struct AdaptiveWarp::Lattice {
     using Point = LatticePoint;
     static_assert(std::is_trivially_default_constructible_v<Point>, "allocated uninitialized");
-    Coord lo;               ///< lattice coordinates of point 0 (leaf coordinates)
-    Coord dim;              ///< points along each axis
+    Coord lo;  ///< lattice coordinates of point 0 (leaf coordinates)
+    Coord dim; ///< points along each axis
     std::unique_ptr<Point[]> points;
     size_t count = 0;
     size_t index(const Coord& leafCoord) const
@@ -120,7 +120,7 @@ struct AdaptiveWarp::Context {
     std::unique_ptr<LeafJob> job = std::make_unique<LeafJob>();
     PairBounds bounds;
     std::vector<char> isNear;
-    std::vector<size_t> nearList; ///< the near pairs, by type, then by index
+    std::vector<size_t> nearList;          ///< the near pairs, by type, then by index
     std::vector<float> termList, hessList; ///< selectNear's copies of the bound's columns
     // What analyze() found of the last cell.
     const LatticePoint* corner[8];
@@ -141,7 +141,6 @@ double linearDistance(const InverseWarp::Affine& a, const InverseWarp::Affine& b
                      (a.col[2] - b.col[2]).lengthSqr());
 }
 
-
 // The warp's vector arithmetic uses GCC's vector extension: one AVX register, or two SSE ones in
 // the baseline build, with the same IEEE operations per lane in both. 8 floats: the kernel's rows
 // of 8 voxels along z and the bound's 8 pairs; 4 doubles: the exact sums' 4 pairs and a leaf's 4
@@ -157,12 +156,30 @@ typedef double v4du __attribute__((vector_size(32), aligned(8)));
 /// The voxels' offsets along a row (z).
 constexpr v8f kZ = {0, 1, 2, 3, 4, 5, 6, 7};
 
-VOLMORPH_ALWAYS_INLINE inline v8f load8(const float* p) { return *reinterpret_cast<const v8fu*>(p); }
-VOLMORPH_ALWAYS_INLINE inline void store8(float* p, v8f v) { *reinterpret_cast<v8fu*>(p) = v; }
-VOLMORPH_ALWAYS_INLINE inline v8f splat8(float v) { return v8f{v, v, v, v, v, v, v, v}; }
-VOLMORPH_ALWAYS_INLINE inline v8f vabs(v8f v) { return reinterpret_cast<v8f>(reinterpret_cast<v8i>(v) & 0x7fffffff); }
-VOLMORPH_ALWAYS_INLINE inline v8f vmax(v8f a, v8f b) { return a > b ? a : b; }
-VOLMORPH_ALWAYS_INLINE inline v8f vmin(v8f a, v8f b) { return a < b ? a : b; }
+VOLMORPH_ALWAYS_INLINE inline v8f load8(const float* p)
+{
+    return *reinterpret_cast<const v8fu*>(p);
+}
+VOLMORPH_ALWAYS_INLINE inline void store8(float* p, v8f v)
+{
+    *reinterpret_cast<v8fu*>(p) = v;
+}
+VOLMORPH_ALWAYS_INLINE inline v8f splat8(float v)
+{
+    return v8f{v, v, v, v, v, v, v, v};
+}
+VOLMORPH_ALWAYS_INLINE inline v8f vabs(v8f v)
+{
+    return reinterpret_cast<v8f>(reinterpret_cast<v8i>(v) & 0x7fffffff);
+}
+VOLMORPH_ALWAYS_INLINE inline v8f vmax(v8f a, v8f b)
+{
+    return a > b ? a : b;
+}
+VOLMORPH_ALWAYS_INLINE inline v8f vmin(v8f a, v8f b)
+{
+    return a < b ? a : b;
+}
 VOLMORPH_ALWAYS_INLINE inline v8f vsqrt(v8f v)
 {
     v8f r;
@@ -170,15 +187,30 @@ VOLMORPH_ALWAYS_INLINE inline v8f vsqrt(v8f v)
     return r;
 }
 
-VOLMORPH_ALWAYS_INLINE inline v4d load4(const double* p) { return *reinterpret_cast<const v4du*>(p); }
-VOLMORPH_ALWAYS_INLINE inline void store4(double* p, v4d v) { *reinterpret_cast<v4du*>(p) = v; }
-VOLMORPH_ALWAYS_INLINE inline v4d splat(double v) { return v4d{v, v, v, v}; }
+VOLMORPH_ALWAYS_INLINE inline v4d load4(const double* p)
+{
+    return *reinterpret_cast<const v4du*>(p);
+}
+VOLMORPH_ALWAYS_INLINE inline void store4(double* p, v4d v)
+{
+    *reinterpret_cast<v4du*>(p) = v;
+}
+VOLMORPH_ALWAYS_INLINE inline v4d splat(double v)
+{
+    return v4d{v, v, v, v};
+}
 VOLMORPH_ALWAYS_INLINE inline v4d vabs(v4d v)
 {
     return reinterpret_cast<v4d>(reinterpret_cast<v4l>(v) & 0x7fffffffffffffffLL);
 }
-VOLMORPH_ALWAYS_INLINE inline v4d vmax(v4d a, v4d b) { return a > b ? a : b; }
-VOLMORPH_ALWAYS_INLINE inline v4d vmin(v4d a, v4d b) { return a < b ? a : b; }
+VOLMORPH_ALWAYS_INLINE inline v4d vmax(v4d a, v4d b)
+{
+    return a > b ? a : b;
+}
+VOLMORPH_ALWAYS_INLINE inline v4d vmin(v4d a, v4d b)
+{
+    return a < b ? a : b;
+}
 VOLMORPH_ALWAYS_INLINE inline v4d vsqrt(v4d v)
 {
     v4d r;
@@ -187,8 +219,14 @@ VOLMORPH_ALWAYS_INLINE inline v4d vsqrt(v4d v)
 }
 
 /// Sums over pairs, 8 lanes of single precision accumulated in double (two 4-lane halves).
-VOLMORPH_ALWAYS_INLINE inline v4d lowHalf(v8f v) { return __builtin_convertvector(__builtin_shufflevector(v, v, 0, 1, 2, 3), v4d); }
-VOLMORPH_ALWAYS_INLINE inline v4d highHalf(v8f v) { return __builtin_convertvector(__builtin_shufflevector(v, v, 4, 5, 6, 7), v4d); }
+VOLMORPH_ALWAYS_INLINE inline v4d lowHalf(v8f v)
+{
+    return __builtin_convertvector(__builtin_shufflevector(v, v, 0, 1, 2, 3), v4d);
+}
+VOLMORPH_ALWAYS_INLINE inline v4d highHalf(v8f v)
+{
+    return __builtin_convertvector(__builtin_shufflevector(v, v, 4, 5, 6, 7), v4d);
+}
 struct WideSum {
     v4d lo{}, hi{};
     VOLMORPH_ALWAYS_INLINE void add(v8f v)
@@ -212,7 +250,8 @@ VOLMORPH_ALWAYS_INLINE inline V outside(V q, V half)
 
 /// Distance in the element's frame at a row's 8 voxels, per type.
 template <FeatureType T>
-VOLMORPH_ALWAYS_INLINE inline v8f frameDistance(v8f qx, v8f qy, v8f qz, float hx, float hy, float hz)
+VOLMORPH_ALWAYS_INLINE inline v8f frameDistance(v8f qx, v8f qy, v8f qz, float hx, float hy,
+                                                float hz)
 {
     if constexpr (T == FeatureType::Point) return vsqrt(qx * qx + qy * qy + qz * qz);
     if constexpr (T == FeatureType::Segment) {
@@ -265,10 +304,10 @@ struct LeafJob {
     /// At the leaf's corners (bit 0: +x, bit 1: +y, bit 2: +z), channels as the kernel's sums:
     /// the exact W, S - W B and T - W B, less the near pairs in fillLeafBody: the far sums.
     double far[7][8];
-    std::vector<NearTerm> near;        ///< grouped by type: Point, Segment, Rectangle, Box
-    size_t typeEnd[4];                 ///< where each type's near pairs end in `near`
-    std::vector<NearRows> rows;        ///< scratch, one per near pair
-    InverseWarp::Affine bS, bT;        ///< the dominant pair's affine maps
+    std::vector<NearTerm> near; ///< grouped by type: Point, Segment, Rectangle, Box
+    size_t typeEnd[4];          ///< where each type's near pairs end in `near`
+    std::vector<NearRows> rows; ///< scratch, one per near pair
+    InverseWarp::Affine bS, bT; ///< the dominant pair's affine maps
     double offset, exponent;
     bool inverseSquare;
 };
@@ -283,9 +322,11 @@ VOLMORPH_ALWAYS_INLINE inline void farRows(const float edge[4][8], int i, v8f& r
     dy = (row8 - row0) * 0.125f;
 }
 
-/// Row r's points from its residual sums and the reciprocal of its weight sum: p = B + sum / weight.
-/// (The slices' reciprocals are taken first, all 8 rows', for the reason given at addNearPairs.)
-VOLMORPH_ALWAYS_INLINE inline void storeRow(WarpLeaf& leaf, int r, const v8f base[6], const v8f acc[7], v8f inv)
+/// Row r's points from its residual sums and the reciprocal of its weight sum: p = B + sum /
+/// weight. (The slices' reciprocals are taken first, all 8 rows', for the reason given at
+/// addNearPairs.)
+VOLMORPH_ALWAYS_INLINE inline void storeRow(WarpLeaf& leaf, int r, const v8f base[6],
+                                            const v8f acc[7], v8f inv)
 {
     for (int c = 0; c < 3; ++c) {
         store8(leaf.s[c] + 8 * r, base[c] + acc[1 + c] * inv);
@@ -300,7 +341,8 @@ VOLMORPH_ALWAYS_INLINE inline void storeRow(WarpLeaf& leaf, int r, const v8f bas
 /// where one pass per row would fill the scheduler with the sums waiting on each row's division.
 /// (Each value takes the same operations in the same order either way, so the bits are the same.)
 template <FeatureType T, bool InverseSquare>
-VOLMORPH_ALWAYS_INLINE inline void addNearPairs(const LeafJob& job, size_t begin, size_t end, v8f sums[64][7])
+VOLMORPH_ALWAYS_INLINE inline void addNearPairs(const LeafJob& job, size_t begin, size_t end,
+                                                v8f sums[64][7])
 {
     const float off = float(job.offset);
     for (size_t p = begin; p < end; ++p) {
@@ -311,11 +353,14 @@ VOLMORPH_ALWAYS_INLINE inline void addNearPairs(const LeafJob& job, size_t begin
                 v8f q[3];
                 for (int c = 0; c < 3; ++c) q[c] = n.f[c].first(i);
                 for (int j = 0; j < 8; ++j) {
-                    const v8f d = off + frameDistance<T>(q[0], q[1], q[2], n.half[0], n.half[1], n.half[2]);
+                    const v8f d =
+                        off + frameDistance<T>(q[0], q[1], q[2], n.half[0], n.half[1], n.half[2]);
                     if constexpr (InverseSquare) {
                         w[j] = 1.0f / (d * d);
                     } else {
-                        for (int l = 0; l < 8; ++l) w[j][l] = float(double(n.scale) * std::pow(double(d[l]), -job.exponent));
+                        for (int l = 0; l < 8; ++l)
+                            w[j][l] =
+                                float(double(n.scale) * std::pow(double(d[l]), -job.exponent));
                     }
                     for (int c = 0; c < 3; ++c) q[c] += n.f[c].dy;
                 }
@@ -378,7 +423,8 @@ VOLMORPH_ALWAYS_INLINE inline void fillLeafBody(LeafJob& job, WarpLeaf& leaf)
         }
         NearRows& n = job.rows[p];
         // Steps of the frame coordinates along x, y and z: the frame's rows.
-        const Vec3d dx(e.x.x(), e.y.x(), e.z.x()), dy(e.x.y(), e.y.y(), e.z.y()), dz(e.x.z(), e.y.z(), e.z.z());
+        const Vec3d dx(e.x.x(), e.y.x(), e.z.x()), dy(e.x.y(), e.y.y(), e.z.y()),
+            dz(e.x.z(), e.y.z(), e.z.z());
         for (int c = 0; c < 3; ++c) {
             n.f[c].set(q0[c], dx[c], dy[c], dz[c]);
             n.f[3 + c].set(t.rs[c], t.drs[0][c], t.drs[1][c], t.drs[2][c]);
@@ -464,24 +510,27 @@ AdaptiveWarp::AdaptiveWarp(const InverseWarp& warp, double toleranceVoxels)
         mTarget.push_back(warp.targetAffine(i));
     }
     const std::vector<InverseWarp::Affine> maps[2] = {mSource, mTarget};
-    auto columns = std::make_unique<Columns>(Columns{PairColumns<double>(warp, maps), PairColumns<float>(warp, maps), {}});
+    auto columns = std::make_unique<Columns>(
+        Columns{PairColumns<double>(warp, maps), PairColumns<float>(warp, maps), {}});
     const size_t padded = columns->bound.padded;
     columns->slope.assign(n * padded, 0.0f);
     for (size_t j = 0; j < n; ++j)
         for (size_t i = 0; i < n; ++i)
-            columns->slope[j * padded + i] =
-                float(std::max(linearDistance(mSource[i], mSource[j]), linearDistance(mTarget[i], mTarget[j])));
+            columns->slope[j * padded + i] = float(std::max(
+                linearDistance(mSource[i], mSource[j]), linearDistance(mTarget[i], mTarget[j])));
     mColumns = std::move(columns);
     // The kernel's order of near pairs: by type, then by index.
     for (size_t i = 0; i < n; ++i) mByType.push_back(i);
-    std::stable_sort(mByType.begin(), mByType.end(),
-                     [&warp](size_t a, size_t b) { return warp.interpolated(a).type < warp.interpolated(b).type; });
+    std::stable_sort(mByType.begin(), mByType.end(), [&warp](size_t a, size_t b) {
+        return warp.interpolated(a).type < warp.interpolated(b).type;
+    });
 }
 
 namespace {
 
 template <class Real>
-PairColumns<Real>::PairColumns(const InverseWarp& warp, const std::vector<InverseWarp::Affine> maps[2])
+PairColumns<Real>::PairColumns(const InverseWarp& warp,
+                               const std::vector<InverseWarp::Affine> maps[2])
 {
     const size_t n = warp.pairCount();
     padded = (n + 7) / 8 * 8;
@@ -491,7 +540,10 @@ PairColumns<Real>::PairColumns(const InverseWarp& warp, const std::vector<Invers
     for (size_t i = 0; i < padded; ++i) {
         // Padding: a point at the origin with zero maps.
         const Feature e = i < n ? warp.interpolated(i) : Feature();
-        const int extent = e.type == FeatureType::Point ? 0 : e.type == FeatureType::Segment ? 1 : e.type == FeatureType::Rectangle ? 2 : 3;
+        const int extent = e.type == FeatureType::Point       ? 0
+                           : e.type == FeatureType::Segment   ? 1
+                           : e.type == FeatureType::Rectangle ? 2
+                                                              : 3;
         const Vec3d* axes[3] = {&e.x, &e.y, &e.z};
         auto set = [&](int c, double v) { groups[i / kLanes].v[c][i % kLanes] = Real(v); };
         for (int k = 0; k < 3; ++k) {
@@ -514,7 +566,6 @@ PairColumns<Real>::PairColumns(const InverseWarp& warp, const std::vector<Invers
 }
 
 } // namespace
-
 
 void AdaptiveWarp::identityLeaf(Context& ctx) const
 {
@@ -545,10 +596,11 @@ namespace {
 CoordBBox widened(const Vec3d& lo, const Vec3d& hi, double margin)
 {
     auto clampInt = [](double v) { return int(std::clamp(v, -1.0e9, 1.0e9)); };
-    return CoordBBox(Coord(clampInt(std::floor(lo.x() - margin)), clampInt(std::floor(lo.y() - margin)),
-                           clampInt(std::floor(lo.z() - margin))),
-                     Coord(clampInt(std::ceil(hi.x() + margin)), clampInt(std::ceil(hi.y() + margin)),
-                           clampInt(std::ceil(hi.z() + margin))));
+    return CoordBBox(
+        Coord(clampInt(std::floor(lo.x() - margin)), clampInt(std::floor(lo.y() - margin)),
+              clampInt(std::floor(lo.z() - margin))),
+        Coord(clampInt(std::ceil(hi.x() + margin)), clampInt(std::ceil(hi.y() + margin)),
+              clampInt(std::ceil(hi.z() + margin))));
 }
 
 /// Bounding box of an affine map's image of the cube [o, o + size]^3.
@@ -581,20 +633,26 @@ bool touches(const Occupancy* occ, const Vec3d& lo, const Vec3d& hi, double marg
 #define VOLMORPH_AVX512 __attribute__((target("avx2,avx512f,avx512vl,avx512dq,avx512bw")))
 VOLMORPH_AVX2 void fillLeafAvx2(LeafJob& job, WarpLeaf& leaf)
 {
-    if (job.inverseSquare) fillLeafBody<true>(job, leaf);
-    else fillLeafBody<false>(job, leaf);
+    if (job.inverseSquare)
+        fillLeafBody<true>(job, leaf);
+    else
+        fillLeafBody<false>(job, leaf);
 }
 VOLMORPH_AVX512 void fillLeafAvx512(LeafJob& job, WarpLeaf& leaf)
 {
-    if (job.inverseSquare) fillLeafBody<true>(job, leaf);
-    else fillLeafBody<false>(job, leaf);
+    if (job.inverseSquare)
+        fillLeafBody<true>(job, leaf);
+    else
+        fillLeafBody<false>(job, leaf);
 }
 #endif
 
 void fillLeafBaseline(LeafJob& job, WarpLeaf& leaf)
 {
-    if (job.inverseSquare) fillLeafBody<true>(job, leaf);
-    else fillLeafBody<false>(job, leaf);
+    if (job.inverseSquare)
+        fillLeafBody<true>(job, leaf);
+    else
+        fillLeafBody<false>(job, leaf);
 }
 
 /// The most capable build allowed (useKernelBuild).
@@ -604,11 +662,12 @@ std::atomic<int> gKernelLimit{int(KernelBuild::Avx512)};
 KernelBuild kernelBuild()
 {
 #ifdef VOLMORPH_HAVE_AVX2_KERNEL
-    static const KernelBuild best = __builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512vl") &&
-                                            __builtin_cpu_supports("avx512dq") && __builtin_cpu_supports("avx512bw")
-                                        ? KernelBuild::Avx512
-                                    : __builtin_cpu_supports("avx2") ? KernelBuild::Avx2
-                                                                     : KernelBuild::Baseline;
+    static const KernelBuild best =
+        __builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512vl") &&
+                __builtin_cpu_supports("avx512dq") && __builtin_cpu_supports("avx512bw")
+            ? KernelBuild::Avx512
+        : __builtin_cpu_supports("avx2") ? KernelBuild::Avx2
+                                         : KernelBuild::Baseline;
     return KernelBuild(std::min(int(best), gKernelLimit.load(std::memory_order_relaxed)));
 #else
     return KernelBuild::Baseline;
@@ -619,9 +678,12 @@ void fillLeaf(LeafJob& job, WarpLeaf& leaf)
 {
 #ifdef VOLMORPH_HAVE_AVX2_KERNEL
     switch (kernelBuild()) {
-    case KernelBuild::Avx512: return fillLeafAvx512(job, leaf);
-    case KernelBuild::Avx2: return fillLeafAvx2(job, leaf);
-    case KernelBuild::Baseline: break;
+    case KernelBuild::Avx512:
+        return fillLeafAvx512(job, leaf);
+    case KernelBuild::Avx2:
+        return fillLeafAvx2(job, leaf);
+    case KernelBuild::Baseline:
+        break;
     }
 #endif
     fillLeafBaseline(job, leaf);
@@ -650,17 +712,26 @@ VOLMORPH_ALWAYS_INLINE inline void leafRangeBody(const WarpLeaf& leaf, Vec3f lo[
 }
 
 #ifdef VOLMORPH_HAVE_AVX2_KERNEL
-VOLMORPH_AVX2 void leafRangeAvx2(const WarpLeaf& leaf, Vec3f lo[2], Vec3f hi[2]) { leafRangeBody(leaf, lo, hi); }
-VOLMORPH_AVX512 void leafRangeAvx512(const WarpLeaf& leaf, Vec3f lo[2], Vec3f hi[2]) { leafRangeBody(leaf, lo, hi); }
+VOLMORPH_AVX2 void leafRangeAvx2(const WarpLeaf& leaf, Vec3f lo[2], Vec3f hi[2])
+{
+    leafRangeBody(leaf, lo, hi);
+}
+VOLMORPH_AVX512 void leafRangeAvx512(const WarpLeaf& leaf, Vec3f lo[2], Vec3f hi[2])
+{
+    leafRangeBody(leaf, lo, hi);
+}
 #endif
 
 void leafRange(const WarpLeaf& leaf, Vec3f lo[2], Vec3f hi[2])
 {
 #ifdef VOLMORPH_HAVE_AVX2_KERNEL
     switch (kernelBuild()) {
-    case KernelBuild::Avx512: return leafRangeAvx512(leaf, lo, hi);
-    case KernelBuild::Avx2: return leafRangeAvx2(leaf, lo, hi);
-    case KernelBuild::Baseline: break;
+    case KernelBuild::Avx512:
+        return leafRangeAvx512(leaf, lo, hi);
+    case KernelBuild::Avx2:
+        return leafRangeAvx2(leaf, lo, hi);
+    case KernelBuild::Baseline:
+        break;
     }
 #endif
     leafRangeBody(leaf, lo, hi);
@@ -668,14 +739,22 @@ void leafRange(const WarpLeaf& leaf, Vec3f lo[2], Vec3f hi[2])
 
 } // namespace
 
-void useKernelBuild(KernelBuild limit) { gKernelLimit = int(limit); }
+void useKernelBuild(KernelBuild limit)
+{
+    gKernelLimit = int(limit);
+}
 
-KernelBuild activeKernelBuild() { return kernelBuild(); }
+KernelBuild activeKernelBuild()
+{
+    return kernelBuild();
+}
 
 /// The bound's terms of every pair over the cube [o, o + size]^3 (a leaf: its voxels and its far
 /// corners), into ctx; see the header for the derivation. The per-pair loops take 8 pairs at a
 /// time in single precision; the sums over pairs are in double.
-VOLMORPH_ALWAYS_INLINE inline void AdaptiveWarp::analyzeBody(Context& ctx, const LatticePoint* const corners[8], const Coord& origin, int size) const
+VOLMORPH_ALWAYS_INLINE inline void AdaptiveWarp::analyzeBody(Context& ctx,
+                                                             const LatticePoint* const corners[8],
+                                                             const Coord& origin, int size) const
 {
     const size_t n = mWarp.pairCount();
     const PairColumns<float>& col = mColumns->bound;
@@ -700,7 +779,8 @@ VOLMORPH_ALWAYS_INLINE inline void AdaptiveWarp::analyzeBody(Context& ctx, const
     pb.resize(padded);
     using C = PairBounds::Column;
     using PC = PairColumns<float>;
-    const v8f zero = splat8(0.0f), one = splat8(1.0f), infinity = splat8(std::numeric_limits<float>::infinity());
+    const v8f zero = splat8(0.0f), one = splat8(1.0f),
+              infinity = splat8(std::numeric_limits<float>::infinity());
 
     // Per pair: frame coordinates q of the centre, the distance dc = |max(|q| - half, 0)| (half 0
     // on the axes a type does not extend along), its gradient g in index axes, the smallest
@@ -716,11 +796,15 @@ VOLMORPH_ALWAYS_INLINE inline void AdaptiveWarp::analyzeBody(Context& ctx, const
         const PC::Group& cg = col.groups[i / 8];
         PairBounds::Group& pg = pb.groups[i / 8];
         const v8i live = load8(cg.v[PC::Live]) != zero;
-        const v8f p[3] = {cf.x() - load8(cg.v[PC::Origin + 0]), cf.y() - load8(cg.v[PC::Origin + 1]), cf.z() - load8(cg.v[PC::Origin + 2])};
+        const v8f p[3] = {cf.x() - load8(cg.v[PC::Origin + 0]),
+                          cf.y() - load8(cg.v[PC::Origin + 1]),
+                          cf.z() - load8(cg.v[PC::Origin + 2])};
         v8f q[3], v[3], out2 = zero;
         v8i inside = load8(cg.v[PC::Box]) != zero;
         for (int k = 0; k < 3; ++k) {
-            q[k] = load8(cg.v[PC::Axis + 3 * k + 0]) * p[0] + load8(cg.v[PC::Axis + 3 * k + 1]) * p[1] + load8(cg.v[PC::Axis + 3 * k + 2]) * p[2];
+            q[k] = load8(cg.v[PC::Axis + 3 * k + 0]) * p[0] +
+                   load8(cg.v[PC::Axis + 3 * k + 1]) * p[1] +
+                   load8(cg.v[PC::Axis + 3 * k + 2]) * p[2];
             const v8f d = outside(q[k], load8(cg.v[PC::Half + k]));
             out2 += d * d;
             v[k] = q[k] < zero ? -d : d;
@@ -731,7 +815,10 @@ VOLMORPH_ALWAYS_INLINE inline void AdaptiveWarp::analyzeBody(Context& ctx, const
         const v8f inv = positive ? one / d : zero;
         v8f gL1 = zero, g[3];
         for (int a = 0; a < 3; ++a) {
-            g[a] = (load8(cg.v[PC::Axis + 3 * 0 + a]) * v[0] + load8(cg.v[PC::Axis + 3 * 1 + a]) * v[1] + load8(cg.v[PC::Axis + 3 * 2 + a]) * v[2]) * inv;
+            g[a] = (load8(cg.v[PC::Axis + 3 * 0 + a]) * v[0] +
+                    load8(cg.v[PC::Axis + 3 * 1 + a]) * v[1] +
+                    load8(cg.v[PC::Axis + 3 * 2 + a]) * v[2]) *
+                   inv;
             gL1 += vabs(g[a]);
         }
         // d is convex (the distance to a convex set), so it lies above its tangent plane at the
@@ -740,13 +827,15 @@ VOLMORPH_ALWAYS_INLINE inline void AdaptiveWarp::analyzeBody(Context& ctx, const
         // And it lies below the distance to the centre's nearest point on the element, c - d g:
         // |x - c + d g|^2 = |x - c|^2 + 2 d g.(x - c) + d^2 <= 3 h^2/4 + h d |g|_1 + d^2 over the
         // cube (d + halfDiagonal only where g is along a diagonal).
-        const v8f dMax = vmin(d + halfDiagonalF, vsqrt((d * d + (hf * d) * gL1) + (0.75f * hf * hf)));
+        const v8f dMax =
+            vmin(d + halfDiagonalF, vsqrt((d * d + (hf * d) * gL1) + (0.75f * hf * hf)));
         const v8f rMin = offset + dMin, rMax = offset + (inside ? zero : dMax);
         store8(pg.v[C::Constant], inside ? one : zero);
         // Weights at the smallest and largest distance and at the centre.
         v8f wMax, wMin, wc;
         if (inverseSquare) {
-            const v8f r0 = vmax(dMin, splat8(float(kTinyRadius) - offset)) + offset, r2 = d + offset;
+            const v8f r0 = vmax(dMin, splat8(float(kTinyRadius) - offset)) + offset,
+                      r2 = d + offset;
             wMax = one / (r0 * r0);
             wMin = one / (rMax * rMax);
             wc = one / (r2 * r2);
@@ -760,7 +849,8 @@ VOLMORPH_ALWAYS_INLINE inline void AdaptiveWarp::analyzeBody(Context& ctx, const
         }
         store8(pg.v[C::WMax], wMax);
         wMinTotal.add(live ? wMin : zero);
-        steep |= live & ((rMin < float(kTinyRadius)) | ~(wMax <= std::numeric_limits<float>::max()));
+        steep |=
+            live & ((rMin < float(kTinyRadius)) | ~(wMax <= std::numeric_limits<float>::max()));
         const v8f centreWeight = live ? wc : splat8(-1.0f);
         const v8i better = centreWeight > best;
         best = better ? centreWeight : best;
@@ -791,7 +881,8 @@ VOLMORPH_ALWAYS_INLINE inline void AdaptiveWarp::analyzeBody(Context& ctx, const
             const v8f hi = vmin(one, vabs(g[a]) + turn), lo = vmax(zero, vabs(g[a]) - turn);
             v8f share = one;
             if (inverseSquare) {
-                const v8f kh = (hf * vabs(g[a])) * invR, f = 2.0f / ((one + kh) + vsqrt(one + kh)); // q (q + 1) = q^2 + q
+                const v8f kh = (hf * vabs(g[a])) * invR,
+                          f = 2.0f / ((one + kh) + vsqrt(one + kh)); // q (q + 1) = q^2 + q
                 share = f * f;
             }
             axial += (share * hi) * (share * hi);
@@ -832,8 +923,10 @@ VOLMORPH_ALWAYS_INLINE inline void AdaptiveWarp::analyzeBody(Context& ctx, const
         for (int side = 0; side < 2; ++side) {
             length2[side] = zero;
             for (int a = 0; a < 3; ++a) {
-                const v8f r = load8(cg.v[PC::Affine + 12 * side + 3 * 0 + a]) * cf.x() + load8(cg.v[PC::Affine + 12 * side + 3 * 1 + a]) * cf.y() +
-                              load8(cg.v[PC::Affine + 12 * side + 3 * 2 + a]) * cf.z() + load8(cg.v[PC::Affine + 12 * side + 3 * 3 + a]) - bc[side][a];
+                const v8f r = load8(cg.v[PC::Affine + 12 * side + 3 * 0 + a]) * cf.x() +
+                              load8(cg.v[PC::Affine + 12 * side + 3 * 1 + a]) * cf.y() +
+                              load8(cg.v[PC::Affine + 12 * side + 3 * 2 + a]) * cf.z() +
+                              load8(cg.v[PC::Affine + 12 * side + 3 * 3 + a]) - bc[side][a];
                 store8(pg.v[(side == 0 ? C::RS0 : C::RT0) + a], r);
                 length2[side] += r * r;
             }
@@ -858,8 +951,13 @@ VOLMORPH_ALWAYS_INLINE inline void AdaptiveWarp::analyzeBody(Context& ctx, const
         const PC::Group& cg = col.groups[i / 8];
         PairBounds::Group& pg = pb.groups[i / 8];
         const v8f w1 = load8(pg.v[C::W1]), w2 = load8(pg.v[C::W2]);
-        const v8i skip = (load8(pg.v[C::Constant]) != zero) | (none != zero) | (load8(cg.v[PC::Live]) == zero);
-        const v8f term = skip ? zero : w2 == infinity ? infinity : k * ((load8(pg.v[C::Resid]) + rhoMaxF) * w2 + 2.0f * load8(&slope[i]) * w1);
+        const v8i skip =
+            (load8(pg.v[C::Constant]) != zero) | (none != zero) | (load8(cg.v[PC::Live]) == zero);
+        const v8f term =
+            skip ? zero
+            : w2 == infinity
+                ? infinity
+                : k * ((load8(pg.v[C::Resid]) + rhoMaxF) * w2 + 2.0f * load8(&slope[i]) * w1);
         const v8f hess = skip ? zero : k * w2;
         store8(pg.v[C::Hess], hess);
         store8(pg.v[C::Term], term);
@@ -893,7 +991,9 @@ VOLMORPH_ALWAYS_INLINE inline void AdaptiveWarp::analyzeBody(Context& ctx, const
         v4d rho[3][2];
         for (int a = 0; a < 3; ++a)
             for (int m = 0; m < 2; ++m) {
-                const v4d bx = ((bA.col[0][a] * cornerX + bA.col[1][a] * cornerY) + bA.col[2][a] * cornerZ[m]) + bA.offset[a];
+                const v4d bx = ((bA.col[0][a] * cornerX + bA.col[1][a] * cornerY) +
+                                bA.col[2][a] * cornerZ[m]) +
+                               bA.offset[a];
                 store4(&ctx.cornerB[side][a][4 * m], bx);
                 v4d sum; // S or T
                 for (int l = 0; l < 4; ++l) {
@@ -920,31 +1020,37 @@ VOLMORPH_ALWAYS_INLINE inline void AdaptiveWarp::analyzeBody(Context& ctx, const
     }
     if (!std::isfinite(ctx.boundAllFar) || n == 1) return;
     const Vec3f mid[2] = {Vec3f(ctx.rhoMid[0]), Vec3f(ctx.rhoMid[1])};
-    const float boundAllFar = float(ctx.boundAllFar), radiusS = float(radius[0]), radiusT = float(radius[1]);
+    const float boundAllFar = float(ctx.boundAllFar), radiusS = float(radius[0]),
+                radiusT = float(radius[1]);
     WideSum tightTotal;
     for (size_t i = 0; i < padded; i += 8) {
         const PC::Group& cg = col.groups[i / 8];
         PairBounds::Group& pg = pb.groups[i / 8];
         v8f length2[2] = {zero, zero};
         for (int a = 0; a < 3; ++a) {
-            const v8f ds = load8(pg.v[C::RS0 + a]) - mid[0][a], dt = load8(pg.v[C::RT0 + a]) - mid[1][a];
+            const v8f ds = load8(pg.v[C::RS0 + a]) - mid[0][a],
+                      dt = load8(pg.v[C::RT0 + a]) - mid[1][a];
             length2[0] += ds * ds;
             length2[1] += dt * dt;
         }
         const v8f w1 = load8(pg.v[C::W1]), w2 = load8(pg.v[C::W2]), term = load8(pg.v[C::Term]);
         const v8f apart = vmax(vsqrt(length2[0]) + radiusS, vsqrt(length2[1]) + radiusT) +
                           load8(&slope[i]) * halfDiagonalF + boundAllFar;
-        const v8i tighter = (term != infinity) & (load8(pg.v[C::Constant]) == zero) & (apart < load8(pg.v[C::Resid]) + rhoMaxF);
+        const v8i tighter = (term != infinity) & (load8(pg.v[C::Constant]) == zero) &
+                            (apart < load8(pg.v[C::Resid]) + rhoMaxF);
         const v8f tightTerm = tighter ? k * (apart * w2 + 2.0f * load8(&slope[i]) * w1) : term;
         store8(pg.v[C::Term], tightTerm);
-        tightTotal.add(load8(cg.v[PC::Live]) != zero ? tightTerm : zero); // padding lanes hold no pair
+        tightTotal.add(load8(cg.v[PC::Live]) != zero ? tightTerm
+                                                     : zero); // padding lanes hold no pair
     }
-    ctx.boundAllFar = std::min(ctx.boundAllFar, bound(ctx, tightTotal.total(), hess, ctx.wCornerMin));
+    ctx.boundAllFar =
+        std::min(ctx.boundAllFar, bound(ctx, tightTotal.total(), hess, ctx.wCornerMin));
 }
 
 /// The exact warp's unnormalized sums W = sum w_i, S = sum w_i A_S,i, T = sum w_i A_T,i at x (so
 /// that S / W and T / W are InverseWarp::map's points), over the pairs' columns, 4 at a time.
-VOLMORPH_ALWAYS_INLINE inline bool AdaptiveWarp::exactSumsBody(const Vec3d& x, LatticePoint& out) const
+VOLMORPH_ALWAYS_INLINE inline bool AdaptiveWarp::exactSumsBody(const Vec3d& x,
+                                                               LatticePoint& out) const
 {
     const size_t n = mWarp.pairCount();
     const PairColumns<double>& col = mColumns->exact;
@@ -956,10 +1062,13 @@ VOLMORPH_ALWAYS_INLINE inline bool AdaptiveWarp::exactSumsBody(const Vec3d& x, L
     using PC = PairColumns<double>;
     for (size_t i = 0; i < col.padded; i += 4) {
         const PC::Group& cg = col.groups[i / 4];
-        const v4d p[3] = {x.x() - load4(cg.v[PC::Origin + 0]), x.y() - load4(cg.v[PC::Origin + 1]), x.z() - load4(cg.v[PC::Origin + 2])};
+        const v4d p[3] = {x.x() - load4(cg.v[PC::Origin + 0]), x.y() - load4(cg.v[PC::Origin + 1]),
+                          x.z() - load4(cg.v[PC::Origin + 2])};
         v4d out2 = zero;
         for (int k = 0; k < 3; ++k) {
-            const v4d q = load4(cg.v[PC::Axis + 3 * k + 0]) * p[0] + load4(cg.v[PC::Axis + 3 * k + 1]) * p[1] + load4(cg.v[PC::Axis + 3 * k + 2]) * p[2];
+            const v4d q = load4(cg.v[PC::Axis + 3 * k + 0]) * p[0] +
+                          load4(cg.v[PC::Axis + 3 * k + 1]) * p[1] +
+                          load4(cg.v[PC::Axis + 3 * k + 2]) * p[2];
             const v4d d = outside(q, load4(cg.v[PC::Half + k]));
             out2 += d * d;
         }
@@ -975,8 +1084,14 @@ VOLMORPH_ALWAYS_INLINE inline bool AdaptiveWarp::exactSumsBody(const Vec3d& x, L
         w = live ? w : zero;
         W += w;
         for (int a = 0; a < 3; ++a) {
-            S[a] += w * (load4(cg.v[PC::Affine + 3 * 0 + a]) * x.x() + load4(cg.v[PC::Affine + 3 * 1 + a]) * x.y() + load4(cg.v[PC::Affine + 3 * 2 + a]) * x.z() + load4(cg.v[PC::Affine + 3 * 3 + a]));
-            T[a] += w * (load4(cg.v[PC::Affine + 12 + 3 * 0 + a]) * x.x() + load4(cg.v[PC::Affine + 12 + 3 * 1 + a]) * x.y() + load4(cg.v[PC::Affine + 12 + 3 * 2 + a]) * x.z() + load4(cg.v[PC::Affine + 12 + 3 * 3 + a]));
+            S[a] += w * (load4(cg.v[PC::Affine + 3 * 0 + a]) * x.x() +
+                         load4(cg.v[PC::Affine + 3 * 1 + a]) * x.y() +
+                         load4(cg.v[PC::Affine + 3 * 2 + a]) * x.z() +
+                         load4(cg.v[PC::Affine + 3 * 3 + a]));
+            T[a] += w * (load4(cg.v[PC::Affine + 12 + 3 * 0 + a]) * x.x() +
+                         load4(cg.v[PC::Affine + 12 + 3 * 1 + a]) * x.y() +
+                         load4(cg.v[PC::Affine + 12 + 3 * 2 + a]) * x.z() +
+                         load4(cg.v[PC::Affine + 12 + 3 * 3 + a]));
         }
     }
     auto total = [](v4d v) { return (v[0] + v[1]) + (v[2] + v[3]); };
@@ -988,37 +1103,52 @@ VOLMORPH_ALWAYS_INLINE inline bool AdaptiveWarp::exactSumsBody(const Vec3d& x, L
 }
 
 #ifdef VOLMORPH_HAVE_AVX2_KERNEL
-VOLMORPH_AVX2 void AdaptiveWarp::analyzeAvx2(Context& ctx, const LatticePoint* const corners[8], const Coord& origin, int size) const
+VOLMORPH_AVX2 void AdaptiveWarp::analyzeAvx2(Context& ctx, const LatticePoint* const corners[8],
+                                             const Coord& origin, int size) const
 {
     analyzeBody(ctx, corners, origin, size);
 }
-VOLMORPH_AVX512 void AdaptiveWarp::analyzeAvx512(Context& ctx, const LatticePoint* const corners[8], const Coord& origin, int size) const
+VOLMORPH_AVX512 void AdaptiveWarp::analyzeAvx512(Context& ctx, const LatticePoint* const corners[8],
+                                                 const Coord& origin, int size) const
 {
     analyzeBody(ctx, corners, origin, size);
 }
-VOLMORPH_AVX2 bool AdaptiveWarp::exactSumsAvx2(const Vec3d& x, LatticePoint& out) const { return exactSumsBody(x, out); }
-VOLMORPH_AVX512 bool AdaptiveWarp::exactSumsAvx512(const Vec3d& x, LatticePoint& out) const { return exactSumsBody(x, out); }
+VOLMORPH_AVX2 bool AdaptiveWarp::exactSumsAvx2(const Vec3d& x, LatticePoint& out) const
+{
+    return exactSumsBody(x, out);
+}
+VOLMORPH_AVX512 bool AdaptiveWarp::exactSumsAvx512(const Vec3d& x, LatticePoint& out) const
+{
+    return exactSumsBody(x, out);
+}
 #endif
 
 bool AdaptiveWarp::exactSums(const Vec3d& x, LatticePoint& out) const
 {
 #ifdef VOLMORPH_HAVE_AVX2_KERNEL
     switch (kernelBuild()) {
-    case KernelBuild::Avx512: return exactSumsAvx512(x, out);
-    case KernelBuild::Avx2: return exactSumsAvx2(x, out);
-    case KernelBuild::Baseline: break;
+    case KernelBuild::Avx512:
+        return exactSumsAvx512(x, out);
+    case KernelBuild::Avx2:
+        return exactSumsAvx2(x, out);
+    case KernelBuild::Baseline:
+        break;
     }
 #endif
     return exactSumsBody(x, out);
 }
 
-void AdaptiveWarp::analyze(Context& ctx, const LatticePoint* const corners[8], const Coord& origin, int size) const
+void AdaptiveWarp::analyze(Context& ctx, const LatticePoint* const corners[8], const Coord& origin,
+                           int size) const
 {
 #ifdef VOLMORPH_HAVE_AVX2_KERNEL
     switch (kernelBuild()) {
-    case KernelBuild::Avx512: return analyzeAvx512(ctx, corners, origin, size);
-    case KernelBuild::Avx2: return analyzeAvx2(ctx, corners, origin, size);
-    case KernelBuild::Baseline: break;
+    case KernelBuild::Avx512:
+        return analyzeAvx512(ctx, corners, origin, size);
+    case KernelBuild::Avx2:
+        return analyzeAvx2(ctx, corners, origin, size);
+    case KernelBuild::Baseline:
+        break;
     }
 #endif
     analyzeBody(ctx, corners, origin, size);
@@ -1046,12 +1176,14 @@ bool AdaptiveWarp::mayTouch(Context& ctx, const Coord& origin, int size) const
     affineImage(bT, o, h, tLo, tHi);
     // Where the corners themselves land: a cube whose corners' box touches an occupied block is
     // kept without a second test on its filled points.
-    ctx.coreTouches = ctx.cornersOk && (touches(ctx.source, sLo + rsLo, sHi + rsHi, kSamplerReach) ||
-                                        touches(ctx.target, tLo + rtLo, tHi + rtHi, kSamplerReach));
+    ctx.coreTouches =
+        ctx.cornersOk && (touches(ctx.source, sLo + rsLo, sHi + rsHi, kSamplerReach) ||
+                          touches(ctx.target, tLo + rtLo, tHi + rtHi, kSamplerReach));
     if (ctx.coreTouches) return true;
     if (ctx.cornersOk && boundAllFar < rhoMax) {
         const double margin = kSamplerReach + boundAllFar;
-        return touches(ctx.source, sLo + rsLo, sHi + rsHi, margin) || touches(ctx.target, tLo + rtLo, tHi + rtHi, margin);
+        return touches(ctx.source, sLo + rsLo, sHi + rsHi, margin) ||
+               touches(ctx.target, tLo + rtLo, tHi + rtHi, margin);
     }
     const double margin = kSamplerReach + rhoMax;
     return touches(ctx.source, sLo, sHi, margin) || touches(ctx.target, tLo, tHi, margin);
@@ -1063,7 +1195,8 @@ double AdaptiveWarp::bound(const Context& ctx, double terms, double hess, double
     // the smallest total weight less what interpolating W_F may take, and at least `floor`
     // (with every pair far, I[W] is a convex combination of the corners' W: their smallest).
     const double denominator = std::max(ctx.wMinSum - hess, floor);
-    return std::isfinite(terms) && denominator > 0.0 ? terms / denominator : std::numeric_limits<double>::infinity();
+    return std::isfinite(terms) && denominator > 0.0 ? terms / denominator
+                                                     : std::numeric_limits<double>::infinity();
 }
 
 double AdaptiveWarp::selectNear(Context& ctx, size_t& nearCount) const
@@ -1143,7 +1276,8 @@ void AdaptiveWarp::fill(Context& ctx, const Coord& origin) const
         NearTerm t;
         t.element = &mWarp.interpolated(p);
         t.scale = mWarp.weightScale(p);
-        for (int k = 0; k < 3; ++k) t.half[k] = mColumns->exact.get(PairColumns<double>::Half + k, p);
+        for (int k = 0; k < 3; ++k)
+            t.half[k] = mColumns->exact.get(PairColumns<double>::Half + k, p);
         t.rs = mSource[p].apply(o) - bso;
         t.rt = mTarget[p].apply(o) - bto;
         for (int k = 0; k < 3; ++k) {
@@ -1153,7 +1287,8 @@ void AdaptiveWarp::fill(Context& ctx, const Coord& origin) const
         job.near.push_back(t);
         ++job.typeEnd[int(mWarp.interpolated(p).type)];
     }
-    for (int type = 1; type < 4; ++type) job.typeEnd[type] += job.typeEnd[type - 1]; // counts to ends
+    for (int type = 1; type < 4; ++type)
+        job.typeEnd[type] += job.typeEnd[type - 1]; // counts to ends
     fillLeaf(job, ctx.leaf);
 }
 
@@ -1170,7 +1305,8 @@ void AdaptiveWarp::leaf(Context& ctx, const Lattice& lattice, const Coord& origi
             Vec3f lo[2], hi[2];
             leafRange(ctx.leaf, lo, hi);
             const double margin = kSamplerReach + errorBound;
-            if (!touches(ctx.source, Vec3d(lo[0]), Vec3d(hi[0]), margin) && !touches(ctx.target, Vec3d(lo[1]), Vec3d(hi[1]), margin))
+            if (!touches(ctx.source, Vec3d(lo[0]), Vec3d(hi[0]), margin) &&
+                !touches(ctx.target, Vec3d(lo[1]), Vec3d(hi[1]), margin))
                 return;
         }
         ++ctx.leaves;
@@ -1211,13 +1347,16 @@ void AdaptiveWarp::leaf(Context& ctx, const Lattice& lattice, const Coord& origi
     visit(bound, !ctx.coreTouches);
 }
 
-void AdaptiveWarp::forEachLeaf(const CoordBBox& box, const Occupancy* source, const Occupancy* target,
-                               const LeafFunction& fn, AdaptiveWarpStats* stats, Interrupter* interrupter,
+void AdaptiveWarp::forEachLeaf(const CoordBBox& box, const Occupancy* source,
+                               const Occupancy* target, const LeafFunction& fn,
+                               AdaptiveWarpStats* stats, Interrupter* interrupter,
                                const CellFilter* wanted) const
 {
     if (box.empty()) return;
     const size_t n = mWarp.pairCount();
-    auto down = [](int v, int size) { return v >= 0 ? v / size * size : -((-v + size - 1) / size) * size; };
+    auto down = [](int v, int size) {
+        return v >= 0 ? v / size * size : -((-v + size - 1) / size) * size;
+    };
 
     // 1. Candidate cells of 2^3 leaves (16 voxels), each with the mask of its leaves that lie in
     //    the box and are wanted, gathered per top cell: top cells the filter refuses, or whose
@@ -1227,55 +1366,64 @@ void AdaptiveWarp::forEachLeaf(const CoordBBox& box, const Occupancy* source, co
         Coord origin;
         uint8_t leaves; ///< bit (x << 2 | y << 1 | z): the leaf at origin + 8 (x, y, z)
     };
-    const Coord lo(down(box.min().x(), kTopCell), down(box.min().y(), kTopCell), down(box.min().z(), kTopCell));
+    const Coord lo(down(box.min().x(), kTopCell), down(box.min().y(), kTopCell),
+                   down(box.min().z(), kTopCell));
     std::vector<Coord> tops;
     for (int x = lo.x(); x <= box.max().x(); x += kTopCell)
         for (int y = lo.y(); y <= box.max().y(); y += kTopCell)
             for (int z = lo.z(); z <= box.max().z(); z += kTopCell) tops.emplace_back(x, y, z);
     std::vector<std::vector<Cell>> perTop(tops.size());
-    tbb::parallel_for(tbb::blocked_range<size_t>(0, tops.size(), 1), [&](const tbb::blocked_range<size_t>& r) {
-        for (size_t ti = r.begin(); ti != r.end(); ++ti) {
-            const CoordBBox cube = CoordBBox::createCube(tops[ti], kTopCell);
-            if (wanted && !(*wanted)(cube)) continue;
-            if ((source || target) && n > 0) {
-                Vec3d slo(std::numeric_limits<double>::max()), shi(-slo), tlo(slo), thi(-slo);
-                for (size_t i = 0; i < n; ++i) {
-                    Vec3d a, c;
-                    affineImage(mSource[i], cube.min().asVec3d(), kTopCell, a, c);
-                    slo = minComponent(slo, a);
-                    shi = maxComponent(shi, c);
-                    affineImage(mTarget[i], cube.min().asVec3d(), kTopCell, a, c);
-                    tlo = minComponent(tlo, a);
-                    thi = maxComponent(thi, c);
-                }
-                if (!touches(source, slo, shi, kSamplerReach) && !touches(target, tlo, thi, kSamplerReach)) continue;
-            }
-            CoordBBox part = cube;
-            part.intersect(box);
-            if (part.empty()) continue;
-            const CoordBBox leafRange(Coord(down(part.min().x(), 8), down(part.min().y(), 8), down(part.min().z(), 8)),
-                                      part.max()); // the leaves' origins
-            // Cells in the order of their blocks of 2^3 cells (step 2 culls blocks, then cells).
-            const CoordBBox cellRange(Coord(down(part.min().x(), 16), down(part.min().y(), 16), down(part.min().z(), 16)),
-                                      part.max());
-            for (int bx = down(part.min().x(), 32); bx <= part.max().x(); bx += 32)
-            for (int by = down(part.min().y(), 32); by <= part.max().y(); by += 32)
-            for (int bz = down(part.min().z(), 32); bz <= part.max().z(); bz += 32) {
-                for (int k = 0; k < 8; ++k) {
-                    const Coord o(bx + ((k >> 2) & 1) * 16, by + ((k >> 1) & 1) * 16, bz + (k & 1) * 16);
-                    if (!cellRange.isInside(o)) continue;
-                    Cell cell{o, 0};
-                    for (int m = 0; m < 8; ++m) {
-                        const Coord c = o.offsetBy(((m >> 2) & 1) * 8, ((m >> 1) & 1) * 8, (m & 1) * 8);
-                        if (!leafRange.isInside(c)) continue;
-                        if (wanted && !(*wanted)(CoordBBox::createCube(c, 8))) continue;
-                        cell.leaves |= uint8_t(1u << m);
+    tbb::parallel_for(
+        tbb::blocked_range<size_t>(0, tops.size(), 1), [&](const tbb::blocked_range<size_t>& r) {
+            for (size_t ti = r.begin(); ti != r.end(); ++ti) {
+                const CoordBBox cube = CoordBBox::createCube(tops[ti], kTopCell);
+                if (wanted && !(*wanted)(cube)) continue;
+                if ((source || target) && n > 0) {
+                    Vec3d slo(std::numeric_limits<double>::max()), shi(-slo), tlo(slo), thi(-slo);
+                    for (size_t i = 0; i < n; ++i) {
+                        Vec3d a, c;
+                        affineImage(mSource[i], cube.min().asVec3d(), kTopCell, a, c);
+                        slo = minComponent(slo, a);
+                        shi = maxComponent(shi, c);
+                        affineImage(mTarget[i], cube.min().asVec3d(), kTopCell, a, c);
+                        tlo = minComponent(tlo, a);
+                        thi = maxComponent(thi, c);
                     }
-                    if (cell.leaves) perTop[ti].push_back(cell);
+                    if (!touches(source, slo, shi, kSamplerReach) &&
+                        !touches(target, tlo, thi, kSamplerReach))
+                        continue;
                 }
+                CoordBBox part = cube;
+                part.intersect(box);
+                if (part.empty()) continue;
+                const CoordBBox leafRange(Coord(down(part.min().x(), 8), down(part.min().y(), 8),
+                                                down(part.min().z(), 8)),
+                                          part.max()); // the leaves' origins
+                // Cells in the order of their blocks of 2^3 cells (step 2 culls blocks, then
+                // cells).
+                const CoordBBox cellRange(Coord(down(part.min().x(), 16), down(part.min().y(), 16),
+                                                down(part.min().z(), 16)),
+                                          part.max());
+                for (int bx = down(part.min().x(), 32); bx <= part.max().x(); bx += 32)
+                    for (int by = down(part.min().y(), 32); by <= part.max().y(); by += 32)
+                        for (int bz = down(part.min().z(), 32); bz <= part.max().z(); bz += 32) {
+                            for (int k = 0; k < 8; ++k) {
+                                const Coord o(bx + ((k >> 2) & 1) * 16, by + ((k >> 1) & 1) * 16,
+                                              bz + (k & 1) * 16);
+                                if (!cellRange.isInside(o)) continue;
+                                Cell cell{o, 0};
+                                for (int m = 0; m < 8; ++m) {
+                                    const Coord c = o.offsetBy(((m >> 2) & 1) * 8,
+                                                               ((m >> 1) & 1) * 8, (m & 1) * 8);
+                                    if (!leafRange.isInside(c)) continue;
+                                    if (wanted && !(*wanted)(CoordBBox::createCube(c, 8))) continue;
+                                    cell.leaves |= uint8_t(1u << m);
+                                }
+                                if (cell.leaves) perTop[ti].push_back(cell);
+                            }
+                        }
             }
-        }
-    });
+        });
     std::vector<Cell> cells;
     for (const auto& v : perTop) cells.insert(cells.end(), v.begin(), v.end());
     if (cells.empty()) return;
@@ -1296,7 +1444,8 @@ void AdaptiveWarp::forEachLeaf(const CoordBBox& box, const Occupancy* source, co
         for (const Cell& cell : cells)
             for (int k = 0; k < 8; ++k)
                 if (cell.leaves & (1u << k))
-                    candidates.push_back(cell.origin.offsetBy(((k >> 2) & 1) * 8, ((k >> 1) & 1) * 8, (k & 1) * 8));
+                    candidates.push_back(
+                        cell.origin.offsetBy(((k >> 2) & 1) * 8, ((k >> 1) & 1) * 8, (k & 1) * 8));
     };
 
     // 2. The exact sums at the corners of the candidate leaves, each lattice point once. With
@@ -1325,20 +1474,25 @@ void AdaptiveWarp::forEachLeaf(const CoordBBox& box, const Occupancy* source, co
             std::vector<size_t> todo;
             todo.swap(pending);
             latticeEvaluations += todo.size();
-            tbb::parallel_for(tbb::blocked_range<size_t>(0, todo.size(), 64), [&](const tbb::blocked_range<size_t>& r) {
-                if (stopped || (interrupter && interrupter->wasInterrupted(progressFrom + int(5 * r.begin() / todo.size())))) {
-                    stopped = true;
-                    return;
-                }
-                const int yz = lattice.dim.y() * lattice.dim.z();
-                for (size_t i = r.begin(); i != r.end(); ++i) {
-                    const size_t idx = todo[i];
-                    const Coord l(lattice.lo.x() + int(idx / yz), lattice.lo.y() + int(idx % yz) / lattice.dim.z(),
-                                  lattice.lo.z() + int(idx % lattice.dim.z()));
-                    Lattice::Point& p = lattice.points[idx];
-                    p.ok = exactSums(Vec3d(l.x() * 8.0, l.y() * 8.0, l.z() * 8.0), p);
-                }
-            });
+            tbb::parallel_for(
+                tbb::blocked_range<size_t>(0, todo.size(), 64),
+                [&](const tbb::blocked_range<size_t>& r) {
+                    if (stopped ||
+                        (interrupter && interrupter->wasInterrupted(
+                                            progressFrom + int(5 * r.begin() / todo.size())))) {
+                        stopped = true;
+                        return;
+                    }
+                    const int yz = lattice.dim.y() * lattice.dim.z();
+                    for (size_t i = r.begin(); i != r.end(); ++i) {
+                        const size_t idx = todo[i];
+                        const Coord l(lattice.lo.x() + int(idx / yz),
+                                      lattice.lo.y() + int(idx % yz) / lattice.dim.z(),
+                                      lattice.lo.z() + int(idx % lattice.dim.z()));
+                        Lattice::Point& p = lattice.points[idx];
+                        p.ok = exactSums(Vec3d(l.x() * 8.0, l.y() * 8.0, l.z() * 8.0), p);
+                    }
+                });
             if (stopped) throw Interrupted();
         };
         // Wants the corners of the cube of `step` lattice cells at origin; new ones go to `list`.
@@ -1346,34 +1500,43 @@ void AdaptiveWarp::forEachLeaf(const CoordBBox& box, const Occupancy* source, co
         auto want = [&](const Coord& origin, int step, std::vector<size_t>& list) {
             const Coord l(origin.x() >> 3, origin.y() >> 3, origin.z() >> 3);
             for (int k = 0; k < 8; ++k) {
-                const size_t i = lattice.index(l.offsetBy((k & 1) * step, ((k >> 1) & 1) * step, ((k >> 2) & 1) * step));
-                if (!wanted[i] && __atomic_exchange_n(&wanted[i], char(1), __ATOMIC_RELAXED) == 0) list.push_back(i);
+                const size_t i = lattice.index(
+                    l.offsetBy((k & 1) * step, ((k >> 1) & 1) * step, ((k >> 2) & 1) * step));
+                if (!wanted[i] && __atomic_exchange_n(&wanted[i], char(1), __ATOMIC_RELAXED) == 0)
+                    list.push_back(i);
             }
         };
         if (source || target) {
             // Blocks of 2^3 cells (32 voxels), then cells (16), each culled from its own corners.
             auto cull = [&](int size) {
-                auto groupOf = [size](const Coord& c) { return Coord(c.x() & -size, c.y() & -size, c.z() & -size); };
+                auto groupOf = [size](const Coord& c) {
+                    return Coord(c.x() & -size, c.y() & -size, c.z() & -size);
+                };
                 std::vector<size_t> begin; // where each group's cells begin
                 for (size_t i = 0; i < cells.size(); ++i)
-                    if (i == 0 || groupOf(cells[i].origin) != groupOf(cells[i - 1].origin)) begin.push_back(i);
+                    if (i == 0 || groupOf(cells[i].origin) != groupOf(cells[i - 1].origin))
+                        begin.push_back(i);
                 begin.push_back(cells.size());
                 const int step = size / 8;
-                for (size_t g = 0; g + 1 < begin.size(); ++g) want(groupOf(cells[begin[g]].origin), step, pending);
+                for (size_t g = 0; g + 1 < begin.size(); ++g)
+                    want(groupOf(cells[begin[g]].origin), step, pending);
                 evaluate(0);
                 std::vector<char> keep(begin.size() - 1, 0);
-                tbb::parallel_for(tbb::blocked_range<size_t>(0, keep.size(), 8), [&](const tbb::blocked_range<size_t>& r) {
-                    Context& ctx = contexts.local();
-                    for (size_t g = r.begin(); g != r.end(); ++g) {
-                        const Coord o = groupOf(cells[begin[g]].origin);
-                        const Coord l(o.x() >> 3, o.y() >> 3, o.z() >> 3);
-                        const LatticePoint* corners[8];
-                        for (int k = 0; k < 8; ++k)
-                            corners[k] = &lattice.points[lattice.index(l.offsetBy((k & 1) * step, ((k >> 1) & 1) * step, ((k >> 2) & 1) * step))];
-                        analyze(ctx, corners, o, size);
-                        keep[g] = mayTouch(ctx, o, size);
-                    }
-                });
+                tbb::parallel_for(
+                    tbb::blocked_range<size_t>(0, keep.size(), 8),
+                    [&](const tbb::blocked_range<size_t>& r) {
+                        Context& ctx = contexts.local();
+                        for (size_t g = r.begin(); g != r.end(); ++g) {
+                            const Coord o = groupOf(cells[begin[g]].origin);
+                            const Coord l(o.x() >> 3, o.y() >> 3, o.z() >> 3);
+                            const LatticePoint* corners[8];
+                            for (int k = 0; k < 8; ++k)
+                                corners[k] = &lattice.points[lattice.index(l.offsetBy(
+                                    (k & 1) * step, ((k >> 1) & 1) * step, ((k >> 2) & 1) * step))];
+                            analyze(ctx, corners, o, size);
+                            keep[g] = mayTouch(ctx, o, size);
+                        }
+                    });
                 size_t kept = 0;
                 for (size_t g = 0; g < keep.size(); ++g)
                     if (keep[g])
@@ -1387,25 +1550,32 @@ void AdaptiveWarp::forEachLeaf(const CoordBBox& box, const Occupancy* source, co
         // The candidates' corners, found in parallel, listed in the threads' order (the points do
         // not depend on the order they are evaluated in).
         tbb::enumerable_thread_specific<std::vector<size_t>> found;
-        tbb::parallel_for(tbb::blocked_range<size_t>(0, candidates.size(), 512), [&](const tbb::blocked_range<size_t>& r) {
-            std::vector<size_t>& list = found.local();
-            for (size_t i = r.begin(); i != r.end(); ++i) want(candidates[i], 1, list);
-        });
-        for (const std::vector<size_t>& list : found) pending.insert(pending.end(), list.begin(), list.end());
+        tbb::parallel_for(tbb::blocked_range<size_t>(0, candidates.size(), 512),
+                          [&](const tbb::blocked_range<size_t>& r) {
+                              std::vector<size_t>& list = found.local();
+                              for (size_t i = r.begin(); i != r.end(); ++i)
+                                  want(candidates[i], 1, list);
+                          });
+        for (const std::vector<size_t>& list : found)
+            pending.insert(pending.end(), list.begin(), list.end());
         evaluate(5);
     } else {
         expand();
     }
 
     // 3. Every candidate leaf: culled by the bound, filled, culled by its points, handed on.
-    tbb::parallel_for(tbb::blocked_range<size_t>(0, candidates.size(), 16), [&](const tbb::blocked_range<size_t>& r) {
-        if (stopped || (interrupter && interrupter->wasInterrupted(10 + int(90 * r.begin() / candidates.size())))) {
-            stopped = true;
-            return;
-        }
-        Context& ctx = contexts.local();
-        for (size_t i = r.begin(); i != r.end(); ++i) leaf(ctx, lattice, candidates[i]);
-    });
+    tbb::parallel_for(tbb::blocked_range<size_t>(0, candidates.size(), 16),
+                      [&](const tbb::blocked_range<size_t>& r) {
+                          if (stopped ||
+                              (interrupter && interrupter->wasInterrupted(
+                                                  10 + int(90 * r.begin() / candidates.size())))) {
+                              stopped = true;
+                              return;
+                          }
+                          Context& ctx = contexts.local();
+                          for (size_t i = r.begin(); i != r.end(); ++i)
+                              leaf(ctx, lattice, candidates[i]);
+                      });
     if (stopped) throw Interrupted();
     if (!stats) return;
     for (const Context& ctx : contexts) {

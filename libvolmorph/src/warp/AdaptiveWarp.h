@@ -31,8 +31,8 @@
 //    rho = p - B (a convex combination of the R_i), |R_i| and W_min bounded over the leaf, both
 //    sides (w_i at least at d_i <= |x - (c - d_c grad d_c)|, the centre's nearest point on the
 //    element); with every pair far, the interpolated W is at least W_floor, the corners'
-//    smallest W. Where this all-far bound is finite, a second pass tightens it: a far pair's share is
-//    (R_i(c) - rho) (I[w_i] - w_i) + (M_i - M_B)(I[w_i (x - c)] - w_i (x - c)), c the centre,
+//    smallest W. Where this all-far bound is finite, a second pass tightens it: a far pair's share
+//    is (R_i(c) - rho) (I[w_i] - w_i) + (M_i - M_B)(I[w_i (x - c)] - w_i (x - c)), c the centre,
 //    and the all-far interpolant's rho lies in the hull of the corners' rho_k, within the bound
 //    of the true rho, so |R_i| + |rho| becomes |R_i(c) - rho_0| + (hull radius) + bound.
 //    Pairs join E, largest term first, until the bound is within the tolerance. An
@@ -102,11 +102,12 @@ struct WarpLeaf {
 };
 
 struct AdaptiveWarpStats {
-    double maxErrorVoxels = 0.0;     ///< the largest error bound of an interpolated leaf (voxels)
-    uint64_t exactEvaluations = 0;   ///< exact warp evaluations (lattice points, exact leaves' voxels)
-    uint64_t nearEvaluations = 0;    ///< near pairs evaluated at single voxels (one pair each)
-    uint64_t allFarLeaves = 0;       ///< interpolated leaves with no near pair
-    uint64_t leaves = 0;             ///< leaves visited (the candidate domain)
+    double maxErrorVoxels = 0.0; ///< the largest error bound of an interpolated leaf (voxels)
+    uint64_t exactEvaluations =
+        0;                        ///< exact warp evaluations (lattice points, exact leaves' voxels)
+    uint64_t nearEvaluations = 0; ///< near pairs evaluated at single voxels (one pair each)
+    uint64_t allFarLeaves = 0;    ///< interpolated leaves with no near pair
+    uint64_t leaves = 0;          ///< leaves visited (the candidate domain)
 };
 
 /// The builds of the leaf kernel, the bound and the lattice's sums, least capable first: the
@@ -134,9 +135,10 @@ public:
     /// by the occupancies (nullptr on both: every leaf of the box) and that `wanted` (if given)
     /// accepts. Deterministic: each leaf's positions depend only on the leaf, not on threads or
     /// order.
-    void forEachLeaf(const openvdb::CoordBBox& box, const Occupancy* source, const Occupancy* target,
-                     const LeafFunction& fn, AdaptiveWarpStats* stats = nullptr,
-                     Interrupter* interrupter = nullptr, const CellFilter* wanted = nullptr) const;
+    void forEachLeaf(const openvdb::CoordBBox& box, const Occupancy* source,
+                     const Occupancy* target, const LeafFunction& fn,
+                     AdaptiveWarpStats* stats = nullptr, Interrupter* interrupter = nullptr,
+                     const CellFilter* wanted = nullptr) const;
 
     /// Leaves are first gathered in cells this many voxels on a side (filtered, and culled by the
     /// hull of every pair's affine image).
@@ -149,7 +151,8 @@ private:
     struct Lattice;
     /// The bound's terms for the cube of `size` (4, 8 or 16) voxels at origin, from the exact
     /// sums at its corners (bit 0: +x, bit 1: +y, bit 2: +z), into ctx.
-    void analyze(Context& ctx, const LatticePoint* const corners[8], const openvdb::Coord& origin, int size) const;
+    void analyze(Context& ctx, const LatticePoint* const corners[8], const openvdb::Coord& origin,
+                 int size) const;
     /// The exact warp's unnormalized sums W, S and T at x (map() gives S / W and T / W), by the
     /// pairs' columns; false where x lies on an element and the weight law has no offset.
     bool exactSums(const Vec3d& x, LatticePoint& out) const;
@@ -157,9 +160,12 @@ private:
     bool exactSumsAvx2(const Vec3d& x, LatticePoint& out) const;
     bool exactSumsAvx512(const Vec3d& x, LatticePoint& out) const;
     /// analyze() and exactSums() in their builds (see KernelBuild).
-    void analyzeBody(Context& ctx, const LatticePoint* const corners[8], const openvdb::Coord& origin, int size) const;
-    void analyzeAvx2(Context& ctx, const LatticePoint* const corners[8], const openvdb::Coord& origin, int size) const;
-    void analyzeAvx512(Context& ctx, const LatticePoint* const corners[8], const openvdb::Coord& origin, int size) const;
+    void analyzeBody(Context& ctx, const LatticePoint* const corners[8],
+                     const openvdb::Coord& origin, int size) const;
+    void analyzeAvx2(Context& ctx, const LatticePoint* const corners[8],
+                     const openvdb::Coord& origin, int size) const;
+    void analyzeAvx512(Context& ctx, const LatticePoint* const corners[8],
+                       const openvdb::Coord& origin, int size) const;
     /// False when the analysed cube's image misses both sides' occupied blocks.
     bool mayTouch(Context& ctx, const openvdb::Coord& origin, int size) const;
     /// The error bound of the analysed cube from its far pairs' summed terms and Hessian bounds,
@@ -176,8 +182,8 @@ private:
     const InverseWarp& mWarp;
     double mTolerance;
     std::vector<InverseWarp::Affine> mSource, mTarget; ///< each pair's affine map on each side
-    std::unique_ptr<const Columns> mColumns; ///< the interpolated elements, by column
-    std::vector<size_t> mByType;             ///< the pairs by type, then by index (the kernel's order)
+    std::unique_ptr<const Columns> mColumns;           ///< the interpolated elements, by column
+    std::vector<size_t> mByType; ///< the pairs by type, then by index (the kernel's order)
 };
 
 } // namespace volmorph::detail

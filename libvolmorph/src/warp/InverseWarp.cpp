@@ -5,7 +5,8 @@
 
 namespace volmorph {
 
-InverseWarp::InverseWarp(const std::vector<FeaturePairSpec>& pairs, const WarpSpec& spec, double t, double unit)
+InverseWarp::InverseWarp(const std::vector<FeaturePairSpec>& pairs, const WarpSpec& spec, double t,
+                         double unit)
     : mWeighting(spec.weighting), mEpsilon(spec.epsilon * unit), mA(spec.a * unit), mB(spec.b)
 {
     mPairs.reserve(pairs.size());

@@ -7,7 +7,10 @@ using openvdb::Coord;
 using openvdb::CoordBBox;
 
 /// Block coordinates: floor division by 8 (an arithmetic shift, also below zero), as in anyIn.
-inline int block(int v) { return v >> 3; }
+inline int block(int v)
+{
+    return v >> 3;
+}
 
 } // namespace
 
@@ -15,7 +18,9 @@ Occupancy::Occupancy(const openvdb::FloatTree& tree)
 {
     openvdb::tree::ValueAccessor<openvdb::MaskTree> acc(mBlocks);
     for (auto leaf = tree.cbeginLeaf(); leaf; ++leaf)
-        if (!leaf->isEmpty()) acc.setValueOn(Coord(block(leaf->origin().x()), block(leaf->origin().y()), block(leaf->origin().z())));
+        if (!leaf->isEmpty())
+            acc.setValueOn(Coord(block(leaf->origin().x()), block(leaf->origin().y()),
+                                 block(leaf->origin().z())));
     auto tiles = tree.cbeginValueOn();
     tiles.setMaxDepth(openvdb::FloatTree::ValueOnCIter::LEAF_DEPTH - 1); // tiles only, not voxels
     for (; tiles; ++tiles) {
@@ -44,8 +49,8 @@ Occupancy::Occupancy(const openvdb::FloatTree& tree)
         for (int y = 1; y <= dim.y(); ++y)
             for (int z = 1; z <= dim.z(); ++z) {
                 uint32_t* p = &mPrefix[size_t(x) * sx + size_t(y) * sy + size_t(z)];
-                *p += p[-ptrdiff_t(sx)] + p[-ptrdiff_t(sy)] + p[-1] - p[-ptrdiff_t(sx + sy)] - p[-ptrdiff_t(sx + 1)] -
-                      p[-ptrdiff_t(sy + 1)] + p[-ptrdiff_t(sx + sy + 1)];
+                *p += p[-ptrdiff_t(sx)] + p[-ptrdiff_t(sy)] + p[-1] - p[-ptrdiff_t(sx + sy)] -
+                      p[-ptrdiff_t(sx + 1)] - p[-ptrdiff_t(sy + 1)] + p[-ptrdiff_t(sx + sy + 1)];
             }
 }
 
@@ -65,7 +70,8 @@ CoordBBox Occupancy::bounds() const
     CoordBBox b;
     if (!mBlocks.evalActiveVoxelBoundingBox(b)) return CoordBBox();
     const Coord lo = b.min(), hi = b.max();
-    return CoordBBox(Coord(lo.x() * 8, lo.y() * 8, lo.z() * 8), Coord(hi.x() * 8 + 7, hi.y() * 8 + 7, hi.z() * 8 + 7));
+    return CoordBBox(Coord(lo.x() * 8, lo.y() * 8, lo.z() * 8),
+                     Coord(hi.x() * 8 + 7, hi.y() * 8 + 7, hi.z() * 8 + 7));
 }
 
 } // namespace volmorph::detail

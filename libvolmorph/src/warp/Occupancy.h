@@ -25,15 +25,17 @@ public:
         if (mPrefix.empty()) return scan(lo, hi);
         // Inclusion-exclusion over the summed-volume table, the box clamped to its bounds.
         const openvdb::Coord a = openvdb::Coord::maxComponent(lo, mLo) - mLo;
-        const openvdb::Coord c = openvdb::Coord::minComponent(hi, mLo + mDim - openvdb::Coord(1)) - mLo;
+        const openvdb::Coord c =
+            openvdb::Coord::minComponent(hi, mLo + mDim - openvdb::Coord(1)) - mLo;
         if (a.x() > c.x() || a.y() > c.y() || a.z() > c.z()) return false;
         const size_t sy = size_t(mDim.z() + 1), sx = sy * size_t(mDim.y() + 1);
         const uint32_t* p = mPrefix.data();
         const size_t x0 = size_t(a.x()) * sx, x1 = size_t(c.x() + 1) * sx;
         const size_t y0 = size_t(a.y()) * sy, y1 = size_t(c.y() + 1) * sy;
         const size_t z0 = size_t(a.z()), z1 = size_t(c.z() + 1);
-        const int64_t count = int64_t(p[x1 + y1 + z1]) - p[x0 + y1 + z1] - p[x1 + y0 + z1] - p[x1 + y1 + z0] +
-                              p[x0 + y0 + z1] + p[x0 + y1 + z0] + p[x1 + y0 + z0] - p[x0 + y0 + z0];
+        const int64_t count = int64_t(p[x1 + y1 + z1]) - p[x0 + y1 + z1] - p[x1 + y0 + z1] -
+                              p[x1 + y1 + z0] + p[x0 + y0 + z1] + p[x0 + y1 + z0] +
+                              p[x1 + y0 + z0] - p[x0 + y0 + z0];
         return count > 0;
     }
     /// Index-space bounds of the occupied blocks (empty when nothing is).
@@ -46,8 +48,8 @@ private:
     openvdb::MaskTree mBlocks;
     // The same blocks as a summed-volume table over their bounds, for box queries in O(1)
     // (empty when that table would be too large; then the tree is scanned).
-    openvdb::Coord mLo, mDim;           ///< block coordinates of the table's first cell, cells per axis
-    std::vector<uint32_t> mPrefix;      ///< (mDim + 1)^3 counts of occupied blocks below each corner
+    openvdb::Coord mLo, mDim;      ///< block coordinates of the table's first cell, cells per axis
+    std::vector<uint32_t> mPrefix; ///< (mDim + 1)^3 counts of occupied blocks below each corner
 };
 
 } // namespace volmorph::detail

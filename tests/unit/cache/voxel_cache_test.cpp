@@ -24,8 +24,9 @@ struct Workspace {
     fs::path dir;
     Workspace()
     {
-        dir = fs::temp_directory_path() / ("volmorph-cache-test-" + std::to_string(getpid()) + "-" +
-                                           ::testing::UnitTest::GetInstance()->current_test_info()->name());
+        dir = fs::temp_directory_path() /
+              ("volmorph-cache-test-" + std::to_string(getpid()) + "-" +
+               ::testing::UnitTest::GetInstance()->current_test_info()->name());
         fs::remove_all(dir);
         fs::create_directories(dir);
         fs::copy_file(kMeshes / "sphere.obj", dir / "sphere.obj");
@@ -35,21 +36,26 @@ struct Workspace {
 };
 
 /// A scene of the two meshes in `dir`; the arguments change what the voxels depend on.
-Scene scene(const fs::path& dir, double voxelSize = 0.05, const std::string& targetColor = "[0.5, 0.5, 0.5]",
-            double translate = 1.5)
+Scene scene(const fs::path& dir, double voxelSize = 0.05,
+            const std::string& targetColor = "[0.5, 0.5, 0.5]", double translate = 1.5)
 {
-    const std::string text = "[source]\nmesh = \"sphere.obj\"\n"
-                             "[target]\nmesh = \"cube.obj\"\ncolor = " + targetColor +
-                             "\ntransform = { translate = [" + std::to_string(translate) + ", 0, 0] }\n"
-                             "[volume]\nvoxel_size = " + std::to_string(voxelSize) +
-                             "\n[frames]\nrange = \"1-2\"\noutput = \"out.####.exr\"\n";
+    const std::string text =
+        "[source]\nmesh = \"sphere.obj\"\n"
+        "[target]\nmesh = \"cube.obj\"\ncolor = " +
+        targetColor + "\ntransform = { translate = [" + std::to_string(translate) +
+        ", 0, 0] }\n"
+        "[volume]\nvoxel_size = " +
+        std::to_string(voxelSize) + "\n[frames]\nrange = \"1-2\"\noutput = \"out.####.exr\"\n";
     return parseScene(text, dir / "scene.toml");
 }
 
 /// True when the two grids have the same active voxels and tiles with the same values, bit for bit.
-template <typename GridT> bool sameGrid(const GridT& a, const GridT& b)
+template <typename GridT>
+bool sameGrid(const GridT& a, const GridT& b)
 {
-    if (a.activeVoxelCount() != b.activeVoxelCount() || a.tree().leafCount() != b.tree().leafCount()) return false;
+    if (a.activeVoxelCount() != b.activeVoxelCount() ||
+        a.tree().leafCount() != b.tree().leafCount())
+        return false;
     if (a.transform() != b.transform()) return false;
     auto bAcc = b.getConstAccessor();
     for (auto it = a.cbeginValueOn(); it; ++it)
@@ -59,7 +65,8 @@ template <typename GridT> bool sameGrid(const GridT& a, const GridT& b)
 
 bool sameVolumes(const VolumeSet& a, const VolumeSet& b)
 {
-    return sameGrid(*a.sdf, *b.sdf) && sameGrid(*a.density, *b.density) && sameGrid(*a.color, *b.color);
+    return sameGrid(*a.sdf, *b.sdf) && sameGrid(*a.density, *b.density) &&
+           sameGrid(*a.color, *b.color);
 }
 
 } // namespace
@@ -137,6 +144,8 @@ TEST(VoxelCache, DisabledWithNoFolderAndTheDefaultFollowsTheEnvironment)
     const std::string saved = old ? old : "";
     setenv("VOLMORPH_CACHE", (w.dir / "somewhere").c_str(), 1);
     EXPECT_EQ(defaultCacheFolder(), w.dir / "somewhere");
-    if (old) setenv("VOLMORPH_CACHE", saved.c_str(), 1);
-    else unsetenv("VOLMORPH_CACHE");
+    if (old)
+        setenv("VOLMORPH_CACHE", saved.c_str(), 1);
+    else
+        unsetenv("VOLMORPH_CACHE");
 }

@@ -16,13 +16,17 @@ namespace {
 
 fs::path freshFolder(const char* name)
 {
-    const fs::path dir = fs::temp_directory_path() / ("volmorph-atomic-" + std::to_string(getpid()) + "-" + name);
+    const fs::path dir =
+        fs::temp_directory_path() / ("volmorph-atomic-" + std::to_string(getpid()) + "-" + name);
     fs::remove_all(dir);
     fs::create_directories(dir);
     return dir;
 }
 
-size_t entries(const fs::path& dir) { return size_t(std::distance(fs::directory_iterator(dir), {})); }
+size_t entries(const fs::path& dir)
+{
+    return size_t(std::distance(fs::directory_iterator(dir), {}));
+}
 
 } // namespace
 
@@ -86,6 +90,7 @@ TEST(AtomicFile, UserFacingFailureNamesThePathAndWhat)
         FAIL() << "no exception";
     } catch (const UserError& e) {
         ASSERT_EQ(e.diagnostics().size(), 1u);
-        EXPECT_EQ(e.diagnostics()[0].str(), "/no/such/folder/frame.vdb: cannot write volume file (cannot open)");
+        EXPECT_EQ(e.diagnostics()[0].str(),
+                  "/no/such/folder/frame.vdb: cannot write volume file (cannot open)");
     }
 }

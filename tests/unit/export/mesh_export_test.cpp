@@ -23,10 +23,14 @@ TEST(Morph, InBetweenExportsAsAClosedColouredMesh)
     EXPECT_EQ(surface.report.components, 1u);
     double volume = 0.0;
     for (const Vec3I& t : surface.triangles)
-        volume += Vec3d(surface.points[t[0]]).dot(Vec3d(surface.points[t[1]]).cross(Vec3d(surface.points[t[2]]))) / 6.0;
-    EXPECT_NEAR(volume / (moments(*mid.density).mass * std::pow(voxel, 3)), 1.0, 0.02); // outward, same volume
+        volume += Vec3d(surface.points[t[0]])
+                      .dot(Vec3d(surface.points[t[1]]).cross(Vec3d(surface.points[t[2]]))) /
+                  6.0;
+    EXPECT_NEAR(volume / (moments(*mid.density).mass * std::pow(voxel, 3)), 1.0,
+                0.02); // outward, same volume
 
-    const std::filesystem::path dir = std::filesystem::temp_directory_path() / "volmorph_export_test";
+    const std::filesystem::path dir =
+        std::filesystem::temp_directory_path() / "volmorph_export_test";
     std::filesystem::create_directories(dir);
     writeMesh(surface, dir / "mid.ply");
     const Mesh back = importMesh(dir / "mid.ply");
@@ -37,7 +41,8 @@ TEST(Morph, InBetweenExportsAsAClosedColouredMesh)
     writeMesh(surface, dir / "mid.obj");
     EXPECT_EQ(importMesh(dir / "mid.obj").triangles.size(), surface.triangles.size());
     size_t files = 0;
-    for (const auto& entry : std::filesystem::directory_iterator(dir)) files += entry.is_regular_file();
+    for (const auto& entry : std::filesystem::directory_iterator(dir))
+        files += entry.is_regular_file();
     EXPECT_GE(files, 2u);
     for (const auto& entry : std::filesystem::directory_iterator(dir))
         EXPECT_EQ(entry.path().string().find("partial"), std::string::npos) << entry.path();

@@ -9,9 +9,13 @@ using namespace volmorph;
 
 namespace {
 
-const std::filesystem::path kMeshes = std::filesystem::path(VOLMORPH_SOURCE_DIR) / "tests" / "data" / "meshes";
+const std::filesystem::path kMeshes =
+    std::filesystem::path(VOLMORPH_SOURCE_DIR) / "tests" / "data" / "meshes";
 
-Mesh load(const std::string& name, const ObjectTransform& xf = {}) { return importMesh(kMeshes / name, xf); }
+Mesh load(const std::string& name, const ObjectTransform& xf = {})
+{
+    return importMesh(kMeshes / name, xf);
+}
 
 void expectBounds(const Mesh& m, const Vec3d& lo, const Vec3d& hi)
 {
@@ -106,9 +110,12 @@ TEST(MeshImport, PlyVertexColours)
         // The fixture colours vertex (0,0,0) red, (1,0,0) green, (0,1,0) blue, (0,0,1) white.
         const Vec3f& p = m.points[i];
         Vec3f expected(1, 1, 1);
-        if (p == Vec3f(0, 0, 0)) expected = Vec3f(1, 0, 0);
-        else if (p == Vec3f(1, 0, 0)) expected = Vec3f(0, 1, 0);
-        else if (p == Vec3f(0, 1, 0)) expected = Vec3f(0, 0, 1);
+        if (p == Vec3f(0, 0, 0))
+            expected = Vec3f(1, 0, 0);
+        else if (p == Vec3f(1, 0, 0))
+            expected = Vec3f(0, 1, 0);
+        else if (p == Vec3f(0, 1, 0))
+            expected = Vec3f(0, 0, 1);
         EXPECT_NEAR((m.colors[i] - expected).length(), 0.0, 1e-3) << "vertex " << p;
     }
 }
@@ -200,7 +207,8 @@ TEST(MeshErrors, SceneKeyIsNamedWhenGiven)
 
 TEST(MeshImport, RealMeshesOfTheScenes)
 {
-    const std::filesystem::path scenes = std::filesystem::path(VOLMORPH_SOURCE_DIR) / "scenes" / "meshes";
+    const std::filesystem::path scenes =
+        std::filesystem::path(VOLMORPH_SOURCE_DIR) / "scenes" / "meshes";
     const Mesh bunny = importMesh(scenes / "bunny.obj");
     EXPECT_EQ(bunny.points.size(), 1839u);
     EXPECT_EQ(bunny.triangles.size(), 3674u);

@@ -1,5 +1,5 @@
-// The Morpher: closed forms of simple pairs (translation, rotation, scale), the ends, and the sparse
-// domain against dense references.
+// The Morpher: closed forms of simple pairs (translation, rotation, scale), the ends, and the
+// sparse domain against dense references.
 #include "support/WarpFixtures.h"
 
 using namespace volmorph;
@@ -11,8 +11,9 @@ TEST(Morph, PointPairTranslatesTheSphereLinearly)
     ObjectTransform moved;
     moved.translate = Vec3d(1, 0, 0);
     const VolumeSet s = voxelized("sphere.obj", voxel), d = voxelized("sphere.obj", voxel, moved);
-    const Morpher morpher(s, d, {pair(FeatureType::Point, element(Vec3d(0.0)), element(Vec3d(1, 0, 0)))}, WarpSpec{},
-                          BlendSpec{});
+    const Morpher morpher(s, d,
+                          {pair(FeatureType::Point, element(Vec3d(0.0)), element(Vec3d(1, 0, 0)))},
+                          WarpSpec{}, BlendSpec{});
     const double c0 = moments(*s.density).centroid.x();
     for (double t : {0.0, 0.25, 0.5, 0.75, 1.0}) {
         const Moments m = moments(*morpher.frame(t).density);
@@ -30,13 +31,15 @@ TEST(Morph, BoxPairRotatesThePrincipalAxis)
     turned.scale = Vec3d(1.0, 0.3, 0.3);
     turned.rotateRadians = Vec3d(0, 0, M_PI / 2);
     const VolumeSet s = voxelized("cube.obj", voxel, bar), d = voxelized("cube.obj", voxel, turned);
-    const auto p = pair(FeatureType::Box, element(Vec3d(0.0), Vec3d(1, 0, 0), Vec3d(0, 1, 0), Vec3d(1, 0.3, 0.3)),
+    const auto p = pair(FeatureType::Box,
+                        element(Vec3d(0.0), Vec3d(1, 0, 0), Vec3d(0, 1, 0), Vec3d(1, 0.3, 0.3)),
                         element(Vec3d(0.0), Vec3d(0, 1, 0), Vec3d(-1, 0, 0), Vec3d(1, 0.3, 0.3)));
     const Morpher morpher(s, d, {p}, WarpSpec{}, BlendSpec{});
     const Moments m = moments(*morpher.frame(0.5).density);
     const double angle = 0.5 * std::atan2(2.0 * m.ixy, m.ixx - m.iyy);
     EXPECT_NEAR(angle * 180.0 / M_PI, 45.0, 0.5);
-    EXPECT_NEAR(m.mass * std::pow(voxel, 3), 0.09, 0.09 * 0.02); // the bar's volume (1 x 0.3 x 0.3) is kept
+    EXPECT_NEAR(m.mass * std::pow(voxel, 3), 0.09,
+                0.09 * 0.02); // the bar's volume (1 x 0.3 x 0.3) is kept
 }
 
 TEST(Morph, ScalingPairScalesTheVolumeCubically)
@@ -46,7 +49,8 @@ TEST(Morph, ScalingPairScalesTheVolumeCubically)
     ObjectTransform twice;
     twice.scale = Vec3d(2.0);
     const VolumeSet s = voxelized("sphere.obj", voxel), d = voxelized("sphere.obj", voxel, twice);
-    const auto p = pair(FeatureType::Box, element(Vec3d(0.0)), element(Vec3d(0.0), Vec3d(1, 0, 0), Vec3d(0, 1, 0), Vec3d(2.0)));
+    const auto p = pair(FeatureType::Box, element(Vec3d(0.0)),
+                        element(Vec3d(0.0), Vec3d(1, 0, 0), Vec3d(0, 1, 0), Vec3d(2.0)));
     const double v0 = moments(*s.density).mass;
     for (BlendMode mode : {BlendMode::Density, BlendMode::Sdf}) {
         BlendSpec blend;
@@ -54,7 +58,8 @@ TEST(Morph, ScalingPairScalesTheVolumeCubically)
         const Morpher morpher(s, d, {p}, WarpSpec{}, blend);
         for (double t : {0.25, 0.5, 0.75}) {
             const double scale = 1.0 + t;
-            EXPECT_NEAR(moments(*morpher.frame(t).density).mass / v0, scale * scale * scale, 0.02 * scale * scale * scale)
+            EXPECT_NEAR(moments(*morpher.frame(t).density).mass / v0, scale * scale * scale,
+                        0.02 * scale * scale * scale)
                 << "t " << t << (mode == BlendMode::Sdf ? " (sdf)" : " (density)");
         }
     }
@@ -67,7 +72,8 @@ TEST(Morph, IdenticalSidesGiveTheSourceAtEveryFrame)
     auto pairs = randomPairs(random, 6, 10.0);
     for (auto& p : pairs) p.target = p.source;
     const Morpher morpher(s, s, pairs, WarpSpec{}, BlendSpec{});
-    for (double t : {0.0, 0.3, 0.7, 1.0}) EXPECT_LT(maxDifference(*morpher.frame(t).density, *s.density), 1e-5) << t;
+    for (double t : {0.0, 0.3, 0.7, 1.0})
+        EXPECT_LT(maxDifference(*morpher.frame(t).density, *s.density), 1e-5) << t;
 }
 
 TEST(Morph, EndsAreSourceAndTarget)
@@ -79,7 +85,8 @@ TEST(Morph, EndsAreSourceAndTarget)
     ObjectTransform up;
     up.translate = Vec3d(0, 0.5, 0);
     const VolumeSet d = voxelized("knot1.off", voxel, up);
-    const Scene scene = loadScene(std::filesystem::path(VOLMORPH_SOURCE_DIR) / "scenes" / "bunny-to-knot.toml");
+    const Scene scene =
+        loadScene(std::filesystem::path(VOLMORPH_SOURCE_DIR) / "scenes" / "bunny-to-knot.toml");
     BlendSpec blend = scene.blend;
     blend.mode = BlendMode::Density; // the density path; SdfModeReproducesTheEndSurfaces covers sdf
     const Morpher morpher(s, d, scene.pairs, scene.warp, blend);
@@ -114,7 +121,8 @@ TEST(Morph, SparseDomainLosesNothing)
         blend.mode = mode;
         for (int trial = 0; trial < 6; ++trial) {
             auto pairs = randomPairs(random, 1 + trial * 3, 1.0);
-            for (auto& p : pairs) { // world units here: origins and scales inside the objects' region
+            for (auto& p :
+                 pairs) { // world units here: origins and scales inside the objects' region
                 for (FeatureElement* e : {&p.source, &p.target}) e->origin -= Vec3d(0.3);
             }
             WarpSpec spec;
@@ -126,8 +134,8 @@ TEST(Morph, SparseDomainLosesNothing)
             openvdb::CoordBBox big = morpher.candidateBounds(t);
             big.expand(big.dim().x() / 4); // well past the candidate box
             const VolumeSet dense = morpher.frameOverBox(t, big, spec.toleranceVoxels, &denseStats);
-            const std::string where = std::string(mode == BlendMode::Sdf ? "sdf" : "density") + " trial " +
-                                      std::to_string(trial);
+            const std::string where = std::string(mode == BlendMode::Sdf ? "sdf" : "density") +
+                                      " trial " + std::to_string(trial);
             ASSERT_GT(sparse.density->activeVoxelCount(), 0u) << where;
             EXPECT_EQ(maxDifference(*sparse.density, *dense.density), 0.0) << where;
             EXPECT_EQ(sparse.color->activeVoxelCount(), dense.color->activeVoxelCount()) << where;
@@ -166,7 +174,8 @@ TEST(Morph, SdfFramesWithoutPairsMatchTheDenseReference)
         auto denseColor = dense.color->getConstAccessor();
         double worstColor = 0.0;
         for (auto it = sparse.color->cbeginValueOn(); it; ++it)
-            worstColor = std::max(worstColor, double((*it - denseColor.getValue(it.getCoord())).length()));
+            worstColor =
+                std::max(worstColor, double((*it - denseColor.getValue(it.getCoord())).length()));
         EXPECT_EQ(worstColor, 0.0) << where;
         if (firstSamples == 0) firstSamples = sparseStats.blendSamples;
     }

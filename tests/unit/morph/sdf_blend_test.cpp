@@ -18,7 +18,8 @@ double surfaceDistanceVoxels(const openvdb::FloatGrid& a, const openvdb::FloatGr
         auto ya = y.getConstAccessor();
         for (auto it = x.cbeginValueOn(); it; ++it)
             if (std::abs(*it) < 0.5 * voxel)
-                worst = std::max(worst, std::abs(double(ya.getValue(it.getCoord())) - double(*it)) / voxel);
+                worst = std::max(worst, std::abs(double(ya.getValue(it.getCoord())) - double(*it)) /
+                                            voxel);
     };
     one(a, b);
     one(b, a);
@@ -29,7 +30,8 @@ double surfaceDistanceVoxels(const openvdb::FloatGrid& a, const openvdb::FloatGr
 
 TEST(Morph, SdfModeReproducesTheEndSurfaces)
 {
-    const Scene scene = loadScene(std::filesystem::path(VOLMORPH_SOURCE_DIR) / "scenes" / "bunny-to-knot.toml");
+    const Scene scene =
+        loadScene(std::filesystem::path(VOLMORPH_SOURCE_DIR) / "scenes" / "bunny-to-knot.toml");
     ASSERT_EQ(scene.blend.mode, BlendMode::Sdf);
     ObjectTransform xf;
     xf.scale = Vec3d(0.1);
@@ -71,16 +73,17 @@ long eulerCharacteristic(const Mesh& mesh)
 
 } // namespace
 
-// Closed form: with exact distances and the identity warp, blending the sdf of concentric spheres of
-// radii r0 and r1 gives (1 - t)(|p| - r0) + t(|p| - r1) = |p| - ((1 - t) r0 + t r1): a sphere whose
-// radius moves linearly. Distances clamped to a narrow band would instead flip the whole shell
-// between the two surfaces at t = 1/2.
+// Closed form: with exact distances and the identity warp, blending the sdf of concentric spheres
+// of radii r0 and r1 gives (1 - t)(|p| - r0) + t(|p| - r1) = |p| - ((1 - t) r0 + t r1): a sphere
+// whose radius moves linearly. Distances clamped to a narrow band would instead flip the whole
+// shell between the two surfaces at t = 1/2.
 TEST(Morph, SdfModeShrinksConcentricSpheresLinearly)
 {
     const double voxel = 0.01;
     ObjectTransform half;
     half.scale = Vec3d(0.5);
-    const VolumeSet big = voxelized("sphere.obj", voxel), small = voxelized("sphere.obj", voxel, half);
+    const VolumeSet big = voxelized("sphere.obj", voxel),
+                    small = voxelized("sphere.obj", voxel, half);
     BlendSpec blend;
     blend.mode = BlendMode::Sdf;
     const Morpher morpher(big, small, {}, WarpSpec{}, blend);
@@ -94,13 +97,15 @@ TEST(Morph, SdfModeShrinksConcentricSpheresLinearly)
         // The rebuilt band holds distances (closed form: |p| - r) all across it.
         double worst = 0.0;
         for (auto it = frame.sdf->cbeginValueOn(); it; ++it)
-            worst = std::max(worst, std::abs(double(*it) - (frame.sdf->indexToWorld(it.getCoord()).length() - expected)));
+            worst = std::max(
+                worst, std::abs(double(*it) -
+                                (frame.sdf->indexToWorld(it.getCoord()).length() - expected)));
         EXPECT_LE(worst / voxel, 0.5) << "t = " << t; // measured: 0.24 to 0.36
     }
 }
 
-// A genus change (sphere, genus 0, into the knot, genus 1) in sdf mode: at every frame the in-between
-// is one closed, consistently oriented surface.
+// A genus change (sphere, genus 0, into the knot, genus 1) in sdf mode: at every frame the
+// in-between is one closed, consistently oriented surface.
 TEST(Morph, SdfModeChangesGenusWithOneClosedSurfacePerFrame)
 {
     const double voxel = 0.02;
@@ -128,10 +133,12 @@ TEST(Morph, SdfModeChangesGenusWithOneClosedSurfacePerFrame)
 // consecutive frames exceeds 3 times the mean step |V(last) - V(first)| / (frames - 1). The blended
 // surface moves at a speed that varies with the local distance between the two surfaces (measured:
 // at most 1.9 times the mean at this resolution); a snap moves a large part of the volume in one
-// frame (the narrow-band blend did: about half the total change at t = 1/2, some 11 times the mean).
+// frame (the narrow-band blend did: about half the total change at t = 1/2, some 11 times the
+// mean).
 TEST(Morph, SdfModeDefaultSceneIsOneSurfaceChangingSmoothly)
 {
-    Scene scene = loadScene(std::filesystem::path(VOLMORPH_SOURCE_DIR) / "scenes" / "bunny-to-knot.toml");
+    Scene scene =
+        loadScene(std::filesystem::path(VOLMORPH_SOURCE_DIR) / "scenes" / "bunny-to-knot.toml");
     scene.volume.voxelSize = 0.012; // coarser than the scene's 0.008, to keep the test short
     const SceneVolumes volumes = voxelizeScene(scene);
     const Morpher morpher(volumes.source, volumes.target, scene.pairs, scene.warp, scene.blend);
@@ -146,11 +153,13 @@ TEST(Morph, SdfModeDefaultSceneIsOneSurfaceChangingSmoothly)
     const double mean = std::abs(v.back() - v.front()) / double(v.size() - 1);
     ASSERT_GT(mean, 0.0);
     double worst = 0.0;
-    for (size_t i = 0; i + 1 < v.size(); ++i) worst = std::max(worst, std::abs(v[i + 1] - v[i]) / mean);
+    for (size_t i = 0; i + 1 < v.size(); ++i)
+        worst = std::max(worst, std::abs(v[i + 1] - v[i]) / mean);
     std::printf("largest volume step: %.2f times the mean\n", worst);
     for (size_t i = 0; i + 1 < v.size(); ++i)
-        EXPECT_LE(std::abs(v[i + 1] - v[i]), 3.0 * mean) << "between frames " << scene.frames.first + int(i)
-                                                         << " and " << scene.frames.first + int(i) + 1;
+        EXPECT_LE(std::abs(v[i + 1] - v[i]), 3.0 * mean)
+            << "between frames " << scene.frames.first + int(i) << " and "
+            << scene.frames.first + int(i) + 1;
 }
 
 // Dust removal (blend.min_island) in sdf mode, on a shape built by OpenVDB's own level-set tools:

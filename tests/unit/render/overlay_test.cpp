@@ -31,7 +31,8 @@ size_t paintedPixels(const render::Image& image)
 // pixel (100 + 100 x, 50 - 100 y).
 Camera orthoCamera()
 {
-    return Camera(Camera::Projection::Orthographic, Vec3d(0, 0, 5), Vec3d(0, 0, 0), Vec3d(0, 1, 0), 40.0, 2.0, 200, 100);
+    return Camera(Camera::Projection::Orthographic, Vec3d(0, 0, 5), Vec3d(0, 0, 0), Vec3d(0, 1, 0),
+                  40.0, 2.0, 200, 100);
 }
 
 } // namespace
@@ -78,7 +79,8 @@ TEST(Overlay, ProjectionMatchesTheCameraRays)
     EXPECT_NEAR((*q)[0], 150.0, 1e-9);
     EXPECT_NEAR((*q)[1], 25.0, 1e-9);
     // Perspective: a point on the ray through a pixel projects back to that pixel; behind: nothing.
-    const Camera persp(Camera::Projection::Perspective, Vec3d(1, 2, 5), Vec3d(0, 0, 0), Vec3d(0, 1, 0), 50.0, 2.0, 320, 180);
+    const Camera persp(Camera::Projection::Perspective, Vec3d(1, 2, 5), Vec3d(0, 0, 0),
+                       Vec3d(0, 1, 0), 50.0, 2.0, 320, 180);
     const render::Ray ray = persp.ray(40.5, 130.25);
     const auto p = render::project(persp, ray.origin + ray.direction * 3.7);
     ASSERT_TRUE(p);
@@ -112,7 +114,8 @@ TEST(Overlay, SegmentsAreDrawnWhereTheyProjectAndClipped)
     for (int x = 0; x < 200; ++x) EXPECT_EQ(wide.at(x, y)[1], 1.0f) << "x " << x;
 
     // Perspective: a segment crossing the camera plane keeps only its part in front of the camera.
-    const Camera persp(Camera::Projection::Perspective, Vec3d(0, 0, 5), Vec3d(0, 0, 0), Vec3d(0, 1, 0), 60.0, 2.0, 200, 100);
+    const Camera persp(Camera::Projection::Perspective, Vec3d(0, 0, 5), Vec3d(0, 0, 0),
+                       Vec3d(0, 1, 0), 60.0, 2.0, 200, 100);
     render::Image cut = blank(200, 100);
     render::drawSegment(cut, persp, Vec3d(0.2, -0.2, 0), Vec3d(0.2, -0.2, 10), {0, 0, 1}, 1);
     EXPECT_GT(paintedPixels(cut), 10u);
@@ -128,12 +131,14 @@ TEST(Overlay, ContactSheetLaysOutTiles)
     std::vector<render::Image> tiles(5, blank(64, 32));
     tiles[4].at(10, 10)[0] = 1.0f; // premultiplied red in the last tile
     tiles[4].at(10, 10)[3] = 1.0f;
-    const render::Image sheet = render::contactSheet(tiles, {"a", "b", "c", "d", "e"}, 3, 128, {0.1f, 0.1f, 0.1f});
+    const render::Image sheet =
+        render::contactSheet(tiles, {"a", "b", "c", "d", "e"}, 3, 128, {0.1f, 0.1f, 0.1f});
     // 3 columns, 2 rows; tiles scaled to 128 x 64 with 6-pixel gaps and a 22-pixel label band.
     EXPECT_EQ(sheet.width, 3 * (128 + 6) + 6);
     EXPECT_EQ(sheet.height, 2 * (64 + 22 + 6) + 6);
-    for (size_t p = 3; p < sheet.pixels.size(); p += 4) ASSERT_NEAR(sheet.pixels[p], 1.0f, 1e-5f); // opaque
-    EXPECT_NEAR(sheet.at(2, 2)[1], 0.1f, 1e-6f); // background
+    for (size_t p = 3; p < sheet.pixels.size(); p += 4)
+        ASSERT_NEAR(sheet.pixels[p], 1.0f, 1e-5f); // opaque
+    EXPECT_NEAR(sheet.at(2, 2)[1], 0.1f, 1e-6f);   // background
     // The red pixel of tile 5 (row 1, column 1) lands near (6 + 134 + 20, 6 + 92 + 20).
     float red = 0.0f;
     for (int y = 112; y < 126; ++y)

@@ -16,7 +16,8 @@ using render::Camera;
 
 namespace {
 
-const std::filesystem::path kMeshes = std::filesystem::path(VOLMORPH_SOURCE_DIR) / "scenes" / "meshes";
+const std::filesystem::path kMeshes =
+    std::filesystem::path(VOLMORPH_SOURCE_DIR) / "scenes" / "meshes";
 
 VolumeSet sphere(int across)
 {
@@ -25,16 +26,20 @@ VolumeSet sphere(int across)
     return voxelize(importMesh(kMeshes / "sphere.obj"), o); // radius 0.5 at the origin
 }
 
-openvdb::FloatGrid::Ptr sphereFog(int across) { return sphere(across).density; }
+openvdb::FloatGrid::Ptr sphereFog(int across)
+{
+    return sphere(across).density;
+}
 
 Camera orthoDown(double width, int pixels)
 {
-    return Camera(Camera::Projection::Orthographic, Vec3d(0, 0, 5), Vec3d(0, 0, 0), Vec3d(0, 1, 0), 40.0, width,
-                  pixels, pixels);
+    return Camera(Camera::Projection::Orthographic, Vec3d(0, 0, 5), Vec3d(0, 0, 0), Vec3d(0, 1, 0),
+                  40.0, width, pixels, pixels);
 }
 
-render::Image absorbOnly(const openvdb::FloatGrid& density, const Camera& camera, double extinction, int samples = 16,
-                         render::Medium::Kind kind = render::Medium::Kind::Fog, double step = 0.25)
+render::Image absorbOnly(const openvdb::FloatGrid& density, const Camera& camera, double extinction,
+                         int samples = 16, render::Medium::Kind kind = render::Medium::Kind::Fog,
+                         double step = 0.25)
 {
     render::Medium medium;
     medium.kind = kind;
@@ -66,19 +71,21 @@ double sphereAlpha(int x, int y, int pixels, double width, double sigma, double 
 
 TEST(Render, BeerLambertThroughASphere)
 {
-    // Closed form: alpha = 1 - exp(-sigma * chord) for a homogeneous sphere of radius 0.5: OpenVDB's
-    // exact level-set sphere (256 voxels across) rendered as a body with a sharp surface. Silhouette
-    // pixels carry the Monte Carlo error of 25 stratified samples over a steep alpha; a jittered step
-    // of 1 voxel through a sharp surface is unbiased.
+    // Closed form: alpha = 1 - exp(-sigma * chord) for a homogeneous sphere of radius 0.5:
+    // OpenVDB's exact level-set sphere (256 voxels across) rendered as a body with a sharp surface.
+    // Silhouette pixels carry the Monte Carlo error of 25 stratified samples over a steep alpha; a
+    // jittered step of 1 voxel through a sharp surface is unbiased.
     const int pixels = 256;
     const double width = 1.2, sigma = 4.0;
-    const auto ball = openvdb::tools::createLevelSetSphere<openvdb::FloatGrid>(0.5f, openvdb::Vec3f(0.0f), 1.0f / 256, 3.0f);
+    const auto ball = openvdb::tools::createLevelSetSphere<openvdb::FloatGrid>(
+        0.5f, openvdb::Vec3f(0.0f), 1.0f / 256, 3.0f);
     const render::Image image =
         absorbOnly(*ball, orthoDown(width, pixels), sigma, 25, render::Medium::Kind::LevelSet, 1.0);
     double sum = 0.0, worst = 0.0;
     for (int y = 0; y < pixels; ++y)
         for (int x = 0; x < pixels; ++x) {
-            const double e = std::abs(image.at(x, y)[3] - sphereAlpha(x, y, pixels, width, sigma, 0.5));
+            const double e =
+                std::abs(image.at(x, y)[3] - sphereAlpha(x, y, pixels, width, sigma, 0.5));
             sum += e;
             worst = std::max(worst, e);
             EXPECT_EQ(image.at(x, y)[0], 0.0f); // albedo 0, no emission: no colour
@@ -109,7 +116,10 @@ TEST(Render, FogAlphaMatchesDirectIntegration)
                     const double wy = (0.5 - (y + (j + 0.5) / 4) / pixels) * width;
                     double tau = 0.0;
                     for (double z = -0.6; z < 0.6; z += 0.0005)
-                        tau += sigma * openvdb::tools::BoxSampler::sample(acc, s.density->worldToIndex(Vec3d(wx, wy, z))) * 0.0005;
+                        tau += sigma *
+                               openvdb::tools::BoxSampler::sample(
+                                   acc, s.density->worldToIndex(Vec3d(wx, wy, z))) *
+                               0.0005;
                     alpha += (1.0 - std::exp(-tau)) / 16.0;
                 }
             worst = std::max(worst, std::abs(alpha - image.at(x, y)[3]));
@@ -124,19 +134,24 @@ TEST(Render, AlphaDoesNotDependOnTheVoxelSize)
     const render::Image fine = absorbOnly(*sphereFog(256), camera, 6.0, 4);
     const render::Image coarse = absorbOnly(*sphereFog(128), camera, 6.0, 4);
     double sum = 0.0;
-    for (size_t p = 3; p < fine.pixels.size(); p += 4) sum += std::abs(fine.pixels[p] - coarse.pixels[p]);
+    for (size_t p = 3; p < fine.pixels.size(); p += 4)
+        sum += std::abs(fine.pixels[p] - coarse.pixels[p]);
     EXPECT_LE(sum / (fine.pixels.size() / 4), 0.003);
 }
 
 TEST(Render, SingleScatteringFromASlab)
 {
     // A homogeneous slab of thickness L, lit from straight above by a directional light of
-    // irradiance E and seen from above: L_out = albedo p E (1 - exp(-2 sigma L)) / 2, p = 1 / (4 pi).
+    // irradiance E and seen from above: L_out = albedo p E (1 - exp(-2 sigma L)) / 2, p = 1 / (4
+    // pi).
     const double voxel = 0.01, thickness = 0.2, sigma = 5.0, albedo = 0.8;
     auto slab = openvdb::FloatGrid::create(0.0f);
     slab->setTransform(openvdb::math::Transform::createLinearTransform(voxel));
-    // Voxels 0..19 hold 1; trilinear sampling ramps half a voxel past each end: thickness 20 voxels.
-    slab->tree().fill(openvdb::CoordBBox(openvdb::Coord(-100, -100, 0), openvdb::Coord(100, 100, 19)), 1.0f, true);
+    // Voxels 0..19 hold 1; trilinear sampling ramps half a voxel past each end: thickness 20
+    // voxels.
+    slab->tree().fill(
+        openvdb::CoordBBox(openvdb::Coord(-100, -100, 0), openvdb::Coord(100, 100, 19)), 1.0f,
+        true);
     render::Light light;
     light.direction = Vec3d(0, 0, -1);
     render::Medium medium;
@@ -145,8 +160,10 @@ TEST(Render, SingleScatteringFromASlab)
     render::RenderSettings settings;
     settings.samples = 4;
     settings.stepVoxels = 0.25;
-    const render::Image image = render::renderVolume(*slab, nullptr, orthoDown(0.4, 16), {light}, medium, settings);
-    const double expected = albedo / (4.0 * M_PI) * (1.0 - std::exp(-2.0 * sigma * thickness)) / 2.0;
+    const render::Image image =
+        render::renderVolume(*slab, nullptr, orthoDown(0.4, 16), {light}, medium, settings);
+    const double expected =
+        albedo / (4.0 * M_PI) * (1.0 - std::exp(-2.0 * sigma * thickness)) / 2.0;
     const double alpha = 1.0 - std::exp(-sigma * thickness);
     for (int y = 0; y < 16; ++y)
         for (int x = 0; x < 16; ++x) {
@@ -158,22 +175,28 @@ TEST(Render, SingleScatteringFromASlab)
 TEST(Render, BitIdenticalForAnyThreadCount)
 {
     const auto density = sphereFog(64);
-    const Camera camera(Camera::Projection::Perspective, Vec3d(1, 0.5, 2), Vec3d(0, 0, 0), Vec3d(0, 1, 0), 40, 1, 96, 64);
+    const Camera camera(Camera::Projection::Perspective, Vec3d(1, 0.5, 2), Vec3d(0, 0, 0),
+                        Vec3d(0, 1, 0), 40, 1, 96, 64);
     render::Light light;
     light.direction = Vec3d(-1, -1, -0.5);
     render::Medium medium;
     render::RenderSettings settings;
     settings.samples = 3;
     settings.threads = 1;
-    const render::Image one = render::renderVolume(*density, nullptr, camera, {light}, medium, settings);
+    const render::Image one =
+        render::renderVolume(*density, nullptr, camera, {light}, medium, settings);
     settings.threads = 2;
-    const render::Image two = render::renderVolume(*density, nullptr, camera, {light}, medium, settings);
+    const render::Image two =
+        render::renderVolume(*density, nullptr, camera, {light}, medium, settings);
     ASSERT_EQ(one.pixels.size(), two.pixels.size());
-    EXPECT_EQ(std::memcmp(one.pixels.data(), two.pixels.data(), one.pixels.size() * sizeof(float)), 0);
+    EXPECT_EQ(std::memcmp(one.pixels.data(), two.pixels.data(), one.pixels.size() * sizeof(float)),
+              0);
     // A different frame number draws other samples.
     settings.frame = 1;
-    const render::Image other = render::renderVolume(*density, nullptr, camera, {light}, medium, settings);
-    EXPECT_NE(std::memcmp(one.pixels.data(), other.pixels.data(), one.pixels.size() * sizeof(float)), 0);
+    const render::Image other =
+        render::renderVolume(*density, nullptr, camera, {light}, medium, settings);
+    EXPECT_NE(
+        std::memcmp(one.pixels.data(), other.pixels.data(), one.pixels.size() * sizeof(float)), 0);
 }
 
 TEST(Render, ExrRoundTripAndAtomicWrite)
@@ -181,9 +204,11 @@ TEST(Render, ExrRoundTripAndAtomicWrite)
     render::Image image;
     image.width = 4;
     image.height = 2;
-    for (int i = 0; i < 8; ++i) image.pixels.insert(image.pixels.end(), {0.1f * i, 0.5f, 1.0f, 0.25f});
+    for (int i = 0; i < 8; ++i)
+        image.pixels.insert(image.pixels.end(), {0.1f * i, 0.5f, 1.0f, 0.25f});
     const Camera camera = orthoDown(1.0, 4);
-    const std::filesystem::path dir = std::filesystem::temp_directory_path() / "volmorph_render_test";
+    const std::filesystem::path dir =
+        std::filesystem::temp_directory_path() / "volmorph_render_test";
     std::filesystem::create_directories(dir);
     render::ExrOptions options;
     options.frame = 7;
@@ -191,13 +216,16 @@ TEST(Render, ExrRoundTripAndAtomicWrite)
     const render::Image back = render::readImage(dir / "a.exr");
     ASSERT_EQ(back.width, 4);
     ASSERT_EQ(back.height, 2);
-    for (size_t i = 0; i < image.pixels.size(); ++i) EXPECT_NEAR(back.pixels[i], image.pixels[i], 1e-3);
+    for (size_t i = 0; i < image.pixels.size(); ++i)
+        EXPECT_NEAR(back.pixels[i], image.pixels[i], 1e-3);
     render::writePng(image, dir / "a.png");
     EXPECT_EQ(render::readImage(dir / "a.png").width, 4);
     size_t files = 0;
-    for (const auto& entry : std::filesystem::directory_iterator(dir)) files += entry.is_regular_file();
+    for (const auto& entry : std::filesystem::directory_iterator(dir))
+        files += entry.is_regular_file();
     EXPECT_EQ(files, 2u); // no temporary left behind
-    EXPECT_THROW(render::writeExr(image, camera, dir / "missing" / "b.exr", options), std::runtime_error);
+    EXPECT_THROW(render::writeExr(image, camera, dir / "missing" / "b.exr", options),
+                 std::runtime_error);
     EXPECT_FALSE(std::filesystem::exists(dir / "missing"));
     std::filesystem::remove_all(dir);
 }
@@ -213,7 +241,8 @@ TEST(Render, EmissionIsAlphaTimesTheEmittedRadiance)
     medium.emission = Vec3d(0.5, 2.0, 0.0);
     render::RenderSettings settings;
     settings.samples = 1;
-    const render::Image image = render::renderVolume(*fog, nullptr, orthoDown(1.2, 64), {}, medium, settings);
+    const render::Image image =
+        render::renderVolume(*fog, nullptr, orthoDown(1.2, 64), {}, medium, settings);
     int covered = 0;
     for (int y = 0; y < 64; ++y)
         for (int x = 0; x < 64; ++x) {
@@ -231,11 +260,12 @@ TEST(Render, ExactOpticalDepthDoesNotDependOnTheStep)
     // Optical depth is integrated exactly per interpolation cell, so alpha cannot change with the
     // step (only the scattering quadrature uses it).
     const auto fog = sphereFog(40);
-    const Camera camera(Camera::Projection::Perspective, Vec3d(0.3, 0.2, 3), Vec3d(0, 0, 0), Vec3d(0, 1, 0), 30.0, 1.0,
-                        48, 48);
+    const Camera camera(Camera::Projection::Perspective, Vec3d(0.3, 0.2, 3), Vec3d(0, 0, 0),
+                        Vec3d(0, 1, 0), 30.0, 1.0, 48, 48);
     const render::Image fine = absorbOnly(*fog, camera, 5.0, 1, render::Medium::Kind::Fog, 0.1);
     const render::Image coarse = absorbOnly(*fog, camera, 5.0, 1, render::Medium::Kind::Fog, 4.0);
     double worst = 0.0;
-    for (size_t i = 3; i < fine.pixels.size(); i += 4) worst = std::max(worst, double(std::abs(fine.pixels[i] - coarse.pixels[i])));
+    for (size_t i = 3; i < fine.pixels.size(); i += 4)
+        worst = std::max(worst, double(std::abs(fine.pixels[i] - coarse.pixels[i])));
     EXPECT_LT(worst, 1e-6);
 }

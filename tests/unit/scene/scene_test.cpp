@@ -23,7 +23,10 @@ mesh = "meshes/tetra.off"
 voxel_size = 0.05
 )";
 
-Scene parse(const std::string& text) { return parseScene(text, kInline); }
+Scene parse(const std::string& text)
+{
+    return parseScene(text, kInline);
+}
 
 /// Parses `text` expecting failure; returns the diagnostics.
 std::vector<Diagnostic> errors(const std::string& text)
@@ -48,7 +51,10 @@ void expectError(const std::string& text, int line, int column, const std::strin
     EXPECT_NE(d[0].message.find(fragment), std::string::npos) << d[0].str();
 }
 
-std::string withPair(const std::string& pair) { return std::string(kMinimal) + "[[pair]]\n" + pair; }
+std::string withPair(const std::string& pair)
+{
+    return std::string(kMinimal) + "[[pair]]\n" + pair;
+}
 
 } // namespace
 
@@ -199,7 +205,8 @@ TEST(SceneErrors, UnknownKeySuggestsNearMiss)
 
 TEST(SceneErrors, UnknownKeyListsChoicesWhenNothingIsClose)
 {
-    expectError(std::string(kMinimal) + "[frames]\nzzz = 1\n", 9, 1, "expected one of: range, output");
+    expectError(std::string(kMinimal) + "[frames]\nzzz = 1\n", 9, 1,
+                "expected one of: range, output");
 }
 
 TEST(SceneErrors, WrongType)
@@ -214,42 +221,54 @@ TEST(SceneErrors, WrongType)
 
 TEST(SceneErrors, OutOfRange)
 {
-    const std::string base = "[source]\nmesh = \"meshes/cube.obj\"\n[target]\nmesh = \"meshes/cube.obj\"\n";
+    const std::string base =
+        "[source]\nmesh = \"meshes/cube.obj\"\n[target]\nmesh = \"meshes/cube.obj\"\n";
     expectError(base + "[volume]\nvoxel_size = -0.5\n", 6, 14, "positive length in world units");
     expectError(base + "[volume]\nvoxel_size = 0.0\n", 6, 14, "positive length in world units");
     expectError(base + "[volume]\nresolution = 2\n", 6, 14, "from 8 to 16384");
     expectError(std::string(kMinimal) + "[render]\nsamples = 0\n", 9, 11, "from 1 to 65536");
-    expectError(std::string(kMinimal) + "[render]\ncamera = { fov = 180 }\n", 9, 18, "0 < fov <= 179");
+    expectError(std::string(kMinimal) + "[render]\ncamera = { fov = 180 }\n", 9, 18,
+                "0 < fov <= 179");
     expectError(std::string(kMinimal) + "[render]\nanisotropy = -1\n", 9, 14, "-1 < g < 1");
 }
 
 TEST(SceneErrors, NanAndInf)
 {
-    expectError(std::string(kMinimal) + "[warp]\nepsilon = nan\n", 9, 11, "expected a finite number, got nan");
+    expectError(std::string(kMinimal) + "[warp]\nepsilon = nan\n", 9, 11,
+                "expected a finite number, got nan");
     expectError(std::string(kMinimal) + "[render]\ncamera = { eye = [0, -inf, 5] }\n", 9, 22,
                 "render.camera.eye[1]: expected a finite number, got -inf");
 }
 
 TEST(SceneErrors, ZeroScale)
 {
-    expectError(withPair("type = \"segment\"\n"
-                         "source = { origin = [0, 0, 0], axes = [[1, 0, 0], [0, 1, 0]], scale = [0, 1, 1] }\n"
-                         "target = { origin = [0, 0, 0], axes = [[1, 0, 0], [0, 1, 0]], scale = [1, 1, 1] }\n"),
-                10, 71, "pair[1].source.scale: expected every component > 0");
+    expectError(
+        withPair(
+            "type = \"segment\"\n"
+            "source = { origin = [0, 0, 0], axes = [[1, 0, 0], [0, 1, 0]], scale = [0, 1, 1] }\n"
+            "target = { origin = [0, 0, 0], axes = [[1, 0, 0], [0, 1, 0]], scale = [1, 1, 1] }\n"),
+        10, 71, "pair[1].source.scale: expected every component > 0");
 }
 
 TEST(SceneErrors, ZeroLengthParallelAndSkewedAxes)
 {
-    const std::string tail = "target = { origin = [0, 0, 0], axes = [[1, 0, 0], [0, 1, 0]], scale = [1, 1, 1] }\n";
-    expectError(withPair("type = \"box\"\nsource = { origin = [0, 0, 0], axes = [[0, 0, 0], [0, 1, 0]], "
-                         "scale = [1, 1, 1] }\n" + tail),
-                10, 40, "an axis has zero length");
-    expectError(withPair("type = \"box\"\nsource = { origin = [0, 0, 0], axes = [[0, 1, 0], [0, 3, 0]], "
-                         "scale = [1, 1, 1] }\n" + tail),
-                10, 39, "parallel");
-    expectError(withPair("type = \"box\"\nsource = { origin = [0, 0, 0], axes = [[1, 0, 0], [1, 1, 0]], "
-                         "scale = [1, 1, 1] }\n" + tail),
-                10, 39, "they are 45 degrees apart");
+    const std::string tail =
+        "target = { origin = [0, 0, 0], axes = [[1, 0, 0], [0, 1, 0]], scale = [1, 1, 1] }\n";
+    expectError(
+        withPair("type = \"box\"\nsource = { origin = [0, 0, 0], axes = [[0, 0, 0], [0, 1, 0]], "
+                 "scale = [1, 1, 1] }\n" +
+                 tail),
+        10, 40, "an axis has zero length");
+    expectError(
+        withPair("type = \"box\"\nsource = { origin = [0, 0, 0], axes = [[0, 1, 0], [0, 3, 0]], "
+                 "scale = [1, 1, 1] }\n" +
+                 tail),
+        10, 39, "parallel");
+    expectError(
+        withPair("type = \"box\"\nsource = { origin = [0, 0, 0], axes = [[1, 0, 0], [1, 1, 0]], "
+                 "scale = [1, 1, 1] }\n" +
+                 tail),
+        10, 39, "they are 45 degrees apart");
 }
 
 TEST(SceneErrors, NonPointFeatureNeedsAxesAndScale)
@@ -265,7 +284,8 @@ TEST(SceneErrors, NonPointFeatureNeedsAxesAndScale)
 
 TEST(SceneErrors, UnknownFeatureTypeSuggests)
 {
-    expectError(withPair("type = \"sgement\"\nsource = { origin = [0, 0, 0] }\ntarget = { origin = [0, 0, 0] }\n"),
+    expectError(withPair("type = \"sgement\"\nsource = { origin = [0, 0, 0] }\ntarget = { origin = "
+                         "[0, 0, 0] }\n"),
                 9, 8, "did you mean \"segment\"?");
 }
 
@@ -294,49 +314,59 @@ TEST(SceneErrors, VoxelSizeAndResolutionExcludeEachOther)
 TEST(SceneErrors, FrameRanges)
 {
     for (const char* bad : {"\"1-\"", "\"x\"", "\"10-1\"", "\"\"", "\"1-2-3\"", "\"1 - 5\""})
-        expectError(std::string(kMinimal) + "[frames]\nrange = " + bad + "\noutput = \"o.#.exr\"\n", 9, 9,
-                    "frames.range: expected \"FIRST-LAST\"");
+        expectError(std::string(kMinimal) + "[frames]\nrange = " + bad + "\noutput = \"o.#.exr\"\n",
+                    9, 9, "frames.range: expected \"FIRST-LAST\"");
 }
 
 TEST(SceneErrors, OutputPattern)
 {
-    expectError(std::string(kMinimal) + "[frames]\nrange = \"1-3\"\noutput = \"frame.exr\"\n", 10, 10,
-                "no frame number placeholder");
-    expectError(std::string(kMinimal) + "[frames]\noutput = \"frame.png\"\n", 9, 10, "ending in .exr");
+    expectError(std::string(kMinimal) + "[frames]\nrange = \"1-3\"\noutput = \"frame.exr\"\n", 10,
+                10, "no frame number placeholder");
+    expectError(std::string(kMinimal) + "[frames]\noutput = \"frame.png\"\n", 9, 10,
+                "ending in .exr");
 }
 
 TEST(SceneErrors, Schedules)
 {
-    expectError(std::string(kMinimal) + "[blend]\ndensity = \"sigmoid(-2)\"\n", 9, 11, "0 < k <= 1000");
-    expectError(std::string(kMinimal) + "[blend]\ndensity = \"easein\"\n", 9, 11, "unknown schedule");
-    expectError(std::string(kMinimal) + "[blend]\ncolor = [[0, 0], [0.5, 0.7], [0.6, 0.4], [1, 1]]\n", 9,
-                30, "tau must not decrease");
+    expectError(std::string(kMinimal) + "[blend]\ndensity = \"sigmoid(-2)\"\n", 9, 11,
+                "0 < k <= 1000");
+    expectError(std::string(kMinimal) + "[blend]\ndensity = \"easein\"\n", 9, 11,
+                "unknown schedule");
+    expectError(std::string(kMinimal) +
+                    "[blend]\ncolor = [[0, 0], [0.5, 0.7], [0.6, 0.4], [1, 1]]\n",
+                9, 30, "tau must not decrease");
     expectError(std::string(kMinimal) + "[blend]\ncolor = [[0, 0], [0.5, 0.7]]\n", 9, 9,
                 "ending at [1, 1]");
 }
 
 TEST(SceneErrors, CameraAndLights)
 {
-    expectError(std::string(kMinimal) + "[render]\ncamera = { eye = [1, 1, 1], lookat = [1, 1, 1] }\n", 9, 10,
-                "eye and lookat are the same point");
-    expectError(std::string(kMinimal) + "[render]\ncamera = { eye = [0, 5, 0], lookat = [0, 0, 0] }\n", 9, 10,
-                "up is parallel to the view direction");
+    expectError(std::string(kMinimal) +
+                    "[render]\ncamera = { eye = [1, 1, 1], lookat = [1, 1, 1] }\n",
+                9, 10, "eye and lookat are the same point");
+    expectError(std::string(kMinimal) +
+                    "[render]\ncamera = { eye = [0, 5, 0], lookat = [0, 0, 0] }\n",
+                9, 10, "up is parallel to the view direction");
     expectError(std::string(kMinimal) +
                     "[render]\nlights = [ { type = \"directional\", direction = [0, 0, 0] } ]\n",
                 9, 48, "render.lights[1].direction: expected a non-zero direction");
     const std::vector<Diagnostic> d =
-        errors(std::string(kMinimal) + "[render]\nlights = [ { type = \"point\", direction = [0, 0, 1] } ]\n");
+        errors(std::string(kMinimal) +
+               "[render]\nlights = [ { type = \"point\", direction = [0, 0, 1] } ]\n");
     ASSERT_EQ(d.size(), 2u);
     EXPECT_EQ(d[0].where.str(), kInline.string() + ":9:12");
     EXPECT_NE(d[0].message.find("missing render.lights[1].position"), std::string::npos);
     EXPECT_EQ(d[1].where.str(), kInline.string() + ":9:42");
-    EXPECT_NE(d[1].message.find("a point light has a position, not a direction"), std::string::npos);
+    EXPECT_NE(d[1].message.find("a point light has a position, not a direction"),
+              std::string::npos);
 }
 
 TEST(SceneErrors, BeierNeelyParametersNeedThatWeighting)
 {
-    expectError(std::string(kMinimal) + "[warp]\nb = 2\n", 9, 5, "only used with weighting = \"beier-neely\"");
-    EXPECT_NO_THROW(parse(std::string(kMinimal) + "[warp]\nweighting = \"beier-neely\"\na = 0.1\nb = 2\np = 0.5\n"));
+    expectError(std::string(kMinimal) + "[warp]\nb = 2\n", 9, 5,
+                "only used with weighting = \"beier-neely\"");
+    EXPECT_NO_THROW(parse(std::string(kMinimal) +
+                          "[warp]\nweighting = \"beier-neely\"\na = 0.1\nb = 2\np = 0.5\n"));
 }
 
 TEST(SceneErrors, EveryErrorInAFileIsReported)
@@ -424,10 +454,14 @@ TEST(Scene, CommentedExampleInScenesReadmeParses)
     std::string line, toml;
     bool inExample = false, seenHeading = false;
     while (std::getline(in, line)) {
-        if (line.rfind("## A fully commented example", 0) == 0) seenHeading = true;
-        else if (seenHeading && !inExample && line == "```toml") inExample = true;
-        else if (inExample && line == "```") break;
-        else if (inExample) toml += line + "\n";
+        if (line.rfind("## A fully commented example", 0) == 0)
+            seenHeading = true;
+        else if (seenHeading && !inExample && line == "```toml")
+            inExample = true;
+        else if (inExample && line == "```")
+            break;
+        else if (inExample)
+            toml += line + "\n";
     }
     ASSERT_FALSE(toml.empty());
     const Scene s = parseScene(toml, kRoot / "scenes" / "README-example.toml");
@@ -450,7 +484,8 @@ camera = { eye = [0, 0, 5], lookat = [0, 0, 0], fov = 40, keys = [
     ASSERT_EQ(s.render.camera.keys.size(), 2u);
     // Values a key leaves out come from the camera.
     EXPECT_DOUBLE_EQ(s.render.camera.keys[0].fovDegrees, 40.0);
-    const CameraSpec before = s.render.camera.at(1), middle = s.render.camera.at(15), after = s.render.camera.at(99);
+    const CameraSpec before = s.render.camera.at(1), middle = s.render.camera.at(15),
+                     after = s.render.camera.at(99);
     EXPECT_EQ(before.eye, Vec3d(0, 0, 5));
     EXPECT_EQ(after.eye, Vec3d(10, 0, 5));
     EXPECT_DOUBLE_EQ(after.fovDegrees, 60.0);
@@ -471,7 +506,8 @@ lights = [ { type = "directional", direction = [0, -1, 0], intensity = 2, keys =
 )");
     ASSERT_EQ(s.render.lights.size(), 1u);
     const LightSpec middle = s.render.lights[0].at(2);
-    EXPECT_NEAR(middle.direction.x(), std::sqrt(0.5), 1e-12); // halfway between -y and +x, unit length
+    EXPECT_NEAR(middle.direction.x(), std::sqrt(0.5),
+                1e-12); // halfway between -y and +x, unit length
     EXPECT_NEAR(middle.direction.y(), -std::sqrt(0.5), 1e-12);
     EXPECT_NEAR(middle.intensity, 1.0, 1e-12);
     EXPECT_NEAR(middle.color.y(), 0.5, 1e-12);
@@ -482,12 +518,15 @@ TEST(SceneAnimation, KeyErrorsNameTheirPlace)
 {
     const std::string base = std::string(kMinimal) + "[render]\n";
     expectError(base + "camera = { keys = [ { frame = 5 }, { frame = 5 } ] }\n", 9, 46,
-                "render.camera.keys[2].frame: frames must increase from key to key (the key before is frame 5)");
+                "render.camera.keys[2].frame: frames must increase from key to key (the key before "
+                "is frame 5)");
     expectError(base + "camera = { keys = [ { eye = [1, 2, 3] } ] }\n", 9, 21,
                 "missing render.camera.keys[1].frame");
     expectError(base + "camera = { keys = [ { frame = 1, lookat = [0, 0, 5] } ] }\n", 9, 21,
                 "render.camera.keys[1]: eye and lookat are the same point");
-    expectError(base + "lights = [ { type = \"point\", position = [0, 1, 0], keys = [ { frame = 1, direction = [0, 1, 0] } ] } ]\n",
-                9, 86, "render.lights[1].keys[1].direction: a point light has a position, not a direction");
+    expectError(
+        base + "lights = [ { type = \"point\", position = [0, 1, 0], keys = [ { frame = 1, "
+               "direction = [0, 1, 0] } ] } ]\n",
+        9, 86, "render.lights[1].keys[1].direction: a point light has a position, not a direction");
     expectError(base + "emission = [1, -1, 0]\n", 9, 12, "render.emission");
 }

@@ -9,7 +9,7 @@
 #include <volmorph/Voxelize.h>
 #include <volmorph/Warp.h>
 
-#include "morph/Stretch.h"      // private to the library; tested directly
+#include "morph/Stretch.h"     // private to the library; tested directly
 #include "warp/AdaptiveWarp.h" // private to the library; tested directly
 
 #include <openvdb/tools/Composite.h>
@@ -32,11 +32,11 @@
 
 namespace volmorph::test {
 
+inline const std::filesystem::path kMeshes =
+    std::filesystem::path(VOLMORPH_SOURCE_DIR) / "scenes" / "meshes";
 
-inline const std::filesystem::path kMeshes = std::filesystem::path(VOLMORPH_SOURCE_DIR) / "scenes" / "meshes";
-
-inline FeatureElement element(const Vec3d& origin, const Vec3d& x = Vec3d(1, 0, 0), const Vec3d& y = Vec3d(0, 1, 0),
-                       const Vec3d& scale = Vec3d(1.0))
+inline FeatureElement element(const Vec3d& origin, const Vec3d& x = Vec3d(1, 0, 0),
+                              const Vec3d& y = Vec3d(0, 1, 0), const Vec3d& scale = Vec3d(1.0))
 {
     FeatureElement e;
     e.origin = origin;
@@ -56,7 +56,8 @@ inline FeaturePairSpec pair(FeatureType type, const FeatureElement& s, const Fea
     return p;
 }
 
-inline VolumeSet voxelized(const std::string& mesh, double voxelSize, const ObjectTransform& xf = {})
+inline VolumeSet voxelized(const std::string& mesh, double voxelSize,
+                           const ObjectTransform& xf = {})
 {
     VoxelizeOptions o;
     o.voxelSize = voxelSize;
@@ -78,7 +79,8 @@ inline Moments moments(const openvdb::FloatGrid& density)
         if (it.isVoxelValue()) {
             samples.emplace_back(density.indexToWorld(it.getCoord()), double(*it));
         } else {
-            for (auto c = b.begin(); c; ++c) samples.emplace_back(density.indexToWorld(*c), double(*it));
+            for (auto c = b.begin(); c; ++c)
+                samples.emplace_back(density.indexToWorld(*c), double(*it));
         }
     }
     for (const auto& [p, w] : samples) {
@@ -113,7 +115,8 @@ inline double maxDifference(const openvdb::FloatGrid& a, const openvdb::FloatGri
 /// Rodrigues' rotation of v about the unit axis k by angle (radians).
 inline Vec3d rotate(const Vec3d& v, const Vec3d& k, double angle)
 {
-    return v * std::cos(angle) + k.cross(v) * std::sin(angle) + k * (k.dot(v) * (1.0 - std::cos(angle)));
+    return v * std::cos(angle) + k.cross(v) * std::sin(angle) +
+           k * (k.dot(v) * (1.0 - std::cos(angle)));
 }
 
 /// A random configuration of n pairs of random types inside a cube of `extent` units, made the way
@@ -136,7 +139,8 @@ inline std::vector<FeaturePairSpec> randomPairs(std::mt19937& random, int n, dou
         s.origin = vec() * extent;
         s.xAxis = direction();
         Vec3d across = s.xAxis.cross(direction());
-        while (across.length() < 0.1) across = s.xAxis.cross(direction()); // a frame, not a near-degenerate one
+        while (across.length() < 0.1)
+            across = s.xAxis.cross(direction()); // a frame, not a near-degenerate one
         s.yAxis = across.unit();
         s.zAxis = s.xAxis.cross(s.yAxis);
         s.scale = (Vec3d(0.1) + vec()) * (extent / 4);
@@ -148,7 +152,8 @@ inline std::vector<FeaturePairSpec> randomPairs(std::mt19937& random, int n, dou
         t.yAxis = rotate(s.yAxis, axis, angle);
         t.zAxis = t.xAxis.cross(t.yAxis);
         const Vec3d factor = Vec3d(0.6) + vec();
-        t.scale = Vec3d(s.scale.x() * factor.x(), s.scale.y() * factor.y(), s.scale.z() * factor.z());
+        t.scale =
+            Vec3d(s.scale.x() * factor.x(), s.scale.y() * factor.y(), s.scale.z() * factor.z());
         pairs.push_back(p);
     }
     return pairs;
@@ -162,26 +167,27 @@ inline double leafError(const InverseWarp& warp, const detail::WarpLeaf& leaf, i
     Vec3d s, d;
     for (int i = 0; i < 512; i += stride) {
         warp.map(leaf.origin.offsetBy(i >> 6, (i >> 3) & 7, i & 7).asVec3d(), s, d);
-        local = std::max({local, (Vec3d(leaf.source(i)) - s).length(), (Vec3d(leaf.target(i)) - d).length()});
+        local = std::max(
+            {local, (Vec3d(leaf.source(i)) - s).length(), (Vec3d(leaf.target(i)) - d).length()});
     }
     return local;
 }
 
 /// The largest leafError over every leaf of the box [0, last]^3 (index space).
-inline double largestError(const InverseWarp& warp, const detail::AdaptiveWarp& adaptive, int last, int stride,
-                    detail::AdaptiveWarpStats& stats)
+inline double largestError(const InverseWarp& warp, const detail::AdaptiveWarp& adaptive, int last,
+                           int stride, detail::AdaptiveWarpStats& stats)
 {
     std::mutex m;
     double worst = 0.0;
-    adaptive.forEachLeaf(openvdb::CoordBBox(openvdb::Coord(0), openvdb::Coord(last)), nullptr, nullptr,
-                         [&](const detail::WarpLeaf& leaf) {
-                             const double local = leafError(warp, leaf, stride);
-                             std::lock_guard<std::mutex> lock(m);
-                             worst = std::max(worst, local);
-                         },
-                         &stats);
+    adaptive.forEachLeaf(
+        openvdb::CoordBBox(openvdb::Coord(0), openvdb::Coord(last)), nullptr, nullptr,
+        [&](const detail::WarpLeaf& leaf) {
+            const double local = leafError(warp, leaf, stride);
+            std::lock_guard<std::mutex> lock(m);
+            worst = std::max(worst, local);
+        },
+        &stats);
     return worst;
 }
-
 
 } // namespace volmorph::test

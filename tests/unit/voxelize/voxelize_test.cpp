@@ -34,7 +34,8 @@ double signedVolume(const Mesh& m)
 double enclosedVolume(const VolumeSet& v)
 {
     double sum = 0.0;
-    for (auto it = v.density->cbeginValueOn(); it; ++it) sum += double(*it) * double(it.getVoxelCount());
+    for (auto it = v.density->cbeginValueOn(); it; ++it)
+        sum += double(*it) * double(it.getVoxelCount());
     return sum * std::pow(v.voxelSize(), 3);
 }
 
@@ -114,7 +115,8 @@ TEST(Voxelize, SphereVolumeAndDistance)
 TEST(Voxelize, CubeVolumeAndDistance)
 {
     ObjectTransform xf;
-    xf.rotateRadians = Vec3d(0.3, 0.5, 0.1); // not axis-aligned, so voxels do not line up with faces
+    xf.rotateRadians =
+        Vec3d(0.3, 0.5, 0.1); // not axis-aligned, so voxels do not line up with faces
     const Mesh cube = sceneMesh("cube.obj", xf);
     const VolumeSet v = voxelize(cube, across(128));
     EXPECT_NEAR(enclosedVolume(v) / 1.0, 1.0, 0.01);
@@ -182,7 +184,8 @@ TEST(Voxelize, NestedShells)
     append(hollow, inner, /*flip=*/true);
     EXPECT_EQ(hollow.report.components, 2u);
     VoxelizeStats stats;
-    EXPECT_NEAR(enclosedVolume(voxelize(hollow, o, nullptr, &stats)) / (outerVolume - innerVolume), 1.0, 0.015);
+    EXPECT_NEAR(enclosedVolume(voxelize(hollow, o, nullptr, &stats)) / (outerVolume - innerVolume),
+                1.0, 0.015);
     EXPECT_TRUE(stats.usedWindingNumber);
 
     Mesh solid = outer; // an outward-facing inner shell is solid (a part inside a part)
@@ -257,7 +260,8 @@ TEST(Voxelize, StopsWhenInterrupted)
 TEST(Voxelize, WritesAndReadsVdbAtomically)
 {
     const VolumeSet v = voxelize(sceneMesh("sphere.obj"), across(32));
-    const std::filesystem::path dir = std::filesystem::temp_directory_path() / "volmorph_voxelize_test";
+    const std::filesystem::path dir =
+        std::filesystem::temp_directory_path() / "volmorph_voxelize_test";
     std::filesystem::create_directories(dir);
     const std::filesystem::path file = dir / "sphere.vdb";
     writeVolumeSet(v, file, {{"volmorph_source", "sphere.obj"}});
@@ -267,7 +271,8 @@ TEST(Voxelize, WritesAndReadsVdbAtomically)
     EXPECT_EQ(back.density->activeVoxelCount(), v.density->activeVoxelCount());
     EXPECT_EQ(back.sdf->metaValue<std::string>("volmorph_source"), "sphere.obj");
     size_t leftovers = 0;
-    for (const auto& entry : std::filesystem::directory_iterator(dir)) leftovers += entry.path() != file;
+    for (const auto& entry : std::filesystem::directory_iterator(dir))
+        leftovers += entry.path() != file;
     EXPECT_EQ(leftovers, 0u);
     EXPECT_THROW(writeVolumeSet(v, dir / "no" / "such" / "dir.vdb"), UserError);
     EXPECT_FALSE(std::filesystem::exists(dir / "no"));
@@ -298,7 +303,8 @@ TEST(WindingNumber, FastAgreesWithExact)
 
 TEST(Voxelize, SceneObjectsShareOneGrid)
 {
-    // sphere-to-box: a sphere of radius 0.5 at the origin and a cube of side 0.8 centred on x = 1.5.
+    // sphere-to-box: a sphere of radius 0.5 at the origin and a cube of side 0.8 centred on x
+    // = 1.5.
     const Scene scene = loadScene(kRoot / "scenes" / "sphere-to-box.toml");
     const SceneVolumes v = voxelizeScene(scene);
     EXPECT_DOUBLE_EQ(v.source.voxelSize(), 0.02);

@@ -33,7 +33,8 @@ TEST(AdaptiveWarp, WithinToleranceOfTheExactWarpOnRandomConfigurations)
             EXPECT_EQ(stats.leaves, 12u * 12u * 12u);
             // Pairs packed this densely (2 voxels of epsilon, elements 2-26 voxels, moved up to
             // 24) leave most pairs near most voxels; the next test is the efficient case.
-            const double pairEvaluations = double(stats.exactEvaluations) * n + double(stats.nearEvaluations);
+            const double pairEvaluations =
+                double(stats.exactEvaluations) * n + double(stats.nearEvaluations);
             EXPECT_LE(pairEvaluations, 1.01 * 96.0 * 96 * 96 * n);
         }
     }
@@ -63,15 +64,17 @@ TEST(AdaptiveWarp, ErrorBoundHoldsAtEveryVoxelOfEveryLeaf)
             for (double tolerance : {0.05, 0.5, 4.0, 1e6}) {
                 const detail::AdaptiveWarp adaptive(warp, tolerance);
                 std::mutex m;
-                adaptive.forEachLeaf(openvdb::CoordBBox(openvdb::Coord(0), openvdb::Coord(63)), nullptr, nullptr,
-                                     [&](const detail::WarpLeaf& leaf) {
-                                         const double local = leafError(warp, leaf, n <= 16 ? 1 : 3);
+                adaptive.forEachLeaf(openvdb::CoordBBox(openvdb::Coord(0), openvdb::Coord(63)),
+                                     nullptr, nullptr, [&](const detail::WarpLeaf& leaf) {
+                                         const double local =
+                                             leafError(warp, leaf, n <= 16 ? 1 : 3);
                                          std::lock_guard<std::mutex> lock(m);
                                          ++checked;
                                          EXPECT_LE(local, leaf.errorBound + 1e-3)
-                                             << n << " pairs, trial " << trial << ", tolerance " << tolerance
-                                             << ", leaf " << leaf.origin;
-                                         if (leaf.errorBound > 1e-3) tightest = std::max(tightest, local / leaf.errorBound);
+                                             << n << " pairs, trial " << trial << ", tolerance "
+                                             << tolerance << ", leaf " << leaf.origin;
+                                         if (leaf.errorBound > 1e-3)
+                                             tightest = std::max(tightest, local / leaf.errorBound);
                                      });
             }
         }
@@ -89,10 +92,12 @@ TEST(AdaptiveWarp, VectorAndBaselineKernelsGiveTheSameBits)
     // sides, so that cells, leaves and the filled points' boxes are culled), compared bit for bit.
     detail::useKernelBuild(detail::KernelBuild::Avx512);
     if (detail::activeKernelBuild() == detail::KernelBuild::Baseline)
-        GTEST_SKIP() << "no vector build of the leaf kernel here (they are built by GCC for x86-64 only, and run "
+        GTEST_SKIP() << "no vector build of the leaf kernel here (they are built by GCC for x86-64 "
+                        "only, and run "
                         "where the CPU has AVX2): nothing to compare with the baseline";
     std::mt19937 random(7);
-    const auto sphere = openvdb::tools::createLevelSetSphere<openvdb::FloatGrid>(30.0f, openvdb::Vec3f(40.0f, 50.0f, 45.0f), 1.0f);
+    const auto sphere = openvdb::tools::createLevelSetSphere<openvdb::FloatGrid>(
+        30.0f, openvdb::Vec3f(40.0f, 50.0f, 45.0f), 1.0f);
     const detail::Occupancy occupancy(sphere->tree());
     for (int trial = 0; trial < 3; ++trial) {
         const auto pairs = randomPairs(random, 12, 96.0);
@@ -115,14 +120,15 @@ TEST(AdaptiveWarp, VectorAndBaselineKernelsGiveTheSameBits)
                 std::map<std::tuple<int, int, int>, std::vector<float>> leaves;
                 detail::AdaptiveWarpStats stats;
                 const detail::Occupancy* occ = trial == 2 ? &occupancy : nullptr;
-                adaptive.forEachLeaf(openvdb::CoordBBox(openvdb::Coord(0), openvdb::Coord(95)), occ, occ,
-                                     [&](const detail::WarpLeaf& leaf) {
-                                         std::vector<float> v(&leaf.s[0][0], &leaf.s[0][0] + 3 * 512);
-                                         v.insert(v.end(), &leaf.t[0][0], &leaf.t[0][0] + 3 * 512);
-                                         std::lock_guard<std::mutex> lock(m);
-                                         leaves[{leaf.origin.x(), leaf.origin.y(), leaf.origin.z()}] = std::move(v);
-                                     },
-                                     &stats);
+                adaptive.forEachLeaf(
+                    openvdb::CoordBBox(openvdb::Coord(0), openvdb::Coord(95)), occ, occ,
+                    [&](const detail::WarpLeaf& leaf) {
+                        std::vector<float> v(&leaf.s[0][0], &leaf.s[0][0] + 3 * 512);
+                        v.insert(v.end(), &leaf.t[0][0], &leaf.t[0][0] + 3 * 512);
+                        std::lock_guard<std::mutex> lock(m);
+                        leaves[{leaf.origin.x(), leaf.origin.y(), leaf.origin.z()}] = std::move(v);
+                    },
+                    &stats);
                 detail::useKernelBuild(detail::KernelBuild::Avx512);
                 EXPECT_GT(stats.nearEvaluations, 0u); // the near-pair loops ran
                 if (tolerance > 1.0) {
@@ -138,7 +144,8 @@ TEST(AdaptiveWarp, VectorAndBaselineKernelsGiveTheSameBits)
                 ASSERT_LT(baseline.size(), 12u * 12u * 12u); // the domain test culled leaves
             }
             // Each vector build this CPU has (the baseline alone where it has none).
-            for (const detail::KernelBuild build : {detail::KernelBuild::Avx2, detail::KernelBuild::Avx512}) {
+            for (const detail::KernelBuild build :
+                 {detail::KernelBuild::Avx2, detail::KernelBuild::Avx512}) {
                 detail::useKernelBuild(build);
                 const bool available = detail::activeKernelBuild() == build;
                 detail::useKernelBuild(detail::KernelBuild::Avx512);
@@ -147,8 +154,10 @@ TEST(AdaptiveWarp, VectorAndBaselineKernelsGiveTheSameBits)
                 ASSERT_EQ(vector.size(), baseline.size());
                 size_t differing = 0;
                 for (const auto& [origin, v] : vector)
-                    differing += std::memcmp(v.data(), baseline.at(origin).data(), v.size() * sizeof(float)) != 0;
-                EXPECT_EQ(differing, 0u) << "build " << int(build) << ", trial " << trial << ", tolerance " << tolerance;
+                    differing += std::memcmp(v.data(), baseline.at(origin).data(),
+                                             v.size() * sizeof(float)) != 0;
+                EXPECT_EQ(differing, 0u)
+                    << "build " << int(build) << ", trial " << trial << ", tolerance " << tolerance;
             }
         }
     }
@@ -167,8 +176,10 @@ TEST(AdaptiveWarp, FewPairEvaluationsWherePairsAreApart)
         const Vec3d at(48.0 + 96 * (k & 1), 48.0 + 96 * ((k >> 1) & 1), 48.0 + 96 * ((k >> 2) & 1));
         const Vec3d axis = Vec3d(u(random), u(random), u(random) + 2.0).unit();
         const double angle = u(random) * M_PI / 9.0;
-        pairs.push_back(pair(FeatureType(k % 4), element(at, Vec3d(1, 0, 0), Vec3d(0, 1, 0), Vec3d(12, 8, 6)),
-                             element(at + 8.0 * Vec3d(u(random), u(random), u(random)), rotate(Vec3d(1, 0, 0), axis, angle),
+        pairs.push_back(pair(FeatureType(k % 4),
+                             element(at, Vec3d(1, 0, 0), Vec3d(0, 1, 0), Vec3d(12, 8, 6)),
+                             element(at + 8.0 * Vec3d(u(random), u(random), u(random)),
+                                     rotate(Vec3d(1, 0, 0), axis, angle),
                                      rotate(Vec3d(0, 1, 0), axis, angle), Vec3d(14, 7, 6))));
     }
     WarpSpec spec;
@@ -178,9 +189,10 @@ TEST(AdaptiveWarp, FewPairEvaluationsWherePairsAreApart)
     detail::AdaptiveWarpStats stats;
     const double worst = largestError(warp, adaptive, 191, 1, stats);
     const double voxels = 192.0 * 192 * 192;
-    const double share = (double(stats.exactEvaluations) * 8 + double(stats.nearEvaluations)) / (8 * voxels);
-    std::cout << "largest error " << worst << " voxel, bound " << stats.maxErrorVoxels << ", pair evaluations "
-              << share << " of the exact warp's\n";
+    const double share =
+        (double(stats.exactEvaluations) * 8 + double(stats.nearEvaluations)) / (8 * voxels);
+    std::cout << "largest error " << worst << " voxel, bound " << stats.maxErrorVoxels
+              << ", pair evaluations " << share << " of the exact warp's\n";
     EXPECT_LE(worst, 0.25);
     EXPECT_LE(stats.maxErrorVoxels, 0.25);
     EXPECT_LT(share, 0.3);

@@ -1,4 +1,5 @@
-// The exact inverse warp (Warp.h): identity, one pair affine, inverse-square weights, degenerate inputs.
+// The exact inverse warp (Warp.h): identity, one pair affine, inverse-square weights, degenerate
+// inputs.
 #include "support/WarpFixtures.h"
 
 using namespace volmorph;
@@ -20,9 +21,11 @@ TEST(InverseWarp, OnePairIsAnAffineMap)
                         element(Vec3d(5, 0, 0), Vec3d(0, 1, 0), Vec3d(-1, 0, 0), Vec3d(2.0)));
     const InverseWarp w({p}, WarpSpec{}, 1.0);
     Vec3d s, t;
-    w.map(Vec3d(5, 2, 0), s, t); // at t = 1 the output is target space: the target side is the identity
+    w.map(Vec3d(5, 2, 0), s,
+          t); // at t = 1 the output is target space: the target side is the identity
     EXPECT_NEAR((t - Vec3d(5, 2, 0)).length(), 0.0, 1e-12);
-    EXPECT_NEAR((s - Vec3d(1, 0, 0)).length(), 0.0, 1e-12); // 2 along target x (= +y) is 1 along source x
+    EXPECT_NEAR((s - Vec3d(1, 0, 0)).length(), 0.0,
+                1e-12); // 2 along target x (= +y) is 1 along source x
     const InverseWarp w0({p}, WarpSpec{}, 0.0);
     w0.map(Vec3d(0.5, 0.5, 0.5), s, t);
     EXPECT_NEAR((s - Vec3d(0.5)).length(), 0.0, 1e-12);
@@ -40,7 +43,8 @@ TEST(InverseWarp, WeightsFollowTheInverseSquareLaw)
     w.map(Vec3d(0, 3, 0), s, t);
     EXPECT_NEAR(s.x(), 0.0, 1e-12);
     // At distance 1 from pair a's interpolated element and 3 from b's... both are at the origin at
-    // t = 1, so move off-centre: weights 1/d^2 are equal; use t = 0.5 with elements at -0.5 and 0.5.
+    // t = 1, so move off-centre: weights 1/d^2 are equal; use t = 0.5 with elements at -0.5 and
+    // 0.5.
     const InverseWarp h({a, b}, spec, 0.5);
     h.map(Vec3d(1.5, 0, 0), s, t); // d_a = 2, d_b = 1: w = 1/4 and 1
     // pair a maps p -> p - 0.5, pair b maps p -> p + 0.5 on the source side.
@@ -57,7 +61,8 @@ TEST(InverseWarp, DegenerateInputsStayFinite)
     const auto c = pair(FeatureType::Point, element(Vec3d(2, 2, 2)), element(Vec3d(2, 2, 3)));
     for (double t : {0.0, 0.5, 1.0}) {
         const InverseWarp w({a, b, c}, spec, t);
-        for (const Vec3d& p : {Vec3d(0.0), Vec3d(0.2, 0, 0), Vec3d(2, 2, 2 + t), Vec3d(1e6, -1e6, 3)}) {
+        for (const Vec3d& p :
+             {Vec3d(0.0), Vec3d(0.2, 0, 0), Vec3d(2, 2, 2 + t), Vec3d(1e6, -1e6, 3)}) {
             Vec3d s, d;
             w.map(p, s, d);
             for (int k = 0; k < 3; ++k) {

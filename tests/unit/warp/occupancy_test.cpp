@@ -11,8 +11,10 @@ TEST(AdaptiveWarp, OccupancyBoxQueriesMatchTheTree)
     openvdb::FloatTree tree(0.0f);
     std::mt19937 random(7);
     std::uniform_int_distribution<int> coord(-200, 200);
-    for (int i = 0; i < 3000; ++i) tree.setValue(openvdb::Coord(coord(random), coord(random), coord(random)), 1.0f);
-    tree.fill(openvdb::CoordBBox(openvdb::Coord(256), openvdb::Coord(256 + 127)), 1.0f, true); // a tile
+    for (int i = 0; i < 3000; ++i)
+        tree.setValue(openvdb::Coord(coord(random), coord(random), coord(random)), 1.0f);
+    tree.fill(openvdb::CoordBBox(openvdb::Coord(256), openvdb::Coord(256 + 127)), 1.0f,
+              true); // a tile
     const detail::Occupancy occupancy(tree);
     openvdb::MaskTree blocks; // the same rule: blocks with active values
     auto block = [](int v) { return v >= 0 ? v / 8 : -((-v + 7) / 8); };

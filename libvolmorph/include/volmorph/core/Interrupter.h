@@ -11,9 +11,9 @@
 namespace volmorph {
 
 /// Cancels when requestStop() is called (e.g. from a SIGINT handler: it is async-signal-safe)
-/// and optionally prints progress to stderr: with `reportProgress` each operation's percentage, with
-/// `logStages` one line per operation as it starts ("volmorph: 1.25 s  render: shadows", seconds
-/// since the interrupter was made), to show a farm log or a user where the time goes.
+/// and optionally prints progress to stderr: with `reportProgress` each operation's percentage,
+/// with `logStages` one line per operation as it starts ("volmorph: 1.25 s  render: shadows",
+/// seconds since the interrupter was made), to show a farm log or a user where the time goes.
 class Interrupter : public openvdb::util::NullInterrupter {
 public:
     explicit Interrupter(bool reportProgress = false, bool logStages = false)

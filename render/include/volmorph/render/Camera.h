@@ -14,8 +14,8 @@ class Camera {
 public:
     enum class Projection { Perspective, Orthographic };
 
-    Camera(Projection projection, const Vec3d& eye, const Vec3d& lookat, const Vec3d& up, double fovDegrees,
-           double orthoWidth, int width, int height);
+    Camera(Projection projection, const Vec3d& eye, const Vec3d& lookat, const Vec3d& up,
+           double fovDegrees, double orthoWidth, int width, int height);
 
     /// The ray through image position (x, y) in pixels: (0, 0) is the top-left corner of the
     /// top-left pixel, (width, height) the bottom-right corner of the last one.
@@ -34,7 +34,8 @@ public:
 private:
     Projection mProjection;
     Vec3d mEye, mForward, mRight, mUp;
-    double mHalfWidth, mHalfHeight; ///< of the image plane at distance 1 (perspective) or in world units
+    double mHalfWidth,
+        mHalfHeight; ///< of the image plane at distance 1 (perspective) or in world units
     int mWidth, mHeight;
 };
 

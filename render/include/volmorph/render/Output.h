@@ -11,7 +11,7 @@
 namespace volmorph::render {
 
 struct ExrOptions {
-    bool halfFloat = true; ///< half RGBA (default) or float
+    bool halfFloat = true;                       ///< half RGBA (default) or float
     std::map<std::string, std::string> metadata; ///< extra string attributes
     int frame = 0;
     int samples = 0;
@@ -19,10 +19,11 @@ struct ExrOptions {
 };
 
 /// Writes `image` as an OpenEXR file: ZIP compression, linear Rec.709 chromaticities, software and
-/// version, frame, worldToCamera and worldToNDC, samples and render time. The file appears at `path`
-/// only when complete (written under a temporary name, then renamed). Throws std::runtime_error
-/// with the reason when it cannot be written.
-void writeExr(const Image& image, const Camera& camera, const std::filesystem::path& path, const ExrOptions& options);
+/// version, frame, worldToCamera and worldToNDC, samples and render time. The file appears at
+/// `path` only when complete (written under a temporary name, then renamed). Throws
+/// std::runtime_error with the reason when it cannot be written.
+void writeExr(const Image& image, const Camera& camera, const std::filesystem::path& path,
+              const ExrOptions& options);
 
 /// Writes an 8-bit sRGB PNG preview (clamped, over black), atomically like writeExr.
 void writePng(const Image& image, const std::filesystem::path& path);

@@ -9,8 +9,8 @@
 // its optical depth is integrated exactly: alpha has no step error, no sample lattice and so no
 // banding, whatever the step. Cells inside an 8^3 block of one value (a tile, or a leaf whose
 // values are all equal) are crossed as one piece.
-// Each piece is cut into equal steps of at most `stepVoxels`; each step adds T (1 - e^-tau) S at its
-// middle and multiplies T by e^-tau, tau being the step's exact optical depth. The source S
+// Each piece is cut into equal steps of at most `stepVoxels`; each step adds T (1 - e^-tau) S at
+// its middle and multiplies T by e^-tau, tau being the step's exact optical depth. The source S
 // (emission plus albedo times the light reaching the point) is evaluated at knots along the ray,
 // the first step end at least one voxel after the previous knot (so knots are 1 to 1 + step voxels
 // apart), and taken linearly in between. That is the only approximation along the ray: second
@@ -62,12 +62,12 @@ struct Medium {
 };
 
 struct RenderSettings {
-    int samples = 4;               ///< per pixel, stratified and jittered; 1 = through the pixel centre
-    double stepVoxels = 0.5;       ///< longest step of the scattering integral along a primary ray
-    int shadowCacheVoxels = 2;     ///< cache spacing, in voxels (1 = every voxel)
+    int samples = 4;           ///< per pixel, stratified and jittered; 1 = through the pixel centre
+    double stepVoxels = 0.5;   ///< longest step of the scattering integral along a primary ray
+    int shadowCacheVoxels = 2; ///< cache spacing, in voxels (1 = every voxel)
     unsigned seed = 0;
-    int frame = 0;                 ///< part of the sampling seed
-    int threads = 0;               ///< 0 = all cores
+    int frame = 0;   ///< part of the sampling seed
+    int threads = 0; ///< 0 = all cores
     /// Asked between pixels and between the shadow maps' columns (OpenVDB's interrupter interface);
     /// when it answers true, renderVolume throws volmorph::Interrupted. May be null.
     openvdb::util::NullInterrupter* interrupter = nullptr;
@@ -79,13 +79,18 @@ struct Image {
     std::vector<float> pixels; ///< 4 floats per pixel
 
     float* at(int x, int y) { return &pixels[4 * (size_t(y) * size_t(width) + size_t(x))]; }
-    const float* at(int x, int y) const { return &pixels[4 * (size_t(y) * size_t(width) + size_t(x))]; }
+    const float* at(int x, int y) const
+    {
+        return &pixels[4 * (size_t(y) * size_t(width) + size_t(x))];
+    }
 };
 
 /// Renders `density` (a fog: any float grid of densities, negative values counting as 0; or a level
 /// set, see Medium::Kind), coloured by `color` (linear RGB albedo colour, may be null: white).
-/// Throws volmorph::Interrupted (volmorph/core/Interrupter.h) when settings.interrupter asks to stop.
-Image renderVolume(const openvdb::FloatGrid& density, const openvdb::Vec3SGrid* color, const Camera& camera,
-                   const std::vector<Light>& lights, const Medium& medium, const RenderSettings& settings);
+/// Throws volmorph::Interrupted (volmorph/core/Interrupter.h) when settings.interrupter asks to
+/// stop.
+Image renderVolume(const openvdb::FloatGrid& density, const openvdb::Vec3SGrid* color,
+                   const Camera& camera, const std::vector<Light>& lights, const Medium& medium,
+                   const RenderSettings& settings);
 
 } // namespace volmorph::render
