@@ -3,6 +3,8 @@
 # --check: changes nothing, lists the files that differ and exits 1 if any does.
 set -eu
 cd "$(dirname "$0")/.."
+command -v clang-format >/dev/null 2>&1 || { echo "clang-format not installed: skipped"; exit 77; }
+[ -d .git ] || git rev-parse --git-dir >/dev/null 2>&1 || { echo "not a git checkout: skipped"; exit 77; }
 files=$(git ls-files '*.cpp' '*.h')
 if [ "${1:-}" = "--check" ]; then
     bad=""

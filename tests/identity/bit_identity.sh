@@ -1,13 +1,14 @@
 #!/bin/sh
 # Proves that two builds of volmorph give the same bits: a refactoring must not change any output.
 #
-#   tests/identity/bit_identity.sh BASE [NEW] [--quick] [--keep] [--base-build DIR]
+#   tests/identity/bit_identity.sh BASE [NEW] [--quick] [--keep] [--base-build DIR] [--new-build DIR]
 #
 # BASE and NEW are commits (NEW defaults to the working tree as it is, uncommitted changes included).
 # Each is built in Release with the benchmarks, in build-identity/ beside the checkout (a commit in a
 # git worktree of its own; kept between runs, so a second run only rebuilds what changed, with ccache).
 # --base-build DIR uses an existing Release build of BASE with the benchmarks instead (it needs
-# DIR/bin/volmorph and DIR/tests/bench/volmorph_bench_warp), to spare a 2-core machine a full build.
+# DIR/bin/volmorph and DIR/tests/bench/volmorph_bench_warp), to spare a 2-core machine a full build;
+# --new-build DIR likewise for NEW (a build of the working tree, say).
 # Then, for each build, at 1 thread (taskset to one core: TBB follows the affinity mask, and
 # --threads 1) and at 2 threads, it records:
 #   - points_hash of the approximated warp (tests/bench/warp_bench.cpp) at 1, 4, 16 and 64 pairs;
@@ -21,16 +22,17 @@
 # left in build-identity/run/ with --keep.
 set -eu
 
-usage() { echo "usage: tests/identity/bit_identity.sh BASE [NEW] [--quick] [--keep] [--base-build DIR]" >&2; exit 2; }
+usage() { echo "usage: tests/identity/bit_identity.sh BASE [NEW] [--quick] [--keep] [--base-build DIR] [--new-build DIR]" >&2; exit 2; }
 root=$(cd "$(dirname "$0")/../.." && pwd)
 cd "$root"
-base="" new="" quick=0 keep=0 base_build=""
+base="" new="" quick=0 keep=0 base_build="" new_build=""
 while [ $# -gt 0 ]; do
     a=$1
     shift
     case "$a" in
         --quick) quick=1 ;;
         --base-build) [ $# -gt 0 ] || usage; base_build=$(cd "$1" && pwd); shift ;;
+        --new-build) [ $# -gt 0 ] || usage; new_build=$(cd "$1" && pwd); shift ;;
         --keep) keep=1 ;;
         -*) usage ;;
         *) if [ -z "$base" ]; then base=$a; elif [ -z "$new" ]; then new=$a; else usage; fi ;;
@@ -108,14 +110,18 @@ manifest() {
     [ "$keep" -eq 1 ] || rm -rf "$files"
 }
 
-if [ -n "$base_build" ]; then
-    [ -x "$base_build/bin/volmorph" ] && [ -x "$base_build/tests/bench/volmorph_bench_warp" ] ||
-        { echo "bit_identity: $base_build has no bin/volmorph and tests/bench/volmorph_bench_warp" >&2; exit 2; }
-    base_dir=$base_build
-else
-    base_dir=$(build "$base")
-fi
-new_dir=$(build "$new")
+# given DIR SPEC: DIR checked, or SPEC built.
+given() {
+    if [ -n "$1" ]; then
+        [ -x "$1/bin/volmorph" ] && [ -x "$1/tests/bench/volmorph_bench_warp" ] ||
+            { echo "bit_identity: $1 has no bin/volmorph and tests/bench/volmorph_bench_warp" >&2; exit 2; }
+        echo "$1"
+    else
+        build "$2"
+    fi
+}
+base_dir=$(given "$base_build" "$base")
+new_dir=$(given "$new_build" "$new")
 run=$work/run
 rm -rf "$run"
 mkdir -p "$run"
