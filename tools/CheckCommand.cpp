@@ -83,14 +83,9 @@ void warnCoincidentFeatures(const Scene& scene)
         }
 }
 
-int runCheck(const std::string& scenePath)
+/// The voxel grid both meshes share and the memory voxelizing them takes.
+void printVolume(const Scene& scene, const SceneMeshes& meshes)
 {
-    const Scene scene = loadScene(scenePath);
-    const SceneMeshes meshes = importSceneMeshes(scene);
-    std::printf("scene   %s\n", scenePath.c_str());
-    printMesh("source", scene.source, meshes.source);
-    printMesh("target", scene.target, meshes.target);
-
     auto [slo, shi] = meshes.source.bounds();
     auto [tlo, thi] = meshes.target.bounds();
     const Vec3d extent = maxComponent(shi, thi) - minComponent(slo, tlo);
@@ -104,7 +99,11 @@ int runCheck(const std::string& scenePath)
         double(estimateVoxelizeBytes(meshes.source, voxel, 3.0f)) / gib,
         double(estimateVoxelizeBytes(meshes.target, voxel, 3.0f)) / gib,
         double(defaultMemoryLimitBytes()) / gib);
+}
 
+/// Every feature pair, numbered as the warp and `preview` number them.
+void printPairs(const Scene& scene)
+{
     std::printf("pairs   %zu\n", scene.pairs.size());
     for (size_t i = 0; i < scene.pairs.size(); ++i) {
         const FeaturePairSpec& p = scene.pairs[i];
@@ -117,6 +116,11 @@ int runCheck(const std::string& scenePath)
         std::printf("  %3zu %-9s source %s\n      %-9s target %s\n", i + 1, toString(p.type),
                     element(p.source).c_str(), "", element(p.target).c_str());
     }
+}
+
+/// The warp, blend and render settings.
+void printSettings(const Scene& scene)
+{
     const WarpSpec& w = scene.warp;
     std::printf("warp    %s, epsilon %s world units, tolerance %s voxels%s\n",
                 w.weighting == Weighting::InverseSquare ? "inverse-square" : "beier-neely",
@@ -131,6 +135,11 @@ int runCheck(const std::string& scenePath)
         "render  %dx%d, %d samples, step %s voxels, extinction %s per world unit, albedo %s\n",
         r.width, r.height, r.samples, fmt(r.stepVoxels).c_str(), fmt(r.extinction).c_str(),
         fmt(r.albedo).c_str());
+}
+
+/// The camera, the emission and the lights (with their animation keys).
+void printView(const RenderSpec& r)
+{
     const CameraSpec& c = r.camera;
     if (c.projection == Projection::Perspective)
         std::printf("camera  perspective, eye %s, lookat %s, fov %s degrees (horizontal)\n",
@@ -154,6 +163,11 @@ int runCheck(const std::string& scenePath)
             std::printf("        animated: %zu keys, frames %d to %d\n", l.keys.size(),
                         l.keys.front().frame, l.keys.back().frame);
     }
+}
+
+/// The frame range, the output pattern and every frame's t.
+void printFrames(const Scene& scene)
+{
     const FramesSpec& f = scene.frames;
     std::printf("frames  %d-%d (%d frames) -> %s\n", f.first, f.last, f.count(),
                 (scene.folder / f.output).string().c_str());
@@ -163,6 +177,20 @@ int runCheck(const std::string& scenePath)
         std::printf("%s%5d: t=%-7.4f", k % kPerLine == 0 ? "       " : "", frame, f.t(frame));
         if (k % kPerLine == kPerLine - 1 || frame == f.last) std::printf("\n");
     }
+}
+
+int runCheck(const std::string& scenePath)
+{
+    const Scene scene = loadScene(scenePath);
+    const SceneMeshes meshes = importSceneMeshes(scene);
+    std::printf("scene   %s\n", scenePath.c_str());
+    printMesh("source", scene.source, meshes.source);
+    printMesh("target", scene.target, meshes.target);
+    printVolume(scene, meshes);
+    printPairs(scene);
+    printSettings(scene);
+    printView(scene.render);
+    printFrames(scene);
     std::fflush(stdout);
     warnFarFeatures(scene, meshes.source, meshes.target);
     warnCoincidentFeatures(scene);
