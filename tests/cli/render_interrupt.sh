@@ -6,10 +6,13 @@
 #      unless the signal landed after "render: shadows" began and before "render: pixels" did);
 #   3. render, morph and preview of a scene during a frame's morph (the exact warp on fine voxels,
 #      seconds per frame; fails unless it landed after "frame 1: morph" and before the next stage).
-# usage: render_interrupt.sh VOLMORPH SOURCE_DIR
+# usage: render_interrupt.sh VOLMORPH SOURCE_DIR [LIMIT]
+#        LIMIT: the longest stop allowed, in seconds (default 1, the promise; sanitizer builds, which
+#        run 5-40 times slower, pass more)
 set -u
 volmorph=$1
 source_dir=$2
+limit=${3:-1.0}
 dir=$(mktemp -d)
 pid=0
 trap 'kill -9 $pid 2>/dev/null; rm -rf "$dir"' EXIT
@@ -38,7 +41,7 @@ stop() {
     t1=$(now)
     elapsed=$(awk -v a="$t0" -v b="$t1" 'BEGIN { printf "%.3f", b - a }')
     [ "$status" -eq 130 ] || fail "$2: exit status $status after SIG$1, expected 130"
-    awk -v e="$elapsed" 'BEGIN { exit !(e < 1.0) }' || fail "$2: took $elapsed s to stop, more than 1 s"
+    awk -v e="$elapsed" -v l="$limit" 'BEGIN { exit !(e < l) }' || fail "$2: took $elapsed s to stop, more than $limit s"
     grep -q "interrupted; no output written" "$dir/err" || fail "$2: no message"
     left=$(ls "$dir/out" 2>/dev/null || true)
     [ -z "$left" ] || fail "$2: left files: $left"
@@ -83,4 +86,4 @@ for command in render morph preview; do
     stop "$signal" "$command during a frame's morph"
     grep -q "render: empty-space mask" "$dir/err" && fail "$command: the morph was done before the signal"
 done
-echo "every interrupt stopped within 1 s with exit 130 and no file"
+echo "every interrupt stopped within $limit s with exit 130 and no file"
