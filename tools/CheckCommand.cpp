@@ -2,6 +2,7 @@
 #include "Common.h"
 
 #include <volmorph/Scene.h>
+#include <volmorph/Schedule.h>
 #include <volmorph/Voxelize.h>
 
 #include <cmath>
@@ -128,8 +129,8 @@ void printSettings(const Scene& scene)
                 w.toleranceVoxels == 0.0 ? " (exact)" : "");
     const BlendSpec& b = scene.blend;
     std::printf("blend   %s mode; density %s, colour %s, sdf %s\n",
-                b.mode == BlendMode::Sdf ? "sdf" : "density", b.density.str().c_str(),
-                b.color.str().c_str(), b.sdf.str().c_str());
+                b.mode == BlendMode::Sdf ? "sdf" : "density", describe(b.density).c_str(),
+                describe(b.color).c_str(), describe(b.sdf).c_str());
     const RenderSpec& r = scene.render;
     std::printf(
         "render  %dx%d, %d samples, step %s voxels, extinction %s per world unit, albedo %s\n",

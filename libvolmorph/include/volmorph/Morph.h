@@ -2,27 +2,11 @@
 //
 // At each t the output domain is found sparsely, each output voxel is warped back into source and
 // target (the approximated warp of src/warp/AdaptiveWarp.h, or the exact one), both are resampled
-// with OpenVDB's samplers, and blended: density by the density schedule, colour density-weighted
-// by the colour schedule (so no colour leaks in from the side that is empty there).
-//
-// sdf mode blends signed distances. A narrow band clamps distances to +/- its width, and the blend
-// of two clamped values, (1 - tau)(-w) + tau(+w), changes sign at tau = 1/2 everywhere at once:
-// every voxel inside one object and a few voxels outside the other would flip in one frame (the
-// shape snaps instead of morphing). So the Morpher first extends both distance fields over the box
-// of source and target together, plus a margin, once: the band's own values near the surface,
-// beyond them a field at twice the voxel size filled in by OpenVDB's fast sweeping
-// (tools::maskSdf).
-//
-// A frame evaluates the blend only where its band can be. The blend's gradient is at most the
-// warp's stretch G (distances change by at most one per unit), so a leaf or a quarter of a leaf
-// whose centre value is farther from zero than G times its reach plus the band is inside or outside
-// as a whole, judged from that one value. In the rest, dust is removed (blend.min_island), the
-// band is rebuilt to first order (|b| / |grad b|, never beyond an edge's zero crossing), and the
-// fog is derived from it. frameOverBox() evaluates every voxel instead: the tests' reference.
-// With no feature pairs the warp is the identity at every t: both extended distances at a voxel
-// are then the same in every frame, and are kept per leaf from the first frame that needs them,
-// as are those at the leaves' centres (the frames are the same bit for bit; only the blend's
-// weight changes with t). The extended fields then need only the objects' box plus 8 voxels.
+// with OpenVDB's samplers, and blended by the method `blend.mode` names (src/blend/): density mode
+// mixes the densities by the density schedule; sdf mode blends signed distances extended beyond
+// their bands, so the surface morphs instead of snapping (src/blend/SdfBlend.h). Colour is mixed
+// by the colour schedule, weighted by each side's density (no colour leaks in from the side that
+// is empty there). frameOverBox() evaluates every voxel instead: the tests' reference.
 #pragma once
 
 #include <volmorph/core/Interrupter.h>
@@ -37,8 +21,7 @@ namespace volmorph {
 
 namespace detail {
 class Occupancy;
-class ExtendedDistance;
-class IdentityDistances;
+class BlendMethod;
 } // namespace detail
 
 struct MorphOptions {
@@ -88,18 +71,10 @@ public:
 private:
     VolumeSet run(double t, const openvdb::CoordBBox& box, bool prune, double tolerance,
                   MorphStats* stats, Interrupter* interrupter) const;
-    VolumeSet runSdf(double t, const openvdb::CoordBBox& box, bool prune, double tolerance,
-                     MorphStats* stats, Interrupter* interrupter) const;
-    template <typename Sampler>
-    VolumeSet runSdf(double t, const openvdb::CoordBBox& box, bool prune, double tolerance,
-                     MorphStats* stats, Interrupter* interrupter) const;
 
     VolumeSet mSource, mTarget;
-    /// sdf mode: the source's and target's distances extended over both objects' box (see above).
-    std::shared_ptr<const detail::ExtendedDistance> mFarSource, mFarTarget;
-    /// sdf mode with no pairs: both extended distances at the output voxels, kept per leaf across
-    /// frames (the identity warp does not change with t). Bounded by a quarter of the memory limit.
-    std::shared_ptr<detail::IdentityDistances> mIdentity;
+    /// The blend method (with what it keeps across frames: sdf mode's extended distances).
+    std::shared_ptr<const detail::BlendMethod> mMethod;
     /// Which 8^3 blocks of source and target are occupied; they do not change with t.
     std::shared_ptr<const detail::Occupancy> mSourceBlocks, mTargetBlocks;
     std::vector<FeaturePairSpec> mPairs;

@@ -78,14 +78,12 @@ struct WarpSpec {
 };
 
 /// tau(t) for one attribute. Points are (t, tau) pairs sorted by t, interpolated linearly.
+/// Evaluated by the blend stage (volmorph/Schedule.h).
 struct ScheduleSpec {
     enum class Kind { Linear, Smoothstep, Sigmoid, Curve };
     Kind kind = Kind::Linear;
     double k = 8.0; ///< sigmoid steepness
     std::vector<std::pair<double, double>> points;
-
-    double evaluate(double t) const; ///< t in [0, 1]
-    std::string str() const;
 };
 
 enum class BlendMode { Density, Sdf };

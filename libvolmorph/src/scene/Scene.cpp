@@ -46,56 +46,6 @@ const char* toString(FeatureType type)
     return "?";
 }
 
-double ScheduleSpec::evaluate(double t) const
-{
-    t = std::clamp(t, 0.0, 1.0);
-    switch (kind) {
-    case Kind::Linear:
-        return t;
-    case Kind::Smoothstep:
-        return t * t * (3.0 - 2.0 * t);
-    case Kind::Sigmoid: {
-        // Logistic curve centred on t = 0.5, rescaled so that tau(0) = 0 and tau(1) = 1 exactly.
-        auto s = [this](double x) { return 1.0 / (1.0 + std::exp(-k * (x - 0.5))); };
-        const double s0 = s(0.0), s1 = s(1.0);
-        return (s(t) - s0) / (s1 - s0);
-    }
-    case Kind::Curve: {
-        assert(points.size() >= 2);
-        if (t <= points.front().first) return points.front().second;
-        if (t >= points.back().first) return points.back().second;
-        const auto hi = std::upper_bound(
-            points.begin(), points.end(), t,
-            [](double v, const std::pair<double, double>& p) { return v < p.first; });
-        const auto lo = hi - 1;
-        const double span = hi->first - lo->first;
-        const double a = span > 0.0 ? (t - lo->first) / span : 1.0;
-        return lo->second + a * (hi->second - lo->second);
-    }
-    }
-    return t;
-}
-
-std::string ScheduleSpec::str() const
-{
-    std::ostringstream s;
-    switch (kind) {
-    case Kind::Linear:
-        s << "linear";
-        break;
-    case Kind::Smoothstep:
-        s << "smoothstep";
-        break;
-    case Kind::Sigmoid:
-        s << "sigmoid(" << k << ")";
-        break;
-    case Kind::Curve:
-        s << "curve of " << points.size() << " points";
-        break;
-    }
-    return s.str();
-}
-
 namespace {
 
 /// The two keys around `frame` and the weight of the second; the same key twice outside them.

@@ -424,29 +424,6 @@ TEST(FrameRange, TimeOfFrame)
     EXPECT_DOUBLE_EQ(f.t(1), 0.0);
 }
 
-TEST(Schedule, EndpointsAndMonotone)
-{
-    ScheduleSpec linear, smooth, sigmoid, curve;
-    smooth.kind = ScheduleSpec::Kind::Smoothstep;
-    sigmoid.kind = ScheduleSpec::Kind::Sigmoid;
-    sigmoid.k = 12;
-    curve.kind = ScheduleSpec::Kind::Curve;
-    curve.points = {{0, 0}, {0.5, 0.8}, {1, 1}};
-    for (const ScheduleSpec* s : {&linear, &smooth, &sigmoid, &curve}) {
-        EXPECT_NEAR(s->evaluate(0.0), 0.0, 1e-12) << s->str();
-        EXPECT_NEAR(s->evaluate(1.0), 1.0, 1e-12) << s->str();
-        double previous = 0.0;
-        for (int i = 1; i <= 100; ++i) {
-            const double tau = s->evaluate(i / 100.0);
-            EXPECT_GE(tau, previous) << s->str();
-            previous = tau;
-        }
-    }
-    EXPECT_NEAR(sigmoid.evaluate(0.5), 0.5, 1e-12);
-    EXPECT_NEAR(curve.evaluate(0.25), 0.4, 1e-12);
-    EXPECT_NEAR(curve.evaluate(0.75), 0.9, 1e-12);
-}
-
 TEST(Scene, CommentedExampleInScenesReadmeParses)
 {
     // scenes/README.md's "fully commented example" is documentation users copy; it must stay valid.

@@ -9,7 +9,7 @@
 #include <volmorph/Voxelize.h>
 #include <volmorph/Warp.h>
 
-#include "morph/Stretch.h"     // private to the library; tested directly
+#include "warp/Stretch.h"      // private to the library; tested directly
 #include "warp/AdaptiveWarp.h" // private to the library; tested directly
 
 #include <openvdb/tools/Composite.h>

@@ -1,4 +1,4 @@
-// The warp's stretch (morph/Stretch.h) against OpenVDB's own diagonalization.
+// The warp's stretch (warp/Stretch.h) against OpenVDB's own diagonalization.
 #include "support/WarpFixtures.h"
 
 using namespace volmorph;

@@ -1,0 +1,18 @@
+// A blend schedule: tau(t), the target's weight at morph time t, for one attribute (density,
+// colour, distance). Its settings are Scene.h's ScheduleSpec; the blend stage evaluates it.
+#pragma once
+
+#include <volmorph/Scene.h>
+
+#include <string>
+
+namespace volmorph {
+
+/// tau at t (clamped to [0, 1]): linear, smoothstep, a logistic sigmoid rescaled to pass through
+/// (0, 0) and (1, 1), or the curve's points interpolated linearly (held beyond its ends).
+double scheduleValue(const ScheduleSpec& schedule, double t);
+
+/// "linear", "smoothstep", "sigmoid(K)" or "curve of N points", for `volmorph check`.
+std::string describe(const ScheduleSpec& schedule);
+
+} // namespace volmorph

@@ -1,0 +1,26 @@
+#include "blend/BlendMethod.h"
+
+#include "blend/DensityBlend.h"
+#include "blend/SdfBlend.h"
+
+#include <stdexcept>
+
+namespace volmorph::detail {
+
+std::unique_ptr<const BlendMethod> makeBlendMethod(const BlendSetup& setup)
+{
+    switch (setup.spec.mode) {
+    case BlendMode::Density:
+        return makeDensityBlend(setup);
+    case BlendMode::Sdf:
+        return makeSdfBlend(setup);
+    }
+    throw std::logic_error("makeBlendMethod: unknown blend mode");
+}
+
+Vec3f blendedColorBackground(const VolumeSet& source, const VolumeSet& target, float tauColor)
+{
+    return (1.0f - tauColor) * source.color->background() + tauColor * target.color->background();
+}
+
+} // namespace volmorph::detail

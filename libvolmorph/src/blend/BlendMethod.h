@@ -1,0 +1,73 @@
+// A blend method: how the two warped sides become one in-between. The Morpher finds the frame's
+// domain and warp, and hands them to the method chosen by `blend.mode`; the method fills the
+// output leaves and returns the grids.
+//
+// Adding a method: a new blend/XBlend.{h,cpp} with a class derived from BlendMethod and a
+// makeXBlend(), and one line in makeBlendMethod() (BlendMethod.cpp).
+#pragma once
+
+#include "blend/OutputLeaves.h"
+#include "warp/AdaptiveWarp.h"
+
+#include <volmorph/core/Interrupter.h>
+#include <volmorph/Scene.h>
+#include <volmorph/VolumeSet.h>
+
+#include <openvdb/Types.h>
+
+#include <cstdint>
+#include <memory>
+
+namespace volmorph::detail {
+
+/// How the sides are read at warped points (OpenVDB's BoxSampler or QuadraticSampler).
+enum class Interpolation { Trilinear, Triquadratic };
+
+/// What a method is made from, once per morph.
+struct BlendSetup {
+    const VolumeSet& source; ///< both on one transform; density and Cd always, sdf for sdf mode
+    const VolumeSet& target;
+    const BlendSpec& spec;
+    Interpolation interpolation = Interpolation::Trilinear;
+    size_t pairCount = 0;          ///< no pairs: the warp is the identity at every t
+    openvdb::CoordBBox candidates; ///< the domain at t = 0 (index space), for kept values
+    uint64_t memoryLimitBytes = 0; ///< resolved (never 0)
+};
+
+/// One frame's request.
+struct BlendRequest {
+    double t = 0.0;
+    openvdb::CoordBBox box;       ///< the candidate domain (output index space)
+    bool prune = true;            ///< false: every voxel of the box (the tests' reference)
+    double toleranceVoxels = 0.0; ///< the approximated warp's error bound
+    const InverseWarp* warp = nullptr;
+    const AdaptiveWarp* adaptive = nullptr;
+    /// The sides' occupied blocks, to skip leaves whose image misses both (null: none skipped).
+    const Occupancy* sourceBlocks = nullptr;
+    const Occupancy* targetBlocks = nullptr;
+    Interrupter* interrupter = nullptr;
+};
+
+/// A method's frame: the grids (density and Cd; sdf in sdf mode), without names or transforms
+/// where the caller sets them, and what it cost.
+struct BlendedFrame {
+    VolumeSet grids;
+    size_t keptLeaves = 0;
+    AdaptiveWarpStats warp;
+    uint64_t blendSamples = 0; ///< points where the blend was evaluated (sdf mode)
+};
+
+class BlendMethod {
+public:
+    virtual ~BlendMethod() = default;
+    /// The in-between for `request`; its leaves go through `leaves` (the memory guard).
+    virtual BlendedFrame frame(const BlendRequest& request, OutputLeaves& leaves) const = 0;
+};
+
+/// The method `setup.spec.mode` names.
+std::unique_ptr<const BlendMethod> makeBlendMethod(const BlendSetup& setup);
+
+/// The output's colour background at t: the sides' backgrounds mixed by the colour schedule.
+Vec3f blendedColorBackground(const VolumeSet& source, const VolumeSet& target, float tauColor);
+
+} // namespace volmorph::detail

@@ -1,0 +1,80 @@
+#include "blend/BlockClasses.h"
+
+#include "warp/Stretch.h"
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+#include <limits>
+
+namespace volmorph::detail {
+
+using openvdb::Coord;
+
+bool BlockClasses::anyToEvaluate(const openvdb::CoordBBox& cells) const
+{
+    openvdb::CoordBBox b = cells >> size_t(3); // leaf coordinates
+    b.intersect(leaves);
+    for (int x = b.min().x(); x <= b.max().x(); ++x)
+        for (int y = b.min().y(); y <= b.max().y(); ++y)
+            for (int z = b.min().z(); z <= b.max().z(); ++z)
+                if (at(Coord(x, y, z)) == 0) return true;
+    return false;
+}
+
+std::vector<float> neighbourhoodMax(const std::vector<float>& values, const Coord& dim)
+{
+    auto index = [&dim](int x, int y, int z) { return (size_t(x) * dim.y() + y) * dim.z() + z; };
+    std::vector<float> out(values.size());
+    tbb::parallel_for(tbb::blocked_range<int>(0, dim.x()), [&](const tbb::blocked_range<int>& r) {
+        for (int x = r.begin(); x != r.end(); ++x)
+            for (int y = 0; y < dim.y(); ++y)
+                for (int z = 0; z < dim.z(); ++z) {
+                    float m = -std::numeric_limits<float>::max();
+                    for (int i = std::max(0, x - 1); i <= std::min(dim.x() - 1, x + 1); ++i)
+                        for (int j = std::max(0, y - 1); j <= std::min(dim.y() - 1, y + 1); ++j)
+                            for (int k = std::max(0, z - 1); k <= std::min(dim.z() - 1, z + 1); ++k)
+                                m = std::max(m, values[index(i, j, k)]);
+                    out[index(x, y, z)] = m;
+                }
+    });
+    return out;
+}
+
+std::vector<float> leafStretch(const std::vector<Vec3d>& ps, const std::vector<Vec3d>& pt,
+                               const Coord& n, float tau)
+{
+    auto index = [&n](int x, int y, int z) { return (size_t(x) * n.y() + y) * n.z() + z; };
+    auto norm = [](const Vec3d& dx, const Vec3d& dy, const Vec3d& dz) {
+        return spectralNorm(dx, dy, dz) / 8.0;
+    };
+    // The difference along `axis` between the neighbouring centres (one-sided at the box's faces).
+    auto diff = [&](const std::vector<Vec3d>& p, int x, int y, int z, int axis) {
+        Coord a(x, y, z), b(x, y, z);
+        if (b[axis] + 1 < n[axis])
+            b[axis] += 1;
+        else if (a[axis] > 0)
+            a[axis] -= 1;
+        else
+            return Vec3d(0.0);
+        return p[index(b.x(), b.y(), b.z())] - p[index(a.x(), a.y(), a.z())];
+    };
+    std::vector<float> own(ps.size(), 1.0f);
+    tbb::parallel_for(tbb::blocked_range<int>(0, n.x()), [&](const tbb::blocked_range<int>& r) {
+        for (int x = r.begin(); x != r.end(); ++x)
+            for (int y = 0; y < n.y(); ++y)
+                for (int z = 0; z < n.z(); ++z) {
+                    const double s =
+                        norm(diff(ps, x, y, z, 0), diff(ps, x, y, z, 1), diff(ps, x, y, z, 2));
+                    const double t =
+                        norm(diff(pt, x, y, z, 0), diff(pt, x, y, z, 1), diff(pt, x, y, z, 2));
+                    own[index(x, y, z)] = float((1.0 - tau) * s + tau * t);
+                }
+    });
+    std::vector<float> stretch = neighbourhoodMax(own, n);
+    for (float& g : stretch) g = std::max(1.0f, 1.25f * g);
+    return stretch;
+}
+
+} // namespace volmorph::detail

@@ -1,0 +1,89 @@
+#include "blend/DensityBlend.h"
+
+#include "blend/ColorBlend.h"
+#include "blend/Sample.h"
+
+#include <volmorph/Schedule.h>
+
+#include <openvdb/tools/Interpolation.h>
+#include <openvdb/tools/Prune.h>
+
+namespace volmorph::detail {
+namespace {
+
+/// Fills one output leaf pair with the blended density and colour.
+template <typename Sampler>
+struct Resampler {
+    const VolumeSet& source;
+    const VolumeSet& target;
+    float tauDensity, tauColor;
+    Vec3f background;
+
+    /// Returns false when the leaf holds nothing.
+    bool operator()(const WarpLeaf& w, OutputLeaves::ValueLeaf& value,
+                    OutputLeaves::ColorLeaf& color) const
+    {
+        auto ds = source.density->getConstAccessor();
+        auto dt = target.density->getConstAccessor();
+        ColorBlend<Sampler> blend(source, target, tauColor, background);
+        bool any = false;
+        for (openvdb::Index n = 0; n < 512; ++n) {
+            const openvdb::Vec3R ps(w.source(n)), pt(w.target(n));
+            const float a = sample<Sampler>(ds, ps);
+            const float b = sample<Sampler>(dt, pt);
+            const float d = (1.0f - tauDensity) * a + tauDensity * b;
+            if (!(d > kEmpty)) continue;
+            value.setValueOn(n, d);
+            any = true;
+            color.setValueOn(n, blend(ps, pt, a, b));
+        }
+        return any;
+    }
+};
+
+template <typename Sampler>
+class DensityBlend final : public BlendMethod {
+public:
+    explicit DensityBlend(const BlendSetup& setup)
+        : mSource(setup.source), mTarget(setup.target), mSpec(setup.spec)
+    {
+    }
+
+    BlendedFrame frame(const BlendRequest& r, OutputLeaves& leaves) const override
+    {
+        const float tauD = float(scheduleValue(mSpec.density, r.t));
+        const float tauC = float(scheduleValue(mSpec.color, r.t));
+        const Resampler<Sampler> resample{mSource, mTarget, tauD, tauC, leaves.background()};
+        BlendedFrame out;
+        r.adaptive->forEachLeaf(
+            r.box, r.sourceBlocks, r.targetBlocks,
+            [&](const WarpLeaf& w) {
+                auto [density, color] = leaves.make(w.origin, 0.0f);
+                if (resample(w, *density, *color))
+                    leaves.keep(std::move(density), std::move(color));
+            },
+            &out.warp, r.interrupter);
+        out.grids.density = openvdb::FloatGrid::create(0.0f);
+        out.grids.color = openvdb::Vec3SGrid::create(leaves.background());
+        out.keptLeaves = leaves.size();
+        leaves.moveInto(out.grids.density->tree(), out.grids.color->tree(), 0.0f);
+        // Leaves of constant interior collapse into tiles.
+        openvdb::tools::prune(out.grids.density->tree());
+        return out;
+    }
+
+private:
+    VolumeSet mSource, mTarget; // the grids are shared, not copied
+    BlendSpec mSpec;
+};
+
+} // namespace
+
+std::unique_ptr<const BlendMethod> makeDensityBlend(const BlendSetup& setup)
+{
+    if (setup.interpolation == Interpolation::Triquadratic)
+        return std::make_unique<DensityBlend<openvdb::tools::QuadraticSampler>>(setup);
+    return std::make_unique<DensityBlend<openvdb::tools::BoxSampler>>(setup);
+}
+
+} // namespace volmorph::detail

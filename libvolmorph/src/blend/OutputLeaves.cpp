@@ -1,0 +1,64 @@
+#include "blend/OutputLeaves.h"
+
+#include <volmorph/core/Diagnostics.h>
+
+#include <algorithm>
+#include <cstdio>
+
+namespace volmorph::detail {
+
+OutputLeaves::OutputLeaves(double t, uint64_t limitBytes, uint64_t bytesPerLeaf, Vec3f background)
+    : mT(t), mLimit(limitBytes),
+      mMaxLeaves(size_t(std::max<uint64_t>(1, limitBytes / bytesPerLeaf))), mBackground(background)
+{
+}
+
+OutputLeaves::~OutputLeaves()
+{
+    for (auto& [value, color] : mLeaves) {
+        delete value;
+        delete color;
+    }
+}
+
+std::pair<std::unique_ptr<OutputLeaves::ValueLeaf>, std::unique_ptr<OutputLeaves::ColorLeaf>>
+OutputLeaves::make(const openvdb::Coord& origin, float value) const
+{
+    return {std::make_unique<ValueLeaf>(origin, value, false),
+            std::make_unique<ColorLeaf>(origin, mBackground, false)};
+}
+
+void OutputLeaves::keep(std::unique_ptr<ValueLeaf> value, std::unique_ptr<ColorLeaf> color)
+{
+    std::lock_guard<std::mutex> lock(mMutex);
+    if (mLeaves.size() >= mMaxLeaves) {
+        char text[300];
+        std::snprintf(text, sizeof text,
+                      "the in-between at t = %.4f needs more than the memory limit of %.1f GiB "
+                      "(over %zu blocks of 8^3 voxels); use a larger voxel size, check the "
+                      "feature pairs' scales, or raise --memory-limit (default: half the "
+                      "machine's memory)",
+                      mT, double(mLimit) / double(1ull << 30), mMaxLeaves);
+        throw UserError(SourceLocation{"morph"}, text);
+    }
+    mLeaves.emplace_back(value.release(), color.release());
+}
+
+void OutputLeaves::insideTile(const openvdb::Coord& origin)
+{
+    std::lock_guard<std::mutex> lock(mMutex);
+    mInside.push_back(origin);
+}
+
+void OutputLeaves::moveInto(openvdb::FloatTree& values, openvdb::Vec3STree& colors,
+                            float insideValue)
+{
+    for (auto& [value, color] : mLeaves) {
+        values.addLeaf(value);
+        colors.addLeaf(color);
+    }
+    mLeaves.clear();
+    for (const openvdb::Coord& origin : mInside) values.addTile(1, origin, insideValue, false);
+}
+
+} // namespace volmorph::detail

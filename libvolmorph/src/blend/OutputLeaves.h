@@ -1,0 +1,54 @@
+// The output leaves of one frame, collected from the warp's threads, under the memory guard: a
+// warp that blows the shape up (a pair scaling by 100, say) would otherwise fill the machine's
+// memory leaf by leaf.
+#pragma once
+
+#include <volmorph/core/Math.h>
+
+#include <openvdb/openvdb.h>
+
+#include <memory>
+#include <mutex>
+#include <utility>
+#include <vector>
+
+namespace volmorph::detail {
+
+class OutputLeaves {
+public:
+    using ValueLeaf = openvdb::FloatTree::LeafNodeType;
+    using ColorLeaf = openvdb::Vec3STree::LeafNodeType;
+
+    /// t: the frame's, for the message; at most `limitBytes / bytesPerLeaf` leaves are kept;
+    /// colour leaves start at `background`.
+    OutputLeaves(double t, uint64_t limitBytes, uint64_t bytesPerLeaf, Vec3f background);
+    ~OutputLeaves();
+    OutputLeaves(const OutputLeaves&) = delete;
+    OutputLeaves& operator=(const OutputLeaves&) = delete;
+
+    /// A value leaf (background `value`, inactive) and a colour leaf at `origin`.
+    std::pair<std::unique_ptr<ValueLeaf>, std::unique_ptr<ColorLeaf>>
+    make(const openvdb::Coord& origin, float value) const;
+
+    /// Keeps both; throws UserError past the memory limit.
+    void keep(std::unique_ptr<ValueLeaf> value, std::unique_ptr<ColorLeaf> color);
+    /// A leaf-sized tile inside the object (sdf mode).
+    void insideTile(const openvdb::Coord& origin);
+
+    size_t size() const { return mLeaves.size(); }
+    const Vec3f& background() const { return mBackground; }
+
+    /// Moves the leaves into the two trees; inside tiles (leaf-sized) get `insideValue`.
+    void moveInto(openvdb::FloatTree& values, openvdb::Vec3STree& colors, float insideValue);
+
+private:
+    double mT;
+    uint64_t mLimit;
+    size_t mMaxLeaves;
+    Vec3f mBackground;
+    std::mutex mMutex;
+    std::vector<std::pair<ValueLeaf*, ColorLeaf*>> mLeaves;
+    std::vector<openvdb::Coord> mInside;
+};
+
+} // namespace volmorph::detail

@@ -1,0 +1,194 @@
+#include "blend/SdfBlend.h"
+
+#include "blend/ExtendedDistance.h"
+#include "blend/IdentityDistances.h"
+#include "blend/Islands.h"
+#include "blend/Redistance.h"
+#include "blend/SdfFrame.h"
+
+#include <volmorph/core/Interrupter.h>
+#include <volmorph/Schedule.h>
+
+#include <openvdb/tools/Interpolation.h>
+
+#include <tbb/parallel_invoke.h>
+
+#include <stdexcept>
+
+namespace volmorph::detail {
+namespace {
+
+/// The box both distance fields are extended over: the objects' box and a margin for warped points
+/// that leave it, an eighth of its size, at least 8 voxels. With no pairs the points are the
+/// output's voxels: the blend's zero set lies within the objects' box (the band's active voxels),
+/// and 8 voxels more hold its compute band. Beyond the box a read takes the nearest face's value,
+/// which underestimates a distance outside: leaves there are judged, if anything, too near
+/// (4 voxels: 15% more leaves evaluated, for a setup hardly cheaper).
+CoordBBox extensionBox(const VolumeSet& source, const VolumeSet& target, size_t pairCount)
+{
+    CoordBBox box = source.sdf->evalActiveVoxelBoundingBox();
+    box.expand(target.sdf->evalActiveVoxelBoundingBox());
+    if (box.empty()) return box;
+    const Coord dim = box.dim();
+    const int margin = pairCount == 0 ? 8 : std::max(8, std::max({dim.x(), dim.y(), dim.z()}) / 8);
+    box.expand(margin);
+    return box;
+}
+
+template <typename Sampler>
+class SdfBlend final : public BlendMethod {
+public:
+    explicit SdfBlend(const BlendSetup& setup)
+        : mSource(setup.source), mTarget(setup.target), mSpec(setup.spec)
+    {
+        if (!mSource.sdf || !mTarget.sdf)
+            throw std::invalid_argument("Morpher: sdf blending needs sdf grids on both sides");
+        const CoordBBox box = extensionBox(mSource, mTarget, setup.pairCount);
+        // Both at once: fast sweeping is partly serial.
+        tbb::parallel_invoke(
+            [&] { mFarSource = std::make_unique<const ExtendedDistance>(mSource.sdf, box); },
+            [&] { mFarTarget = std::make_unique<const ExtendedDistance>(mTarget.sdf, box); });
+        if (setup.pairCount == 0)
+            mIdentity = std::make_unique<IdentityDistances>(
+                setup.candidates,
+                size_t(setup.memoryLimitBytes / 4 / sizeof(IdentityDistances::Leaf)));
+    }
+
+    BlendedFrame frame(const BlendRequest& r, OutputLeaves& leaves) const override
+    {
+        const float tauC = float(scheduleValue(mSpec.color, r.t));
+        const float tauS = float(scheduleValue(mSpec.sdf, r.t));
+        SdfFrame<Sampler> blend(mSource, mTarget, *mFarSource, *mFarTarget, *r.warp, tauS, tauC,
+                                leaves.background(), r.toleranceVoxels);
+        // With no pairs (and pruning), distances are read from those kept across frames.
+        IdentityDistances* const kept =
+            r.prune && r.warp->pairCount() == 0 ? mIdentity.get() : nullptr;
+        blend.classify(r.box, r.prune, kept);
+        BlendedFrame out;
+        const std::vector<Coord> evaluate = sortLeaves(blend.classes(), kept != nullptr, leaves);
+        if (kept) {
+            fromKeptDistances(blend, *kept, evaluate, leaves, r.interrupter);
+            out.warp.leaves = evaluate.size();
+        } else {
+            throughWarp(blend, r, leaves, out.warp);
+        }
+        assemble(blend, leaves, out);
+        return out;
+    }
+
+private:
+    /// Leaves inside as a whole become inside tiles. With kept distances, returns the leaves to
+    /// evaluate (the warp's traversal finds them itself otherwise).
+    static std::vector<Coord> sortLeaves(const BlockClasses& classes, bool listThem,
+                                         OutputLeaves& leaves)
+    {
+        std::vector<Coord> evaluate;
+        for (int x = classes.leaves.min().x(); x <= classes.leaves.max().x(); ++x)
+            for (int y = classes.leaves.min().y(); y <= classes.leaves.max().y(); ++y)
+                for (int z = classes.leaves.min().z(); z <= classes.leaves.max().z(); ++z) {
+                    const int8_t kind = classes.at(Coord(x, y, z));
+                    if (kind < 0)
+                        leaves.insideTile(Coord(x * 8, y * 8, z * 8));
+                    else if (kind == 0 && listThem)
+                        evaluate.emplace_back(x * 8, y * 8, z * 8);
+                }
+        return evaluate;
+    }
+
+    /// Keeps a filled leaf, or makes it an inside tile, or drops it (outside).
+    static void settle(int whole, const Coord& origin,
+                       std::unique_ptr<OutputLeaves::ValueLeaf> value,
+                       std::unique_ptr<OutputLeaves::ColorLeaf> color, OutputLeaves& leaves)
+    {
+        if (whole == 0)
+            leaves.keep(std::move(value), std::move(color));
+        else if (whole < 0)
+            leaves.insideTile(origin);
+    }
+
+    /// The leaves `evaluate`, from the distances kept across frames (no pairs).
+    void fromKeptDistances(const SdfFrame<Sampler>& blend, IdentityDistances& kept,
+                           const std::vector<Coord>& evaluate, OutputLeaves& leaves,
+                           Interrupter* interrupter) const
+    {
+        const float band = blend.computeBand();
+        std::atomic<bool> stopped{false};
+        tbb::parallel_for(
+            tbb::blocked_range<size_t>(0, evaluate.size(), 8),
+            [&](const tbb::blocked_range<size_t>& r) {
+                if (stopped || (interrupter && interrupter->wasInterrupted(
+                                                   int(100 * r.begin() / evaluate.size())))) {
+                    stopped = true;
+                    return;
+                }
+                typename ExtendedDistance::template Reader<Sampler> a(*mFarSource), b(*mFarTarget);
+                auto scratch = std::make_unique<IdentityDistances::Leaf>();
+                uint64_t computed = 0;
+                for (size_t i = r.begin(); i != r.end(); ++i) {
+                    const auto& distances =
+                        kept.get<Sampler>(evaluate[i], a, b, *scratch, computed);
+                    auto [value, color] = leaves.make(evaluate[i], band);
+                    const int whole = blend(evaluate[i], distances, *value, *color);
+                    settle(whole, evaluate[i], std::move(value), std::move(color), leaves);
+                }
+                blend.addSamples(computed);
+            });
+        if (stopped) throw Interrupted();
+    }
+
+    /// The leaves the warp's traversal visits (those the classes want, when pruning).
+    void throughWarp(const SdfFrame<Sampler>& blend, const BlendRequest& r, OutputLeaves& leaves,
+                     AdaptiveWarpStats& stats) const
+    {
+        const float band = blend.computeBand();
+        const BlockClasses& classes = blend.classes();
+        const AdaptiveWarp::CellFilter wanted = [&classes](const CoordBBox& cells) {
+            return classes.anyToEvaluate(cells);
+        };
+        r.adaptive->forEachLeaf(
+            r.box, nullptr, nullptr,
+            [&](const WarpLeaf& w) {
+                auto [value, color] = leaves.make(w.origin, band);
+                const int whole = blend(w, *value, *color);
+                settle(whole, w.origin, std::move(value), std::move(color), leaves);
+            },
+            &stats, r.interrupter, r.prune ? &wanted : nullptr);
+    }
+
+    /// The grids from the leaves: tiles and the background take the output band's values at once
+    /// (+/- its width); the leaves' values beyond the compute band are rewritten by redistance().
+    void assemble(const SdfFrame<Sampler>& blend, OutputLeaves& leaves, BlendedFrame& out) const
+    {
+        openvdb::FloatGrid::Ptr values = openvdb::FloatGrid::create(blend.width());
+        values->setTransform(mSource.density->transform().copy());
+        values->setGridClass(openvdb::GRID_LEVEL_SET);
+        out.grids.color = openvdb::Vec3SGrid::create(leaves.background());
+        out.keptLeaves = leaves.size();
+        leaves.moveInto(values->tree(), out.grids.color->tree(), -blend.width());
+        dropIslands(*values, mSpec.minIslandVoxels, blend.computeBand(), blend.deepVoxels());
+        const float voxel = float(mSource.voxelSize());
+        RedistanceBands bands{voxel, blend.width(),
+                              [&blend](const Coord& origin) { return blend.keepBandAt(origin); }};
+        out.grids.density = redistance(*values, bands, kSdfRampVoxels * voxel);
+        out.grids.sdf = values;
+        out.blendSamples = blend.samples();
+    }
+
+    VolumeSet mSource, mTarget; // the grids are shared, not copied
+    BlendSpec mSpec;
+    std::unique_ptr<const ExtendedDistance> mFarSource, mFarTarget;
+    /// With no pairs: both extended distances at the output voxels, kept per leaf across frames
+    /// (the identity warp does not change with t). Bounded by a quarter of the memory limit.
+    std::unique_ptr<IdentityDistances> mIdentity;
+};
+
+} // namespace
+
+std::unique_ptr<const BlendMethod> makeSdfBlend(const BlendSetup& setup)
+{
+    if (setup.interpolation == Interpolation::Triquadratic)
+        return std::make_unique<SdfBlend<openvdb::tools::QuadraticSampler>>(setup);
+    return std::make_unique<SdfBlend<openvdb::tools::BoxSampler>>(setup);
+}
+
+} // namespace volmorph::detail

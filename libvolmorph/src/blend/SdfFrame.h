@@ -1,0 +1,332 @@
+// One sdf-mode frame: the blend of the two extended distances through their warps, evaluated
+// only in the blocks that can hold its narrow band (BlockClasses.h), with colour on the band.
+// SdfBlend.cpp then removes dust (Islands.h) and rebuilds the band (Redistance.h).
+#pragma once
+
+#include "blend/BlockClasses.h"
+#include "blend/ColorBlend.h"
+#include "blend/ExtendedDistance.h"
+#include "blend/IdentityDistances.h"
+#include "warp/AdaptiveWarp.h"
+
+#include <volmorph/Voxelize.h>
+#include <volmorph/Warp.h>
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+#include <atomic>
+#include <cmath>
+#include <vector>
+
+namespace volmorph::detail {
+
+/// sdf mode: the fog rises from 0 to 1 across this many voxels around the surface.
+inline constexpr float kSdfRampVoxels = 1.5f;
+
+inline constexpr float kSqrt3 = 1.7320508f;
+/// The farthest a voxel of a 2^3 block can be from the mean of the block's voxels under a map
+/// with Lipschitz constant 1: (3 + 3 sqrt(2) + sqrt(3)) / 8 voxels (a sum over the others).
+inline constexpr float kBlockReach = 1.1222f;
+
+template <typename Sampler>
+class SdfFrame {
+public:
+    using ValueLeaf = openvdb::FloatTree::LeafNodeType;
+    using ColorLeaf = openvdb::Vec3STree::LeafNodeType;
+
+    SdfFrame(const VolumeSet& source, const VolumeSet& target, const ExtendedDistance& farSource,
+             const ExtendedDistance& farTarget, const InverseWarp& warp, float tauSdf,
+             float tauColor, Vec3f background, double toleranceVoxels)
+        : mSource(source), mTarget(target), mFarSource(farSource), mFarTarget(farTarget),
+          mWarp(warp), mTau(tauSdf), mTauColor(tauColor), mBackground(background),
+          mVoxel(float(source.voxelSize())),
+          mWidth(std::min(source.sdf->background(), target.sdf->background()) / mVoxel),
+          // The extended fields' slack, and the approximated warp's error: leaves are judged with
+          // the exact warp at their centres, their voxels evaluated with the approximated one
+          // (with no pairs both are the identity, exactly).
+          mSlack(std::max(farSource.transitionError(), farTarget.transitionError()) + 0.5f +
+                 (warp.pairCount() > 0 ? float(toleranceVoxels) : 0.0f))
+    {
+    }
+
+    /// Classifies the leaves of `box`. With `prune` false every leaf is evaluated (the reference).
+    /// `identity`: with no pairs, the distances kept across frames (for the leaves' centres).
+    void classify(const CoordBBox& box, bool prune, IdentityDistances* identity = nullptr)
+    {
+        BlockClasses& c = mClasses;
+        c.leaves = box >> size_t(3);
+        const Coord n = c.leaves.dim();
+        const size_t count = size_t(n.x()) * n.y() * n.z();
+        std::vector<Vec3d> ps, pt; // the warped centres (with pairs)
+        const std::vector<float> blend =
+            identity ? keptCentreBlends(box, *identity) : centreBlends(ps, pt);
+        // The warp's stretch per leaf; the identity's is 1 exactly.
+        std::vector<float> stretch =
+            mWarp.pairCount() > 0 ? leafStretch(ps, pt, n, mTau) : std::vector<float>(count, 1.0f);
+        c.maxStretch = *std::max_element(stretch.begin(), stretch.end());
+        // Values are computed within the compute band of each leaf: the band and one voxel more,
+        // so that every band voxel's neighbours are known. A voxel of leaf L is in the band that
+        // is kept when its value is within G_L width voxels of zero (G_L the leaf's stretch), and
+        // its neighbours, in L or a face neighbour L', are then within G_L (width + 1) voxels, so
+        // each leaf's compute band is (width + 1) voxels times the largest G of the leaf and its
+        // 26 neighbours. (One band for the whole box, from the largest G anywhere, costs some two
+        // times the samples where the warp stretches only some leaves.) A leaf can be skipped
+        // when its centre is farther than its corners' reach plus that, plus a voxel for the
+        // extended fields' transition.
+        c.band = neighbourhoodMax(stretch, n);
+        for (float& g : c.band) g *= (mWidth + 1.0f) * mVoxel;
+        mComputeBand = float(c.maxStretch) * (mWidth + 1.0f) * mVoxel;
+        c.kind.assign(count, 0);
+        c.stretch = std::move(stretch);
+        mPrune = prune;
+        if (!prune) return;
+        for (size_t i = 0; i < count; ++i)
+            if (!(std::abs(blend[i]) < limit(c.stretch[i], 3.5f * kSqrt3, c.band[i])))
+                c.kind[i] = blend[i] < 0.0f ? -1 : 1;
+    }
+
+    /// Beyond this blend (world units) at a point, no voxel within `reach` voxels of it is in the
+    /// compute band `band` (of the leaf that holds them): G reach, plus the slack of the extended
+    /// fields' transition (where they pass from the band to the coarse field, they may change by
+    /// up to the coarse error more than a distance does).
+    float limit(float stretch, float reach, float band) const
+    {
+        return (stretch * reach + mSlack) * mVoxel + band;
+    }
+
+    const BlockClasses& classes() const { return mClasses; }
+    /// The widest compute band of the box (world units): beyond it, a value is outside every one.
+    float computeBand() const { return mComputeBand; }
+    /// The output band's half width, world units.
+    float width() const { return mWidth * mVoxel; }
+    uint64_t samples() const { return mSamples + mClasses.kind.size(); }
+    /// Inactive values lie at least this many voxels from the zero set (compute band / G).
+    int deepVoxels() const { return int(mWidth + 1.0f); }
+
+    /// What a leaf's voxels turned out to be.
+    struct Seen {
+        bool on = false, inside = false, outside = false;
+        /// -1 when every value is inside and none active, +1 when every value is outside and
+        /// none active, 0 otherwise (keep the leaf).
+        int whole() const
+        {
+            return on ? 0 : (inside && !outside ? -1 : (outside && !inside ? 1 : 0));
+        }
+    };
+
+    /// The leaf's bands (world units): its compute band, and the band that is kept.
+    struct Bands {
+        float compute, keep;
+    };
+    Bands bandsAt(const Coord& origin) const
+    {
+        const size_t i = mClasses.index(origin >> size_t(3));
+        return {mClasses.band[i], mClasses.stretch[i] * mWidth * mVoxel};
+    }
+
+    /// Blends voxel n from its two distances: active within the compute band, +/- the band
+    /// (inactive) beyond it; its colour, colorAt(), within the band that is kept.
+    template <typename ColorAt>
+    void blendVoxel(openvdb::Index n, float da, float db, const Bands& bands, ValueLeaf& value,
+                    ColorLeaf& color, Seen& seen, const ColorAt& colorAt) const
+    {
+        const float d = (1.0f - mTau) * da + mTau * db;
+        seen.inside = seen.inside || d < 0.0f;
+        seen.outside = seen.outside || !(d < 0.0f);
+        if (!(std::abs(d) < bands.compute)) {
+            value.setValueOff(n, d < 0.0f ? -bands.compute : bands.compute);
+            return;
+        }
+        value.setValueOn(n, d);
+        seen.on = true;
+        if (std::abs(d) < bands.keep) color.setValueOn(n, colorAt());
+    }
+
+    /// Fills one leaf: the blend within the compute band (active), +/- the compute band beyond
+    /// (inactive); colour where the band may be. Returns -1 when every value is inside and none
+    /// active, +1 when every value is outside and none active, 0 otherwise (keep the leaf).
+    int operator()(const WarpLeaf& w, ValueLeaf& value, ColorLeaf& color) const
+    {
+        LeafFill fill(*this, w, value, color);
+        for (int q = 0; q < 8; ++q)
+            fill.quarter((q & 1) * 4, ((q >> 1) & 1) * 4, ((q >> 2) & 1) * 4);
+        mSamples += fill.samples;
+        return fill.seen.whole();
+    }
+
+    /// Fills one leaf as operator() does, from the two distances at its voxels (the identity
+    /// warp's points, cached across frames). Every voxel is blended: from distances at hand that is
+    /// cheaper than judging quarters and blocks, and gives the same leaf (what those judgements
+    /// skip is beyond the compute band, with their sign).
+    int operator()(const Coord& origin, const IdentityDistances::Leaf& distances, ValueLeaf& value,
+                   ColorLeaf& color) const
+    {
+        ColorBlend<Sampler> colors(mSource, mTarget, mTauColor, mBackground);
+        const float ramp = kSdfRampVoxels * mVoxel;
+        Seen seen;
+        const Bands bands = bandsAt(origin);
+        for (openvdb::Index n = 0; n < 512; ++n) {
+            const float da = distances.source[n], db = distances.target[n];
+            blendVoxel(n, da, db, bands, value, color, seen, [&] {
+                return colors.atVoxel(origin + value.offsetToLocalCoord(n), fogRamp(da, ramp),
+                                      fogRamp(db, ramp));
+            });
+        }
+        return seen.whole();
+    }
+
+    void addSamples(uint64_t n) const { mSamples += n; }
+
+    /// The kept band (world units) of the leaf at `origin`, or the widest one outside the box.
+    float keepBandAt(const Coord& origin) const
+    {
+        return mClasses.leaves.isInside(origin >> size_t(3)) ? bandsAt(origin).keep
+                                                             : float(mClasses.maxStretch) * width();
+    }
+
+private:
+    /// One leaf's fill through the warp. Each 4^3 quarter of the leaf is first judged by its
+    /// voxel (2, 2, 2), at most 2 sqrt(3) voxels from the others, then each of its 2^3 blocks by
+    /// the blend at the mean of its voxels' warped points: voxel v is within
+    /// sum_u |p(v) - p(u)| / 8 <= G (3 + 3 sqrt(2) + sqrt(3)) / 8 of that mean. Beyond the limit
+    /// a quarter or block is inside or outside as a whole. The rest is blended voxel by voxel.
+    class LeafFill {
+    public:
+        LeafFill(const SdfFrame& f, const WarpLeaf& w, ValueLeaf& value, ColorLeaf& color)
+            : mF(f), mW(w), mValue(value), mColor(color), mA(f.mFarSource), mB(f.mFarTarget),
+              mColors(f.mSource, f.mTarget, f.mTauColor, f.mBackground),
+              // Each side's colour weight is its fog at the warped point, derived from its
+              // distance with the output's ramp: what "empty there" means for a surface.
+              mRamp(kSdfRampVoxels * f.mVoxel), mBands(f.bandsAt(w.origin))
+        {
+            const float stretch = f.mClasses.stretch[f.mClasses.index(w.origin >> size_t(3))];
+            mQuarterLimit = f.limit(stretch, 2.0f * kSqrt3, mBands.compute);
+            mBlockLimit = f.limit(stretch, kBlockReach, mBands.compute);
+        }
+
+        void quarter(int qx, int qy, int qz)
+        {
+            if (mF.mPrune) {
+                const openvdb::Index c = ((qx + 2) * 8 + qy + 2) * 8 + qz + 2;
+                const float d = blendAt(mW.source(c), mW.target(c));
+                if (!(std::abs(d) < mQuarterLimit)) return constant(qx, qy, qz, 4, d);
+            }
+            for (int bq = 0; bq < 8; ++bq)
+                block(qx + (bq & 1) * 2, qy + ((bq >> 1) & 1) * 2, qz + ((bq >> 2) & 1) * 2);
+        }
+
+        Seen seen;
+        uint64_t samples = 0;
+
+    private:
+        void block(int bx, int by, int bz)
+        {
+            if (mF.mPrune) {
+                Vec3f ms(0.0f), mt(0.0f);
+                for (int v = 0; v < 8; ++v) {
+                    const openvdb::Index n = openvdb::Index(
+                        ((bx + (v & 1)) * 8 + by + ((v >> 1) & 1)) * 8 + bz + (v >> 2));
+                    ms += mW.source(n);
+                    mt += mW.target(n);
+                }
+                const float d = blendAt(ms * 0.125f, mt * 0.125f);
+                if (!(std::abs(d) < mBlockLimit)) return constant(bx, by, bz, 2, d);
+            }
+            for (int i = bx; i < bx + 2; ++i)
+                for (int j = by; j < by + 2; ++j)
+                    for (int k = bz; k < bz + 2; ++k) {
+                        const openvdb::Index n = openvdb::Index((i * 8 + j) * 8 + k);
+                        const openvdb::Vec3R ps(mW.source(n)), pt(mW.target(n));
+                        const float da = mA(ps), db = mB(pt);
+                        ++samples;
+                        mF.blendVoxel(n, da, db, mBands, mValue, mColor, seen, [&] {
+                            return mColors(ps, pt, fogRamp(da, mRamp), fogRamp(db, mRamp));
+                        });
+                    }
+        }
+
+        /// The blend at one pair of warped points (index space), counted as a sample.
+        float blendAt(const Vec3f& ps, const Vec3f& pt)
+        {
+            ++samples;
+            return (1.0f - mF.mTau) * mA(openvdb::Vec3R(ps)) + mF.mTau * mB(openvdb::Vec3R(pt));
+        }
+
+        /// The cube of `size` voxels at (x0, y0, z0) of the leaf is inside or outside as a whole.
+        void constant(int x0, int y0, int z0, int size, float d)
+        {
+            const float v = d < 0.0f ? -mBands.compute : mBands.compute;
+            for (int i = x0; i < x0 + size; ++i)
+                for (int j = y0; j < y0 + size; ++j)
+                    for (int k = z0; k < z0 + size; ++k)
+                        mValue.setValueOff(openvdb::Index((i * 8 + j) * 8 + k), v);
+            (d < 0.0f ? seen.inside : seen.outside) = true;
+        }
+
+        const SdfFrame& mF;
+        const WarpLeaf& mW;
+        ValueLeaf& mValue;
+        ColorLeaf& mColor;
+        typename ExtendedDistance::template Reader<Sampler> mA, mB;
+        ColorBlend<Sampler> mColors;
+        float mRamp;
+        Bands mBands;
+        float mQuarterLimit = 0.0f, mBlockLimit = 0.0f;
+    };
+
+    /// The blend at the centres of the classified box's leaves through the exact warp, and the
+    /// warped centres (index space) into ps and pt.
+    std::vector<float> centreBlends(std::vector<Vec3d>& ps, std::vector<Vec3d>& pt) const
+    {
+        const BlockClasses& c = mClasses;
+        const Coord n = c.leaves.dim();
+        auto index = [&n](int x, int y, int z) { return (size_t(x) * n.y() + y) * n.z() + z; };
+        const size_t count = size_t(n.x()) * n.y() * n.z();
+        std::vector<float> blend(count);
+        ps.resize(count);
+        pt.resize(count);
+        tbb::parallel_for(tbb::blocked_range<int>(0, n.x()), [&](const tbb::blocked_range<int>& r) {
+            typename ExtendedDistance::template Reader<Sampler> a(mFarSource), b(mFarTarget);
+            for (int x = r.begin(); x != r.end(); ++x)
+                for (int y = 0; y < n.y(); ++y)
+                    for (int z = 0; z < n.z(); ++z) {
+                        const size_t i = index(x, y, z);
+                        const Coord leaf = c.leaves.min().offsetBy(x, y, z);
+                        const Vec3d centre(leaf.x() * 8 + 3.5, leaf.y() * 8 + 3.5,
+                                           leaf.z() * 8 + 3.5);
+                        mWarp.map(centre, ps[i], pt[i]);
+                        blend[i] = (1.0f - mTau) * a(ps[i]) + mTau * b(pt[i]);
+                    }
+        });
+        return blend;
+    }
+
+    /// The same from the distances kept across frames (the identity warp).
+    std::vector<float> keptCentreBlends(const CoordBBox& box, IdentityDistances& identity) const
+    {
+        const auto centres = identity.centres<Sampler>(box, mFarSource, mFarTarget);
+        std::vector<float> blend(centres->source.size());
+        for (size_t i = 0; i < blend.size(); ++i)
+            blend[i] = (1.0f - mTau) * centres->source[i] + mTau * centres->target[i];
+        return blend;
+    }
+
+    const VolumeSet& mSource;
+    const VolumeSet& mTarget;
+    const ExtendedDistance& mFarSource;
+    const ExtendedDistance& mFarTarget;
+    const InverseWarp& mWarp;
+    float mTau, mTauColor;
+    Vec3f mBackground;
+    float mVoxel;              ///< world units
+    float mWidth;              ///< the output band's half width, voxels
+    float mSlack;              ///< voxels
+    float mComputeBand = 0.0f; ///< the widest compute band (world units)
+    bool mPrune = true;
+    BlockClasses mClasses;
+    mutable std::atomic<uint64_t> mSamples{0};
+};
+
+} // namespace volmorph::detail

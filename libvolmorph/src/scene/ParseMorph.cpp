@@ -1,0 +1,128 @@
+// [warp] (weights, tolerance) and [blend] (mode, schedules, dust).
+#include "TableParsers.h"
+
+#include <cmath>
+#include <cstdlib>
+#include <limits>
+
+namespace volmorph::detail {
+namespace {
+
+const std::vector<std::string> kWarpKeys = {"epsilon", "tolerance", "weighting", "a", "b", "p"};
+const std::vector<std::string> kBlendKeys = {"mode", "density", "color", "sdf", "min_island"};
+
+void parseSchedule(Reader& r, const toml::node& node, const std::string& path, ScheduleSpec& s)
+{
+    if (const auto* str = node.as_string()) {
+        const std::string& text = str->get();
+        if (text == "linear")
+            s.kind = ScheduleSpec::Kind::Linear;
+        else if (text == "smoothstep")
+            s.kind = ScheduleSpec::Kind::Smoothstep;
+        else if (text.rfind("sigmoid(", 0) == 0 && text.back() == ')') {
+            const std::string arg = text.substr(8, text.size() - 9);
+            char* end = nullptr;
+            const double k = std::strtod(arg.c_str(), &end);
+            if (arg.empty() || *end != '\0' || !std::isfinite(k) || k <= 0.0 || k > 1000.0)
+                r.error(r.at(node), path + ": sigmoid(k) needs a steepness 0 < k <= 1000, got \"" +
+                                        text + "\"");
+            s.kind = ScheduleSpec::Kind::Sigmoid;
+            s.k = k;
+        } else {
+            r.error(r.at(node), path + ": unknown schedule \"" + text +
+                                    "\"; expected linear, smoothstep, sigmoid(k) or an array "
+                                    "of [t, tau] points");
+        }
+        return;
+    }
+    const toml::array* a = node.as_array();
+    if (!a) {
+        r.error(r.at(node), path +
+                                ": expected a schedule name or an array of [t, tau] points, got " +
+                                typeName(node));
+        return;
+    }
+    std::vector<std::pair<double, double>> points;
+    for (size_t i = 0; i < a->size(); ++i) {
+        const toml::node& p = *a->get(i);
+        const toml::array* pt = p.as_array();
+        const std::string ppath = path + "[" + std::to_string(i) + "]";
+        if (!pt || pt->size() != 2) {
+            r.error(r.at(p), ppath + ": expected a point [t, tau]");
+            return;
+        }
+        const auto t = r.numberIn(*pt->get(0), ppath + " t", 0.0, true, 1.0, "t from 0 to 1");
+        const auto tau = r.numberIn(*pt->get(1), ppath + " tau", 0.0, true, 1.0, "tau from 0 to 1");
+        if (!t || !tau) return;
+        if (!points.empty() && *t <= points.back().first) {
+            r.error(r.at(p), ppath + ": t must increase from point to point");
+            return;
+        }
+        if (!points.empty() && *tau < points.back().second) {
+            r.error(r.at(p), ppath + ": tau must not decrease (a schedule is monotone)");
+            return;
+        }
+        points.emplace_back(*t, *tau);
+    }
+    if (points.size() < 2 || points.front() != std::make_pair(0.0, 0.0) ||
+        points.back() != std::make_pair(1.0, 1.0)) {
+        r.error(r.at(node), path + ": a curve needs at least two points, starting at [0, 0] and "
+                                   "ending at [1, 1]");
+        return;
+    }
+    s.kind = ScheduleSpec::Kind::Curve;
+    s.points = std::move(points);
+}
+
+} // namespace
+
+void parseWarp(Reader& r, const toml::node& node, WarpSpec& w)
+{
+    const toml::table* t = r.table(node, "warp");
+    if (!t) return;
+    r.checkKeys(*t, "warp", kWarpKeys);
+
+    const double big = std::numeric_limits<double>::max();
+    if (const toml::node* n = t->get("epsilon"))
+        if (auto v = r.numberIn(*n, "warp.epsilon", 0.0, true, big, "a length >= 0 in world units"))
+            w.epsilon = *v;
+    if (const toml::node* n = t->get("tolerance"))
+        if (auto v = r.numberIn(*n, "warp.tolerance", 0.0, true, 64.0,
+                                "a tolerance from 0 (exact) to 64 voxels"))
+            w.toleranceVoxels = *v;
+    if (const toml::node* n = t->get("weighting"))
+        if (auto s = r.choice(*n, "warp.weighting", {"inverse-square", "beier-neely"}))
+            w.weighting = *s == "beier-neely" ? Weighting::BeierNeely : Weighting::InverseSquare;
+    if (const toml::node* n = t->get("a"))
+        if (auto v = r.numberIn(*n, "warp.a", 0.0, false, big, "a length > 0 in world units"))
+            w.a = *v;
+    if (const toml::node* n = t->get("b"))
+        if (auto v = r.numberIn(*n, "warp.b", 0.0, true, 16.0, "an exponent from 0 to 16"))
+            w.b = *v;
+    if (const toml::node* n = t->get("p"))
+        if (auto v = r.numberIn(*n, "warp.p", 0.0, true, 1.0, "an exponent from 0 to 1")) w.p = *v;
+    if (w.weighting == Weighting::InverseSquare)
+        for (const char* k : {"a", "b", "p"})
+            if (const toml::node* n = t->get(k))
+                r.error(r.at(*n),
+                        std::string("warp.") + k + ": only used with weighting = \"beier-neely\"");
+}
+
+void parseBlend(Reader& r, const toml::node& node, BlendSpec& b)
+{
+    const toml::table* t = r.table(node, "blend");
+    if (!t) return;
+    r.checkKeys(*t, "blend", kBlendKeys);
+
+    if (const toml::node* n = t->get("mode"))
+        if (auto s = r.choice(*n, "blend.mode", {"density", "sdf"}))
+            b.mode = *s == "sdf" ? BlendMode::Sdf : BlendMode::Density;
+    if (const toml::node* n = t->get("density")) parseSchedule(r, *n, "blend.density", b.density);
+    if (const toml::node* n = t->get("color")) parseSchedule(r, *n, "blend.color", b.color);
+    if (const toml::node* n = t->get("sdf")) parseSchedule(r, *n, "blend.sdf", b.sdf);
+    if (const toml::node* n = t->get("min_island"))
+        if (auto v = r.integerIn(*n, "blend.min_island", 0, 1000000000))
+            b.minIslandVoxels = int(*v);
+}
+
+} // namespace volmorph::detail

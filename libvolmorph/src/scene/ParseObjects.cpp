@@ -1,0 +1,83 @@
+// [source], [target] (mesh, transform, colour) and [volume].
+#include "TableParsers.h"
+
+#include <limits>
+
+namespace volmorph::detail {
+namespace {
+
+const std::vector<std::string> kObjectKeys = {"mesh", "transform", "color"};
+const std::vector<std::string> kTransformKeys = {"translate", "rotate", "scale"};
+const std::vector<std::string> kVolumeKeys = {"voxel_size", "resolution"};
+
+void parseTransform(Reader& r, const toml::node& node, const std::string& path, ObjectTransform& xf)
+{
+    const toml::table* t = r.table(node, path);
+    if (!t) return;
+    r.checkKeys(*t, path, kTransformKeys);
+    if (const toml::node* n = t->get("translate"))
+        if (auto v = r.vec3(*n, path + ".translate")) xf.translate = *v;
+    if (const toml::node* n = t->get("rotate"))
+        if (auto v = r.vec3(*n, path + ".rotate")) xf.rotateRadians = *v * kDegreesToRadians;
+    if (const toml::node* n = t->get("scale")) {
+        if (n->is_array()) {
+            if (auto v = r.positiveVec3(*n, path + ".scale", "a factor")) xf.scale = *v;
+        } else if (auto s = r.numberIn(*n, path + ".scale", 0.0, false,
+                                       std::numeric_limits<double>::max(),
+                                       "a positive factor or an array of 3")) {
+            xf.scale = Vec3d(*s);
+        }
+    }
+}
+
+} // namespace
+
+void parseObject(Reader& r, const toml::node& node, const std::string& path,
+                 const std::filesystem::path& folder, ObjectSpec& object)
+{
+    const toml::table* t = r.table(node, path);
+    if (!t) return;
+    r.checkKeys(*t, path, kObjectKeys);
+    if (const toml::node* n = t->get("mesh")) {
+        if (auto s = r.string(*n, path + ".mesh")) {
+            object.meshWhere = r.at(*n);
+            std::filesystem::path p(*s);
+            object.mesh = p.is_absolute() ? p : folder / p;
+            std::error_code ec;
+            if (s->empty())
+                r.error(r.at(*n), path + ".mesh: expected a file name");
+            else if (!std::filesystem::is_regular_file(object.mesh, ec))
+                r.error(r.at(*n), path + ".mesh: file not found: '" + *s + "' (looked for " +
+                                      object.mesh.string() + ")");
+        }
+    } else {
+        r.missing(node, path + ".mesh", "a mesh file name, relative to the scene file");
+    }
+    if (const toml::node* n = t->get("transform"))
+        parseTransform(r, *n, path + ".transform", object.transform);
+    if (const toml::node* n = t->get("color"))
+        if (auto c = r.nonNegativeVec3(*n, path + ".color")) object.color = *c;
+}
+
+void parseVolume(Reader& r, const toml::node& node, VolumeSpec& volume)
+{
+    const toml::table* t = r.table(node, "volume");
+    if (!t) return;
+    r.checkKeys(*t, "volume", kVolumeKeys);
+    const toml::node* size = t->get("voxel_size");
+    const toml::node* res = t->get("resolution");
+    if (size && res) {
+        r.error(r.at(*res), "volume: give either voxel_size or resolution, not both");
+    } else if (size) {
+        volume.voxelSize =
+            r.numberIn(*size, "volume.voxel_size", 0.0, false, std::numeric_limits<double>::max(),
+                       "a positive length in world units");
+    } else if (res) {
+        if (auto v = r.integerIn(*res, "volume.resolution", 8, 16384)) volume.resolution = int(*v);
+    } else {
+        r.missing(node, "volume.voxel_size",
+                  "a positive length in world units, or resolution in voxels");
+    }
+}
+
+} // namespace volmorph::detail

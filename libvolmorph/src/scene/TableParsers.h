@@ -1,0 +1,32 @@
+// The scene parser's table groups, one unit each (SceneParser.cpp is the root). Each reads its
+// tables into the Scene's settings and reports problems through the Reader, never throwing.
+#pragma once
+
+#include <volmorph/Scene.h>
+
+#include "TomlReader.h"
+
+#include <toml++/toml.h>
+
+#include <filesystem>
+#include <string>
+#include <vector>
+
+namespace volmorph::detail {
+
+inline constexpr double kDegreesToRadians = 3.14159265358979323846 / 180.0;
+
+/// [source] and [target]: mesh (resolved against `folder`), transform, color.
+void parseObject(Reader& r, const toml::node& node, const std::string& path,
+                 const std::filesystem::path& folder, ObjectSpec& object);
+/// [volume]: voxel_size or resolution.
+void parseVolume(Reader& r, const toml::node& node, VolumeSpec& volume);
+/// [[pair]]: appends every pair that is complete.
+void parsePairs(Reader& r, const toml::node& node, std::vector<FeaturePairSpec>& pairs);
+/// [warp] and [blend] (with its schedules).
+void parseWarp(Reader& r, const toml::node& node, WarpSpec& warp);
+void parseBlend(Reader& r, const toml::node& node, BlendSpec& blend);
+/// [render], its camera and lights (with their keys).
+void parseRender(Reader& r, const toml::node& node, RenderSpec& render);
+
+} // namespace volmorph::detail
