@@ -1,5 +1,7 @@
 #include "SceneRender.h"
 
+#include "KeyframeTrack.h"
+
 #include <algorithm>
 #include <cmath>
 
@@ -36,14 +38,14 @@ SceneRender::SceneRender(const Scene& scene, int threads, int width)
 
 render::Camera SceneRender::camera(int frame) const
 {
-    return sceneCamera(mSpec.camera.at(frame), mSpec, mWidth);
+    return sceneCamera(cameraAt(mSpec.camera, frame), mSpec, mWidth);
 }
 
 std::vector<render::Light> SceneRender::lights(int frame) const
 {
     std::vector<render::Light> lights;
     for (const LightSpec& spec : mSpec.lights) {
-        const LightSpec l = spec.at(frame);
+        const LightSpec l = lightAt(spec, frame);
         render::Light light;
         light.type = l.type == LightType::Point ? render::Light::Type::Point
                                                 : render::Light::Type::Directional;

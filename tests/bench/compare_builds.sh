@@ -2,8 +2,8 @@
 # Two builds of volmorph timed side by side, rounds interleaved (old, new, old, new, ...) so that a
 # slow spell of a shared machine hits both alike: the render of render_vs_vdb_render.sh (the bunny
 # fog at 256 across, 640x360, one sample, shadows; whole commands) with vdb_render in the same
-# rounds as the anchor, and the morph-frame bench (tests/bench/warp_bench.cpp: one frame at t = 0.5
-# at 256 across, sdf and density modes). Prints each series' median, min and max, and the
+# rounds as the anchor, the morph-frame bench (tests/bench/warp_bench.cpp: one frame at t = 0.5
+# at 256 across, sdf and density modes) and the warp bench at 16 pairs (exact and approximated). Prints each series' median, min and max, and the
 # new/old ratio of medians. For a change that must not cost time (a refactoring).
 # usage: tests/bench/compare_builds.sh OLD_BUILD NEW_BUILD [ROUNDS (default 7)]
 #        each BUILD has bin/volmorph and tests/bench/volmorph_bench_warp; needs vdb_render
@@ -38,6 +38,8 @@ for r in $(seq "$rounds"); do
         seconds "$build/bin/volmorph" $vm_args -o "$out/$side.exr" >>"$out/render-$side"
         bench_ms "$build" 'morphFrame/256/' >>"$out/sdf-$side"
         bench_ms "$build" 'morphFrameDensity/256/' >>"$out/density-$side"
+        bench_ms "$build" '^exactWarp/16$' >>"$out/exact16-$side"
+        bench_ms "$build" '^approximatedWarp/16$' >>"$out/approx16-$side"
     done
     # shellcheck disable=SC2086
     seconds vdb_render "$out/bunny.vdb" "$out/vdb.exr" $vdb_args >>"$out/render-vdb_render"
@@ -51,7 +53,7 @@ else
 fi
 stats() { sort -g "$1" | awk '{a[NR]=$1} END {printf "median %.4g  min %.4g  max %.4g  (n=%d)", a[int((NR+1)/2)], a[1], a[NR], NR}'; }
 median() { sort -g "$1" | awk '{a[NR]=$1} END {print a[int((NR+1)/2)]}'; }
-for series in render sdf density; do
+for series in render sdf density exact16 approx16; do
     unit=$([ $series = render ] && echo s || echo ms)
     echo "$series ($unit): old $(stats "$out/$series-old")"
     echo "$series ($unit): new $(stats "$out/$series-new")"

@@ -115,11 +115,8 @@ struct CameraSpec {
     Vec3d up{0.0, 1.0, 0.0};
     double fovDegrees = 40.0;    ///< horizontal, perspective only
     double orthoWidth = 2.0;     ///< world units, orthographic only
-    std::vector<CameraKey> keys; ///< animation, by increasing frame; empty: still
-
-    /// The camera at `frame`: values interpolated linearly between the keys around it (up
-    /// renormalized), held before the first key and after the last.
-    CameraSpec at(int frame) const;
+    std::vector<CameraKey> keys; ///< animation, by increasing frame; empty: still (the CLI's
+                                 ///< KeyframeTrack interpolates them)
 };
 
 enum class LightType { Directional, Point };
@@ -137,11 +134,8 @@ struct LightSpec {
     Vec3d position{0.0, 0.0, 0.0};   ///< point: world units
     Vec3d color{1.0, 1.0, 1.0};
     double intensity = 1.0;
-    std::vector<LightKey> keys; ///< animation, by increasing frame; empty: still
-
-    /// The light at `frame`: values interpolated linearly between the keys around it (direction
-    /// renormalized), held before the first key and after the last.
-    LightSpec at(int frame) const;
+    std::vector<LightKey> keys; ///< animation, by increasing frame; empty: still (the CLI's
+                                ///< KeyframeTrack interpolates them)
 };
 
 struct RenderSpec {

@@ -64,6 +64,18 @@ public:
     virtual BlendedFrame frame(const BlendRequest& request, OutputLeaves& leaves) const = 0;
 };
 
+/// What every method keeps: both sides (their grids shared, not copied) and the blend's settings.
+class TwoSidedBlend : public BlendMethod {
+protected:
+    explicit TwoSidedBlend(const BlendSetup& setup)
+        : mSource(setup.source), mTarget(setup.target), mSpec(setup.spec)
+    {
+    }
+
+    VolumeSet mSource, mTarget;
+    BlendSpec mSpec;
+};
+
 /// The method `setup.spec.mode` names.
 std::unique_ptr<const BlendMethod> makeBlendMethod(const BlendSetup& setup);
 

@@ -2,6 +2,7 @@
 
 #include "blend/ColorBlend.h"
 #include "blend/Sample.h"
+#include "blend/WithSampler.h"
 
 #include <volmorph/Schedule.h>
 
@@ -42,12 +43,9 @@ struct Resampler {
 };
 
 template <typename Sampler>
-class DensityBlend final : public BlendMethod {
+class DensityBlend final : public TwoSidedBlend {
 public:
-    explicit DensityBlend(const BlendSetup& setup)
-        : mSource(setup.source), mTarget(setup.target), mSpec(setup.spec)
-    {
-    }
+    explicit DensityBlend(const BlendSetup& setup) : TwoSidedBlend(setup) {}
 
     BlendedFrame frame(const BlendRequest& r, OutputLeaves& leaves) const override
     {
@@ -71,19 +69,13 @@ public:
         openvdb::tools::prune(out.grids.density->tree());
         return out;
     }
-
-private:
-    VolumeSet mSource, mTarget; // the grids are shared, not copied
-    BlendSpec mSpec;
 };
 
 } // namespace
 
 std::unique_ptr<const BlendMethod> makeDensityBlend(const BlendSetup& setup)
 {
-    if (setup.interpolation == Interpolation::Triquadratic)
-        return std::make_unique<DensityBlend<openvdb::tools::QuadraticSampler>>(setup);
-    return std::make_unique<DensityBlend<openvdb::tools::BoxSampler>>(setup);
+    return withSampler<DensityBlend>(setup);
 }
 
 } // namespace volmorph::detail

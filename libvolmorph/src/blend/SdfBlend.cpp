@@ -5,6 +5,7 @@
 #include "blend/Islands.h"
 #include "blend/Redistance.h"
 #include "blend/SdfFrame.h"
+#include "blend/WithSampler.h"
 
 #include <volmorph/core/Interrupter.h>
 #include <volmorph/Schedule.h>
@@ -36,10 +37,9 @@ CoordBBox extensionBox(const VolumeSet& source, const VolumeSet& target, size_t 
 }
 
 template <typename Sampler>
-class SdfBlend final : public BlendMethod {
+class SdfBlend final : public TwoSidedBlend {
 public:
-    explicit SdfBlend(const BlendSetup& setup)
-        : mSource(setup.source), mTarget(setup.target), mSpec(setup.spec)
+    explicit SdfBlend(const BlendSetup& setup) : TwoSidedBlend(setup)
     {
         if (!mSource.sdf || !mTarget.sdf)
             throw std::invalid_argument("Morpher: sdf blending needs sdf grids on both sides");
@@ -174,8 +174,6 @@ private:
         out.blendSamples = blend.samples();
     }
 
-    VolumeSet mSource, mTarget; // the grids are shared, not copied
-    BlendSpec mSpec;
     std::unique_ptr<const ExtendedDistance> mFarSource, mFarTarget;
     /// With no pairs: both extended distances at the output voxels, kept per leaf across frames
     /// (the identity warp does not change with t). Bounded by a quarter of the memory limit.
@@ -186,9 +184,7 @@ private:
 
 std::unique_ptr<const BlendMethod> makeSdfBlend(const BlendSetup& setup)
 {
-    if (setup.interpolation == Interpolation::Triquadratic)
-        return std::make_unique<SdfBlend<openvdb::tools::QuadraticSampler>>(setup);
-    return std::make_unique<SdfBlend<openvdb::tools::BoxSampler>>(setup);
+    return withSampler<SdfBlend>(setup);
 }
 
 } // namespace volmorph::detail

@@ -130,6 +130,57 @@ struct RawMesh {
     std::string error;                    ///< set when the file could not be read
 };
 
+/// Assimp's reason for refusing a file, kept to one printable line of reasonable length (it may
+/// quote the file).
+std::string assimpError(const Assimp::Importer& importer)
+{
+    std::string why;
+    for (const char c : std::string(importer.GetErrorString())) {
+        if (why.size() >= 160) {
+            why += "...";
+            break;
+        }
+        why += (c >= 32 && c < 127) ? c : ' ';
+    }
+    return "cannot read mesh (" + (why.empty() ? std::string("unknown reason") : why) + ")";
+}
+
+/// Appends one mesh placed by `node`: its vertices (and colours, grey where it has none, when
+/// `anyColors`), its polygons as fans (exact when convex); points and lines are of no use to a
+/// voxelizer. Sets raw.error on a face that names a missing vertex.
+void addMesh(RawMesh& raw, const aiMesh* am, const aiMatrix4x4& node, bool anyColors)
+{
+    const uint32_t base = uint32_t(raw.positions.size() / 3);
+    for (unsigned v = 0; v < am->mNumVertices; ++v) {
+        const aiVector3D& a = am->mVertices[v];
+        // A non-finite input stays non-finite (the transform could hide a NaN behind a 0 scale).
+        const bool finite = std::isfinite(a.x) && std::isfinite(a.y) && std::isfinite(a.z);
+        const aiVector3D w =
+            finite ? node * a : aiVector3D(std::numeric_limits<float>::quiet_NaN());
+        raw.positions.insert(raw.positions.end(), {w.x, w.y, w.z});
+        if (anyColors) {
+            const aiColor4D c =
+                am->HasVertexColors(0) ? am->mColors[0][v] : aiColor4D(0.8f, 0.8f, 0.8f, 1.0f);
+            raw.colors.insert(raw.colors.end(), {c.r, c.g, c.b});
+        }
+    }
+    for (unsigned f = 0; f < am->mNumFaces; ++f) {
+        const aiFace& face = am->mFaces[f];
+        if (face.mNumIndices < 3) continue;
+        bool inRange = true;
+        for (unsigned k = 0; k < face.mNumIndices; ++k)
+            inRange = inRange && face.mIndices[k] < am->mNumVertices;
+        if (!inRange) {
+            raw.error = "face " + std::to_string(f + 1) + " names a vertex that does not exist";
+            return;
+        }
+        for (unsigned k = 1; k + 1 < face.mNumIndices; ++k)
+            raw.triangles.insert(
+                raw.triangles.end(),
+                {base + face.mIndices[0], base + face.mIndices[k], base + face.mIndices[k + 1]});
+    }
+}
+
 /// Reads `file` with Assimp into a RawMesh (in whichever process calls it).
 RawMesh readWithAssimp(const std::filesystem::path& file)
 {
@@ -140,17 +191,7 @@ RawMesh readWithAssimp(const std::filesystem::path& file)
     // found by fuzzing). Node transforms and polygon splitting are done here instead.
     const aiScene* scene = importer.ReadFile(file.string(), aiProcess_ValidateDataStructure);
     if (!scene) {
-        // Assimp's message may quote the file: keep it to one printable line of reasonable length.
-        std::string why;
-        for (const char c : std::string(importer.GetErrorString())) {
-            if (why.size() >= 160) {
-                why += "...";
-                break;
-            }
-            why += (c >= 32 && c < 127) ? c : ' ';
-        }
-        raw.error =
-            "cannot read mesh (" + (why.empty() ? std::string("unknown reason") : why) + ")";
+        raw.error = assimpError(importer);
         return raw;
     }
     if (scene->mFlags & AI_SCENE_FLAGS_INCOMPLETE) {
@@ -160,39 +201,6 @@ RawMesh readWithAssimp(const std::filesystem::path& file)
     bool anyColors = false;
     for (unsigned mi = 0; mi < scene->mNumMeshes; ++mi)
         anyColors = anyColors || scene->mMeshes[mi]->HasVertexColors(0);
-    auto addMesh = [&](const aiMesh* am, const aiMatrix4x4& node) {
-        const uint32_t base = uint32_t(raw.positions.size() / 3);
-        for (unsigned v = 0; v < am->mNumVertices; ++v) {
-            const aiVector3D& a = am->mVertices[v];
-            // A non-finite input stays non-finite (the transform could hide a NaN behind a 0
-            // scale).
-            const bool finite = std::isfinite(a.x) && std::isfinite(a.y) && std::isfinite(a.z);
-            const aiVector3D w =
-                finite ? node * a : aiVector3D(std::numeric_limits<float>::quiet_NaN());
-            raw.positions.insert(raw.positions.end(), {w.x, w.y, w.z});
-            if (anyColors) {
-                const aiColor4D c =
-                    am->HasVertexColors(0) ? am->mColors[0][v] : aiColor4D(0.8f, 0.8f, 0.8f, 1.0f);
-                raw.colors.insert(raw.colors.end(), {c.r, c.g, c.b});
-            }
-        }
-        // Points and lines are of no use to a voxelizer; polygons become fans (exact when convex).
-        for (unsigned f = 0; f < am->mNumFaces; ++f) {
-            const aiFace& face = am->mFaces[f];
-            if (face.mNumIndices < 3) continue;
-            bool inRange = true;
-            for (unsigned k = 0; k < face.mNumIndices; ++k)
-                inRange = inRange && face.mIndices[k] < am->mNumVertices;
-            if (!inRange) {
-                raw.error = "face " + std::to_string(f + 1) + " names a vertex that does not exist";
-                return;
-            }
-            for (unsigned k = 1; k + 1 < face.mNumIndices; ++k)
-                raw.triangles.insert(raw.triangles.end(),
-                                     {base + face.mIndices[0], base + face.mIndices[k],
-                                      base + face.mIndices[k + 1]});
-        }
-    };
     // Every mesh as often as the node hierarchy places it (what PreTransformVertices would do).
     std::vector<std::pair<const aiNode*, aiMatrix4x4>> stack;
     if (scene->mRootNode) stack.emplace_back(scene->mRootNode, scene->mRootNode->mTransformation);
@@ -202,7 +210,7 @@ RawMesh readWithAssimp(const std::filesystem::path& file)
         stack.pop_back();
         for (unsigned i = 0; i < node->mNumMeshes; ++i)
             if (node->mMeshes[i] < scene->mNumMeshes) {
-                addMesh(scene->mMeshes[node->mMeshes[i]], xf);
+                addMesh(raw, scene->mMeshes[node->mMeshes[i]], xf, anyColors);
                 ++placed;
             }
         if (stack.size() + node->mNumChildren > 100000) {
@@ -214,7 +222,7 @@ RawMesh readWithAssimp(const std::filesystem::path& file)
     }
     if (placed == 0 && raw.error.empty()) // no node hierarchy: the meshes as stored
         for (unsigned mi = 0; mi < scene->mNumMeshes; ++mi)
-            addMesh(scene->mMeshes[mi], aiMatrix4x4());
+            addMesh(raw, scene->mMeshes[mi], aiMatrix4x4(), anyColors);
     return raw;
 }
 

@@ -1,4 +1,4 @@
-// Value functions of the scene types; parsing lives in SceneParser.cpp.
+// Value functions of the scene's settings; parsing lives in SceneParser.cpp and its table units.
 #include <volmorph/Scene.h>
 
 #include <algorithm>
@@ -44,73 +44,6 @@ const char* toString(FeatureType type)
         return "box";
     }
     return "?";
-}
-
-namespace {
-
-/// The two keys around `frame` and the weight of the second; the same key twice outside them.
-template <typename Key>
-void around(const std::vector<Key>& keys, int frame, const Key*& a, const Key*& b, double& u)
-{
-    a = b = &keys.front();
-    u = 0.0;
-    if (frame <= keys.front().frame) return;
-    a = b = &keys.back();
-    if (frame >= keys.back().frame) return;
-    for (size_t i = 1; i < keys.size(); ++i) {
-        if (frame <= keys[i].frame) {
-            a = &keys[i - 1];
-            b = &keys[i];
-            u = double(frame - a->frame) / double(b->frame - a->frame);
-            return;
-        }
-    }
-}
-
-Vec3d lerp(const Vec3d& a, const Vec3d& b, double u)
-{
-    return a + (b - a) * u;
-}
-
-/// Linear interpolation of two directions, renormalized (keys may not be opposite: the parser
-/// refuses that).
-Vec3d lerpDirection(const Vec3d& a, const Vec3d& b, double u)
-{
-    const Vec3d d = lerp(a.unit(), b.unit(), u);
-    return d.length() > 1e-12 ? d.unit() : a.unit();
-}
-
-} // namespace
-
-CameraSpec CameraSpec::at(int frame) const
-{
-    CameraSpec c = *this;
-    if (keys.empty()) return c;
-    const CameraKey *a, *b;
-    double u;
-    around(keys, frame, a, b, u);
-    c.eye = lerp(a->eye, b->eye, u);
-    c.lookat = lerp(a->lookat, b->lookat, u);
-    c.up = lerpDirection(a->up, b->up, u);
-    c.fovDegrees = a->fovDegrees + (b->fovDegrees - a->fovDegrees) * u;
-    c.orthoWidth = a->orthoWidth + (b->orthoWidth - a->orthoWidth) * u;
-    c.keys.clear();
-    return c;
-}
-
-LightSpec LightSpec::at(int frame) const
-{
-    LightSpec l = *this;
-    if (keys.empty()) return l;
-    const LightKey *a, *b;
-    double u;
-    around(keys, frame, a, b, u);
-    l.direction = lerpDirection(a->direction, b->direction, u);
-    l.position = lerp(a->position, b->position, u);
-    l.color = lerp(a->color, b->color, u);
-    l.intensity = a->intensity + (b->intensity - a->intensity) * u;
-    l.keys.clear();
-    return l;
 }
 
 double FramesSpec::t(int frame) const

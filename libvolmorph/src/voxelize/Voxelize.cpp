@@ -3,7 +3,8 @@
 // This is one of the few translation units that include OpenVDB's tools headers; keep it so.
 #include <volmorph/Voxelize.h>
 
-#include "WindingNumber.h"
+#include "mesh/Orientation.h"
+#include "mesh/WindingNumber.h"
 
 #include <openvdb/math/Proximity.h>
 #include <openvdb/tools/MeshToVolume.h>
@@ -170,6 +171,44 @@ Vec3SGrid::Ptr colorFromIndex(const Mesh& mesh, const Int32Grid* index, const Fl
     return color;
 }
 
+/// The estimated bytes of voxelizing `input`; a UserError when they pass the memory limit or the
+/// index coordinates (32-bit) come near their limit.
+uint64_t checkBudget(const Mesh& input, const VoxelizeOptions& options, double voxelSize,
+                     float halfWidth, const SourceLocation& where)
+{
+    const auto [lo, hi] = input.bounds();
+    const Vec3d extent = hi - lo;
+    const double cells = std::max({extent.x(), extent.y(), extent.z()}) / voxelSize;
+    const uint64_t limit =
+        options.memoryLimitBytes ? options.memoryLimitBytes : defaultMemoryLimitBytes();
+    const uint64_t estimate = estimateVoxelizeBytes(input, voxelSize, halfWidth);
+    if (cells > 1e6 || estimate > limit) {
+        std::ostringstream s;
+        s << "voxel size " << voxelSize << " world units gives " << std::ceil(cells)
+          << " voxels across the mesh and needs about " << gib(estimate)
+          << ", more than the limit of " << gib(limit)
+          << "; use a larger voxel size (or fewer voxels across), or raise the limit "
+          << "with --memory-limit (default: half the machine's memory)";
+        throw UserError(where, s.str());
+    }
+    return estimate;
+}
+
+/// The sign from the winding number (else OpenVDB's flood fill): asked for, or, by default, for
+/// every mesh but a closed single shell.
+bool usesWindingNumber(const Mesh& input, const VoxelizeOptions& options)
+{
+    switch (options.sign) {
+    case VoxelizeOptions::Sign::FloodFill:
+        return false;
+    case VoxelizeOptions::Sign::WindingNumber:
+        return true;
+    case VoxelizeOptions::Sign::Auto:
+        break;
+    }
+    return !(input.report.watertight() && input.report.components == 1);
+}
+
 } // namespace
 
 /// density = smoothstep of the signed distance across [-ramp, +ramp] (0.5 on the surface), 1 in
@@ -260,36 +299,10 @@ VolumeSet voxelize(const Mesh& input, const VoxelizeOptions& options, Interrupte
                                "may be flat or a single point)");
     const float halfWidth = std::max(3.0f, options.halfWidthVoxels);
 
-    // Index coordinates are 32-bit; stay far from their limit.
-    const auto [lo, hi] = input.bounds();
-    const Vec3d extent = hi - lo;
-    const double cells = std::max({extent.x(), extent.y(), extent.z()}) / voxelSize;
-    const uint64_t limit =
-        options.memoryLimitBytes ? options.memoryLimitBytes : defaultMemoryLimitBytes();
-    const uint64_t estimate = estimateVoxelizeBytes(input, voxelSize, halfWidth);
-    if (cells > 1e6 || estimate > limit) {
-        std::ostringstream s;
-        s << "voxel size " << voxelSize << " world units gives " << std::ceil(cells)
-          << " voxels across the mesh and needs about " << gib(estimate)
-          << ", more than the limit of " << gib(limit)
-          << "; use a larger voxel size (or fewer voxels across), or raise the limit "
-          << "with --memory-limit (default: half the machine's memory)";
-        throw UserError(where, s.str());
-    }
+    const uint64_t estimate = checkBudget(input, options, voxelSize, halfWidth, where);
 
     if (interrupter) interrupter->start("voxelize");
-    bool useWinding = false;
-    switch (options.sign) {
-    case VoxelizeOptions::Sign::FloodFill:
-        useWinding = false;
-        break;
-    case VoxelizeOptions::Sign::WindingNumber:
-        useWinding = true;
-        break;
-    case VoxelizeOptions::Sign::Auto:
-        useWinding = !(input.report.watertight() && input.report.components == 1);
-        break;
-    }
+    const bool useWinding = usesWindingNumber(input, options);
     Mesh repaired;
     if (useWinding) {
         repaired = input;

@@ -56,9 +56,11 @@
 //    coordinates and residuals walked the same way, affine in the voxel; its rows' square roots
 //    and divisions independent, so they overlap), then the points, in single precision as they
 //    are stored (with no near pair, a third of the leaves, the rows' sums go straight into the
-//    points, unstored: the same operations and bits, 2% less time). Each of these is compiled
+//    points, unstored: the same operations and bits). Each of these is compiled
 //    for AVX2, for AVX2 with AVX-512VL (32 vector registers) and for the baseline and picked by
-//    the CPU, with the same bits from all (no FMA contraction in this file).
+//    the CPU, with the same bits from all (no FMA contraction in their units). The code is in
+//    src/warp/adaptive/: PairColumns, ErrorBound (3), DomainTest (4), LeafKernel and LatticeSums
+//    (5), and AdaptiveWarp.cpp, the traversal (1-4 in order). Measurements: BENCHMARKS.md.
 //
 // Lerios et al. (1995) interpolated the warp over an adaptive grid checked at the next finer
 // lattice; here no sample decides the error, and the exact warp is evaluated at about one point
@@ -113,18 +115,26 @@ struct AdaptiveWarpStats {
 /// The builds of the leaf kernel, the bound and the lattice's sums, least capable first: the
 /// baseline, AVX2, and AVX2 with AVX-512VL (its 32 vector registers). All give the same bits.
 enum class KernelBuild { Baseline, Avx2, Avx512 };
-/// The most capable build the CPU has runs, at most `limit` (process-wide; for tests that compare
-/// the builds; Avx512, the default, means no limit).
-void useKernelBuild(KernelBuild limit);
-/// The build that runs now.
-KernelBuild activeKernelBuild();
+/// The most capable build this CPU has.
+KernelBuild bestKernelBuild();
+
+// The implementation's types (src/warp/adaptive/).
+struct LatticePoint;
+struct Lattice;
+struct WarpColumns;
+struct WarpContext;
 
 class AdaptiveWarp {
 public:
     /// `warp` must map output index space to source and target index space (built with unit
-    /// 1 / voxel size). Tolerance 0 means exact: every voxel is evaluated.
-    AdaptiveWarp(const InverseWarp& warp, double toleranceVoxels);
+    /// 1 / voxel size). Tolerance 0 means exact: every voxel is evaluated. The kernels run in the
+    /// most capable build the CPU has, at most `limit` (tests compare the builds with it).
+    AdaptiveWarp(const InverseWarp& warp, double toleranceVoxels,
+                 KernelBuild limit = KernelBuild::Avx512);
     ~AdaptiveWarp();
+
+    /// The build the kernels run in.
+    KernelBuild kernelBuild() const { return mBuild; }
 
     using LeafFunction = std::function<void(const WarpLeaf&)>;
     /// "Is any leaf of this cell (output index space) wanted?"; cells answered no are skipped
@@ -145,44 +155,51 @@ public:
     static constexpr int kTopCell = 64;
 
 private:
-    struct Columns;
-    struct Context;
-    struct LatticePoint;
-    struct Lattice;
-    /// The bound's terms for the cube of `size` (4, 8 or 16) voxels at origin, from the exact
+    /// One forEachLeaf call's steps (adaptive/AdaptiveWarp.cpp).
+    class Traversal;
+
+    // adaptive/ErrorBound.cpp
+    /// The bound's terms for the cube of `size` (8, 16 or 32) voxels at origin, from the exact
     /// sums at its corners (bit 0: +x, bit 1: +y, bit 2: +z), into ctx.
-    void analyze(Context& ctx, const LatticePoint* const corners[8], const openvdb::Coord& origin,
-                 int size) const;
+    void analyze(WarpContext& ctx, const LatticePoint* const corners[8],
+                 const openvdb::Coord& origin, int size) const;
+    /// analyze() and exactSums() in their builds (see KernelBuild): one body, inlined into each.
+    void analyzeBody(WarpContext& ctx, const LatticePoint* const corners[8],
+                     const openvdb::Coord& origin, int size) const;
+    void analyzeBaseline(WarpContext& ctx, const LatticePoint* const corners[8],
+                         const openvdb::Coord& origin, int size) const;
+    void analyzeAvx2(WarpContext& ctx, const LatticePoint* const corners[8],
+                     const openvdb::Coord& origin, int size) const;
+    void analyzeAvx512(WarpContext& ctx, const LatticePoint* const corners[8],
+                       const openvdb::Coord& origin, int size) const;
+    /// Marks the analysed cube's near pairs; returns its bound.
+    double selectNear(WarpContext& ctx, size_t& nearCount) const;
+
+    // adaptive/LatticeSums.cpp
     /// The exact warp's unnormalized sums W, S and T at x (map() gives S / W and T / W), by the
     /// pairs' columns; false where x lies on an element and the weight law has no offset.
     bool exactSums(const Vec3d& x, LatticePoint& out) const;
     bool exactSumsBody(const Vec3d& x, LatticePoint& out) const;
+    bool exactSumsBaseline(const Vec3d& x, LatticePoint& out) const;
     bool exactSumsAvx2(const Vec3d& x, LatticePoint& out) const;
     bool exactSumsAvx512(const Vec3d& x, LatticePoint& out) const;
-    /// analyze() and exactSums() in their builds (see KernelBuild).
-    void analyzeBody(Context& ctx, const LatticePoint* const corners[8],
-                     const openvdb::Coord& origin, int size) const;
-    void analyzeAvx2(Context& ctx, const LatticePoint* const corners[8],
-                     const openvdb::Coord& origin, int size) const;
-    void analyzeAvx512(Context& ctx, const LatticePoint* const corners[8],
-                       const openvdb::Coord& origin, int size) const;
+
+    // adaptive/DomainTest.cpp
     /// False when the analysed cube's image misses both sides' occupied blocks.
-    bool mayTouch(Context& ctx, const openvdb::Coord& origin, int size) const;
-    /// The error bound of the analysed cube from its far pairs' summed terms and Hessian bounds,
-    /// and `floor`, a lower bound of the interpolated total weight (0: none).
-    double bound(const Context& ctx, double terms, double hess, double floor) const;
-    /// Marks the analysed cube's near pairs; returns its bound.
-    double selectNear(Context& ctx, size_t& nearCount) const;
+    bool mayTouch(WarpContext& ctx, const openvdb::Coord& origin, int size) const;
+
+    // adaptive/AdaptiveWarp.cpp
     /// Fills the analysed leaf at origin: far sums interpolated, near pairs evaluated.
-    void fill(Context& ctx, const openvdb::Coord& origin) const;
-    void leaf(Context& ctx, const Lattice& lattice, const openvdb::Coord& origin) const;
-    void exactLeaf(Context& ctx) const;
-    void identityLeaf(Context& ctx) const;
+    void fill(WarpContext& ctx, const openvdb::Coord& origin) const;
+    void leaf(WarpContext& ctx, const Lattice& lattice, const openvdb::Coord& origin) const;
+    void exactLeaf(WarpContext& ctx) const;
+    void identityLeaf(WarpContext& ctx) const;
 
     const InverseWarp& mWarp;
     double mTolerance;
+    KernelBuild mBuild;
     std::vector<InverseWarp::Affine> mSource, mTarget; ///< each pair's affine map on each side
-    std::unique_ptr<const Columns> mColumns;           ///< the interpolated elements, by column
+    std::unique_ptr<const WarpColumns> mColumns;       ///< the interpolated elements, by column
     std::vector<size_t> mByType; ///< the pairs by type, then by index (the kernel's order)
 };
 

@@ -1,4 +1,5 @@
 #include <volmorph/Scene.h>
+#include "KeyframeTrack.h" // tools/: the CLI's keyframe track (header-only)
 
 #include <gtest/gtest.h>
 
@@ -461,8 +462,9 @@ camera = { eye = [0, 0, 5], lookat = [0, 0, 0], fov = 40, keys = [
     ASSERT_EQ(s.render.camera.keys.size(), 2u);
     // Values a key leaves out come from the camera.
     EXPECT_DOUBLE_EQ(s.render.camera.keys[0].fovDegrees, 40.0);
-    const CameraSpec before = s.render.camera.at(1), middle = s.render.camera.at(15),
-                     after = s.render.camera.at(99);
+    const CameraSpec before = cli::cameraAt(s.render.camera, 1),
+                     middle = cli::cameraAt(s.render.camera, 15),
+                     after = cli::cameraAt(s.render.camera, 99);
     EXPECT_EQ(before.eye, Vec3d(0, 0, 5));
     EXPECT_EQ(after.eye, Vec3d(10, 0, 5));
     EXPECT_DOUBLE_EQ(after.fovDegrees, 60.0);
@@ -482,13 +484,13 @@ lights = [ { type = "directional", direction = [0, -1, 0], intensity = 2, keys =
     { frame = 3, direction = [1, 0, 0], intensity = 0, color = [1, 0, 0] } ] } ]
 )");
     ASSERT_EQ(s.render.lights.size(), 1u);
-    const LightSpec middle = s.render.lights[0].at(2);
+    const LightSpec middle = cli::lightAt(s.render.lights[0], 2);
     EXPECT_NEAR(middle.direction.x(), std::sqrt(0.5),
                 1e-12); // halfway between -y and +x, unit length
     EXPECT_NEAR(middle.direction.y(), -std::sqrt(0.5), 1e-12);
     EXPECT_NEAR(middle.intensity, 1.0, 1e-12);
     EXPECT_NEAR(middle.color.y(), 0.5, 1e-12);
-    EXPECT_EQ(s.render.lights[0].at(0).intensity, 2.0);
+    EXPECT_EQ(cli::lightAt(s.render.lights[0], 0).intensity, 2.0);
 }
 
 TEST(SceneAnimation, KeyErrorsNameTheirPlace)

@@ -1,6 +1,7 @@
 #include <volmorph/Voxelize.h>
 
-#include "voxelize/WindingNumber.h" // private to the library; tested directly
+#include "mesh/Orientation.h"   // private to the library; tested directly
+#include "mesh/WindingNumber.h" // private to the library; tested directly
 
 #include <gtest/gtest.h>
 

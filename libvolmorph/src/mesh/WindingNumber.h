@@ -38,9 +38,4 @@ private:
     std::vector<Node> mNodes;
 };
 
-/// Makes each connected shell's triangle orientation consistent (the majority orientation of the
-/// shell wins across manifold edges), then flips shells of negative volume that lie inside no
-/// other shell. Returns the number of triangles flipped.
-size_t repairOrientation(Mesh& mesh);
-
 } // namespace volmorph::detail

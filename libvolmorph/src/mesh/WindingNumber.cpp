@@ -1,9 +1,8 @@
-#include "WindingNumber.h"
+#include "mesh/WindingNumber.h"
 
 #include <algorithm>
 #include <cmath>
 #include <numeric>
-#include <unordered_map>
 
 namespace volmorph::detail {
 namespace {
@@ -119,105 +118,6 @@ double WindingNumber::exact(const Vec3d& p) const
     double sum = 0.0;
     for (const Vec3I& t : mTriangles) sum += solidAngle(t, p);
     return sum / kFourPi;
-}
-
-size_t repairOrientation(Mesh& mesh)
-{
-    const size_t n = mesh.triangles.size();
-    // Directed edge (a -> b) to the triangles that use it, to find each triangle's neighbours.
-    std::unordered_map<uint64_t, std::vector<uint32_t>> byEdge;
-    byEdge.reserve(3 * n);
-    auto key = [](uint32_t a, uint32_t b) {
-        return (uint64_t(std::min(a, b)) << 32) | std::max(a, b);
-    };
-    for (uint32_t t = 0; t < n; ++t)
-        for (int k = 0; k < 3; ++k)
-            byEdge[key(mesh.triangles[t][k], mesh.triangles[t][(k + 1) % 3])].push_back(t);
-
-    auto traverses = [&mesh](uint32_t t, uint32_t a, uint32_t b) {
-        const Vec3I& tri = mesh.triangles[t];
-        for (int k = 0; k < 3; ++k)
-            if (tri[k] == a && tri[(k + 1) % 3] == b) return true;
-        return false;
-    };
-
-    // Breadth-first over manifold edges; flipRelative[t] says t must flip to agree with its seed.
-    std::vector<int> shell(n, -1);
-    std::vector<char> flipRelative(n, 0);
-    std::vector<std::vector<uint32_t>> shells;
-    for (uint32_t seed = 0; seed < n; ++seed) {
-        if (shell[seed] >= 0) continue;
-        const int id = int(shells.size());
-        shells.emplace_back();
-        std::vector<uint32_t> queue{seed};
-        shell[seed] = id;
-        for (size_t q = 0; q < queue.size(); ++q) {
-            const uint32_t t = queue[q];
-            shells[id].push_back(t);
-            const Vec3I& tri = mesh.triangles[t];
-            for (int k = 0; k < 3; ++k) {
-                // Orientation of t's edge as t will be after its relative flip.
-                uint32_t a = tri[k], b = tri[(k + 1) % 3];
-                if (flipRelative[t]) std::swap(a, b);
-                const auto& users = byEdge[key(a, b)];
-                if (users.size() != 2) continue; // boundary or non-manifold: no orientation to copy
-                const uint32_t u = users[0] == t ? users[1] : users[0];
-                if (shell[u] >= 0) continue;
-                shell[u] = id;
-                // Consistent neighbours traverse the shared edge the other way (b -> a).
-                flipRelative[u] = traverses(u, a, b) ? 1 : 0;
-                queue.push_back(u);
-            }
-        }
-    }
-
-    size_t flipped = 0;
-    auto flip = [&mesh, &flipped](uint32_t t) {
-        std::swap(mesh.triangles[t][1], mesh.triangles[t][2]);
-        ++flipped;
-    };
-    // The majority orientation of each shell wins.
-    for (const auto& triangles : shells) {
-        size_t relative = 0;
-        for (uint32_t t : triangles) relative += flipRelative[t];
-        const bool flipMarked = relative * 2 <= triangles.size();
-        for (uint32_t t : triangles)
-            if (bool(flipRelative[t]) == flipMarked) flip(t);
-    }
-    // Inverted shells: negative volume and inside no other shell.
-    std::vector<double> volume(shells.size(), 0.0);
-    for (size_t s = 0; s < shells.size(); ++s)
-        for (uint32_t t : shells[s]) {
-            const Vec3I& tri = mesh.triangles[t];
-            volume[s] += Vec3d(mesh.points[tri[0]])
-                             .dot(Vec3d(mesh.points[tri[1]]).cross(Vec3d(mesh.points[tri[2]]))) /
-                         6.0;
-        }
-    // Nesting is checked pairwise; beyond this many shells (debris, particles) it is skipped and
-    // every negative shell is turned outward.
-    constexpr size_t kMaxNestingShells = 64;
-    std::vector<WindingNumber> perShell;
-    if (shells.size() <= kMaxNestingShells) {
-        perShell.reserve(shells.size());
-        for (const auto& triangles : shells) {
-            std::vector<Vec3I> tris;
-            for (uint32_t t : triangles) tris.push_back(mesh.triangles[t]);
-            perShell.emplace_back(mesh.points, std::move(tris));
-        }
-    }
-    for (size_t s = 0; s < shells.size(); ++s) {
-        if (volume[s] >= 0.0) continue;
-        bool nested = false;
-        if (!perShell.empty()) {
-            const Vec3d probe(mesh.points[mesh.triangles[shells[s][0]][0]]);
-            for (size_t o = 0; o < shells.size() && !nested; ++o)
-                nested = o != s && std::abs(perShell[o](probe)) > 0.5;
-        }
-        if (!nested)
-            for (uint32_t t : shells[s]) flip(t);
-    }
-    analyzeTopology(mesh);
-    return flipped;
 }
 
 } // namespace volmorph::detail

@@ -1,0 +1,94 @@
+// Animation of the scene's camera and lights: one keyframe track type for both. A track is the
+// keys of one camera or light (Scene.h's CameraKey or LightKey: a frame and every value), held
+// before the first key and after the last, and interpolated linearly between the two keys around
+// a frame (directions renormalized). Header-only: the CLI's SceneRender and the tests use it.
+#pragma once
+
+#include <volmorph/Scene.h>
+
+#include <vector>
+
+namespace volmorph::cli {
+
+template <typename Key>
+class KeyframeTrack {
+public:
+    /// `keys`: by increasing frame (the parser checks it); not empty.
+    explicit KeyframeTrack(const std::vector<Key>& keys) : mKeys(keys) {}
+
+    /// The two keys around `frame` and the weight u of the second; the same key twice outside
+    /// them.
+    struct Span {
+        const Key* a;
+        const Key* b;
+        double u;
+    };
+    Span at(int frame) const
+    {
+        Span s{&mKeys.front(), &mKeys.front(), 0.0};
+        if (frame <= mKeys.front().frame) return s;
+        s.a = s.b = &mKeys.back();
+        if (frame >= mKeys.back().frame) return s;
+        for (size_t i = 1; i < mKeys.size(); ++i) {
+            if (frame <= mKeys[i].frame) {
+                s.a = &mKeys[i - 1];
+                s.b = &mKeys[i];
+                s.u = double(frame - s.a->frame) / double(s.b->frame - s.a->frame);
+                break;
+            }
+        }
+        return s;
+    }
+
+    static double lerp(double a, double b, double u) { return a + (b - a) * u; }
+    static Vec3d lerp(const Vec3d& a, const Vec3d& b, double u) { return a + (b - a) * u; }
+    /// Linear interpolation of two directions, renormalized (keys may not be opposite: the
+    /// parser refuses that).
+    static Vec3d lerpDirection(const Vec3d& a, const Vec3d& b, double u)
+    {
+        const Vec3d d = lerp(a.unit(), b.unit(), u);
+        return d.length() > 1e-12 ? d.unit() : a.unit();
+    }
+
+private:
+    const std::vector<Key>& mKeys;
+};
+
+/// `spec` (a camera or a light) at `frame`: a copy without keys whose values `interpolate(copy,
+/// span)` sets from the two keys around the frame; `spec` itself, less its keys, when it has none.
+template <typename Spec, typename Interpolate>
+Spec atFrame(const Spec& spec, int frame, const Interpolate& interpolate)
+{
+    using Key = typename decltype(spec.keys)::value_type;
+    Spec out = spec;
+    out.keys.clear();
+    if (!spec.keys.empty()) interpolate(out, KeyframeTrack<Key>(spec.keys).at(frame));
+    return out;
+}
+
+/// The camera at `frame`: its keys interpolated, up renormalized.
+inline CameraSpec cameraAt(const CameraSpec& camera, int frame)
+{
+    using T = KeyframeTrack<CameraKey>;
+    return atFrame(camera, frame, [](CameraSpec& c, const T::Span& s) {
+        c.eye = T::lerp(s.a->eye, s.b->eye, s.u);
+        c.lookat = T::lerp(s.a->lookat, s.b->lookat, s.u);
+        c.up = T::lerpDirection(s.a->up, s.b->up, s.u);
+        c.fovDegrees = T::lerp(s.a->fovDegrees, s.b->fovDegrees, s.u);
+        c.orthoWidth = T::lerp(s.a->orthoWidth, s.b->orthoWidth, s.u);
+    });
+}
+
+/// The light at `frame`: its keys interpolated, direction renormalized.
+inline LightSpec lightAt(const LightSpec& light, int frame)
+{
+    using T = KeyframeTrack<LightKey>;
+    return atFrame(light, frame, [](LightSpec& l, const T::Span& s) {
+        l.direction = T::lerpDirection(s.a->direction, s.b->direction, s.u);
+        l.position = T::lerp(s.a->position, s.b->position, s.u);
+        l.color = T::lerp(s.a->color, s.b->color, s.u);
+        l.intensity = T::lerp(s.a->intensity, s.b->intensity, s.u);
+    });
+}
+
+} // namespace volmorph::cli
