@@ -38,8 +38,8 @@ for r in $(seq "$rounds"); do
         seconds "$build/bin/volmorph" $vm_args -o "$out/$side.exr" >>"$out/render-$side"
         bench_ms "$build" 'morphFrame/256/' >>"$out/sdf-$side"
         bench_ms "$build" 'morphFrameDensity/256/' >>"$out/density-$side"
-        bench_ms "$build" '^exactWarp/16$' >>"$out/exact16-$side"
-        bench_ms "$build" '^approximatedWarp/16$' >>"$out/approx16-$side"
+        bench_ms "$build" '^exactWarp/16/' >>"$out/exact16-$side"
+        bench_ms "$build" '^approximatedWarp/16/' >>"$out/approx16-$side"
     done
     # shellcheck disable=SC2086
     seconds vdb_render "$out/bunny.vdb" "$out/vdb.exr" $vdb_args >>"$out/render-vdb_render"

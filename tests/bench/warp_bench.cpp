@@ -267,36 +267,19 @@ void identityResampleDensity(benchmark::State& state)
 
 } // namespace
 
-BENCHMARK(exactWarp)
-    ->Arg(1)
-    ->Arg(4)
-    ->Arg(16)
-    ->Arg(64)
-    ->Unit(benchmark::kMillisecond)
-    ->UseRealTime();
-BENCHMARK(approximatedWarp)
-    ->Arg(1)
-    ->Arg(4)
-    ->Arg(16)
-    ->Arg(64)
-    ->Unit(benchmark::kMillisecond)
-    ->UseRealTime();
-BENCHMARK(morphFrame)->Arg(128)->Arg(256)->Arg(512)->Unit(benchmark::kMillisecond)->UseRealTime();
-BENCHMARK(morphFrameDensity)
-    ->Arg(128)
-    ->Arg(256)
-    ->Arg(512)
-    ->Unit(benchmark::kMillisecond)
-    ->UseRealTime();
-BENCHMARK(identityResample)
-    ->Arg(128)
-    ->Arg(256)
-    ->Arg(512)
-    ->Unit(benchmark::kMillisecond)
-    ->UseRealTime();
-BENCHMARK(identityResampleDensity)
-    ->Arg(128)
-    ->Arg(256)
-    ->Arg(512)
-    ->Unit(benchmark::kMillisecond)
-    ->UseRealTime();
+/// 1, 4, 16 and 64 pairs, in milliseconds of wall time.
+void pairCounts(benchmark::internal::Benchmark* b)
+{
+    b->Arg(1)->Arg(4)->Arg(16)->Arg(64)->Unit(benchmark::kMillisecond)->UseRealTime();
+}
+BENCHMARK(exactWarp)->Apply(pairCounts);
+BENCHMARK(approximatedWarp)->Apply(pairCounts);
+/// 128, 256 and 512 voxels across, in milliseconds of wall time.
+void resolutions(benchmark::internal::Benchmark* b)
+{
+    b->Arg(128)->Arg(256)->Arg(512)->Unit(benchmark::kMillisecond)->UseRealTime();
+}
+BENCHMARK(morphFrame)->Apply(resolutions);
+BENCHMARK(morphFrameDensity)->Apply(resolutions);
+BENCHMARK(identityResample)->Apply(resolutions);
+BENCHMARK(identityResampleDensity)->Apply(resolutions);

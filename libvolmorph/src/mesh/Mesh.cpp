@@ -226,16 +226,26 @@ RawMesh readWithAssimp(const std::filesystem::path& file)
     return raw;
 }
 
+/// One ::read or ::write (`io`) of at most `size` bytes at p, retried when a signal interrupts
+/// it; advances p and size. False on an error or the end of the file.
+template <typename Io, typename Byte>
+bool transfer(Io io, int fd, Byte*& p, size_t& size)
+{
+    ssize_t n;
+    do {
+        n = io(fd, p, size);
+    } while (n < 0 && errno == EINTR);
+    if (n <= 0) return false;
+    p += n;
+    size -= size_t(n);
+    return true;
+}
+
 bool writeAll(int fd, const void* data, size_t size)
 {
     const char* p = static_cast<const char*>(data);
-    while (size > 0) {
-        const ssize_t n = ::write(fd, p, size);
-        if (n < 0 && errno == EINTR) continue;
-        if (n <= 0) return false;
-        p += n;
-        size -= size_t(n);
-    }
+    while (size > 0)
+        if (!transfer(::write, fd, p, size)) return false;
     return true;
 }
 
@@ -263,11 +273,7 @@ bool readAll(int fd, void* data, size_t size, std::chrono::steady_clock::time_po
         if (r < 0 && errno == EINTR) continue;
         if (r < 0) return false;
         if (r == 0) continue;
-        const ssize_t n = ::read(fd, p, size);
-        if (n < 0 && errno == EINTR) continue;
-        if (n <= 0) return false;
-        p += n;
-        size -= size_t(n);
+        if (!transfer(::read, fd, p, size)) return false;
     }
     return true;
 }
