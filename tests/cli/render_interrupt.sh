@@ -21,13 +21,15 @@ export VOLMORPH_CACHE="$dir/cache"
 fail() { echo "FAIL: $*"; [ -f "$dir/err" ] && { echo "stderr:"; cat "$dir/err"; }; exit 1; }
 now() { date +%s.%N; }
 
-# wait_for PATTERN: until the running command's stderr shows PATTERN (polled every 20 ms).
+# wait_for PATTERN: until the running command's stderr shows PATTERN (polled every 20 ms), for at
+# most 60 s times LIMIT (a sanitizer build voxelizes the morph case's sides for over a minute).
+polls=$(awk -v l="$limit" 'BEGIN { printf "%d", 3000 * (l > 1 ? l : 1) }')
 wait_for() {
     i=0
     until grep -q "$1" "$dir/err"; do
         kill -0 "$pid" 2>/dev/null || fail "the command ended before \"$1\""
         i=$((i + 1))
-        [ $i -lt 3000 ] || fail "\"$1\" never came"
+        [ $i -lt "$polls" ] || fail "\"$1\" never came"
         sleep 0.02
     done
 }
