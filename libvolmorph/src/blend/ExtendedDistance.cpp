@@ -33,7 +33,8 @@ ExtendedDistance::ExtendedDistance(openvdb::FloatGrid::ConstPtr band, const Coor
     openvdb::FloatGrid::Ptr wide =
         openvdb::tools::maskSdf(*lattice, mask, /*ignoreActiveTiles*/ false, /*nIter*/ 1);
     if (!wide)
-        throw std::runtime_error("Morpher: fast sweeping could not extend a signed distance field");
+        throw std::runtime_error(
+            "sdf blend: fast sweeping could not extend a signed distance field");
     makeDense(*wide, coarse);
     measureErrors();
 }

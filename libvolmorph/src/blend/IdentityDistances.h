@@ -17,9 +17,6 @@
 
 namespace volmorph::detail {
 
-using openvdb::Coord;
-using openvdb::CoordBBox;
-
 /// With no feature pairs the warp is the identity at every t, so the two extended distances at a
 /// voxel are the same in every frame; only the blend's weight changes. This keeps them per output
 /// leaf, computed the first time a frame needs the leaf, for the frames after it. The values are
@@ -34,7 +31,7 @@ public:
     };
 
     /// `box`: output index space, the leaves to keep.
-    IdentityDistances(const CoordBBox& box, size_t maxLeaves)
+    IdentityDistances(const openvdb::CoordBBox& box, size_t maxLeaves)
         : mLeaves(box >> size_t(3)), mMax(maxLeaves)
     {
         if (!box.empty()) {
@@ -54,13 +51,13 @@ public:
     /// The distances at the voxels of the leaf at `origin`: the kept ones, or computed with `a`
     /// and `b` (into `scratch` when they are not to be kept). `computed` counts the samples taken.
     template <typename Sampler>
-    const Leaf& get(const Coord& origin, ExtendedDistance::Reader<Sampler>& a,
+    const Leaf& get(const openvdb::Coord& origin, ExtendedDistance::Reader<Sampler>& a,
                     ExtendedDistance::Reader<Sampler>& b, Leaf& scratch, uint64_t& computed)
     {
-        const Coord leaf = origin >> 3;
+        const openvdb::Coord leaf = origin >> 3;
         std::atomic<Leaf*>* slot = nullptr;
         if (mSlotCount && mLeaves.isInside(leaf)) {
-            const Coord d = leaf - mLeaves.min(), n = mLeaves.dim();
+            const openvdb::Coord d = leaf - mLeaves.min(), n = mLeaves.dim();
             slot = &mSlots[(size_t(d.x()) * n.y() + d.y()) * n.z() + d.z()];
             if (const Leaf* kept = slot->load(std::memory_order_acquire)) return *kept;
         }
@@ -92,11 +89,12 @@ public:
     /// box >> 3: what SdfFrame::classify() samples first in every frame. Computed by the first
     /// frame that asks for this box.
     struct Centres {
-        CoordBBox box;
+        openvdb::CoordBBox box;
         std::vector<float> source, target;
     };
     template <typename Sampler>
-    std::shared_ptr<const Centres> centres(const CoordBBox& box, const ExtendedDistance& farSource,
+    std::shared_ptr<const Centres> centres(const openvdb::CoordBBox& box,
+                                           const ExtendedDistance& farSource,
                                            const ExtendedDistance& farTarget)
     {
         {
@@ -105,8 +103,8 @@ public:
         }
         auto c = std::make_shared<Centres>();
         c->box = box;
-        const CoordBBox leaves = box >> size_t(3);
-        const Coord n = leaves.dim();
+        const openvdb::CoordBBox leaves = box >> size_t(3);
+        const openvdb::Coord n = leaves.dim();
         c->source.resize(size_t(n.x()) * n.y() * n.z());
         c->target.resize(c->source.size());
         tbb::parallel_for(tbb::blocked_range<int>(0, n.x()), [&](const tbb::blocked_range<int>& r) {
@@ -114,7 +112,7 @@ public:
             for (int x = r.begin(); x != r.end(); ++x)
                 for (int y = 0; y < n.y(); ++y)
                     for (int z = 0; z < n.z(); ++z) {
-                        const Coord leaf = leaves.min().offsetBy(x, y, z);
+                        const openvdb::Coord leaf = leaves.min().offsetBy(x, y, z);
                         const openvdb::Vec3R centre(leaf.x() * 8 + 3.5, leaf.y() * 8 + 3.5,
                                                     leaf.z() * 8 + 3.5);
                         const size_t i = (size_t(x) * n.y() + y) * n.z() + z;
@@ -128,7 +126,7 @@ public:
     }
 
 private:
-    CoordBBox mLeaves; ///< leaf coordinates (index >> 3)
+    openvdb::CoordBBox mLeaves; ///< leaf coordinates (index >> 3)
     std::mutex mCentresMutex;
     std::shared_ptr<const Centres> mCentres;
     size_t mMax;

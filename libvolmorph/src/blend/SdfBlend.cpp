@@ -17,6 +17,10 @@
 #include <stdexcept>
 
 namespace volmorph::detail {
+
+using openvdb::Coord;
+using openvdb::CoordBBox;
+
 namespace {
 
 /// The box both distance fields are extended over: the objects' box and a margin for warped points
@@ -42,7 +46,7 @@ public:
     explicit SdfBlend(const BlendSetup& setup) : TwoSidedBlend(setup)
     {
         if (!mSource.sdf || !mTarget.sdf)
-            throw std::invalid_argument("Morpher: sdf blending needs sdf grids on both sides");
+            throw std::invalid_argument("sdf blending needs sdf grids on both sides");
         const CoordBBox box = extensionBox(mSource, mTarget, setup.pairCount);
         // Both at once: fast sweeping is partly serial.
         tbb::parallel_invoke(

@@ -53,11 +53,11 @@ public:
 
     /// Classifies the leaves of `box`. With `prune` false every leaf is evaluated (the reference).
     /// `identity`: with no pairs, the distances kept across frames (for the leaves' centres).
-    void classify(const CoordBBox& box, bool prune, IdentityDistances* identity = nullptr)
+    void classify(const openvdb::CoordBBox& box, bool prune, IdentityDistances* identity = nullptr)
     {
         BlockClasses& c = mClasses;
         c.leaves = box >> size_t(3);
-        const Coord n = c.leaves.dim();
+        const openvdb::Coord n = c.leaves.dim();
         const size_t count = size_t(n.x()) * n.y() * n.z();
         std::vector<Vec3d> ps, pt; // the warped centres (with pairs)
         const std::vector<float> blend =
@@ -120,7 +120,7 @@ public:
     struct Bands {
         float compute, keep;
     };
-    Bands bandsAt(const Coord& origin) const
+    Bands bandsAt(const openvdb::Coord& origin) const
     {
         const size_t i = mClasses.index(origin >> size_t(3));
         return {mClasses.band[i], mClasses.stretch[i] * mWidth * mVoxel};
@@ -160,8 +160,8 @@ public:
     /// warp's points, cached across frames). Every voxel is blended: from distances at hand that is
     /// cheaper than judging quarters and blocks, and gives the same leaf (what those judgements
     /// skip is beyond the compute band, with their sign).
-    int operator()(const Coord& origin, const IdentityDistances::Leaf& distances, ValueLeaf& value,
-                   ColorLeaf& color) const
+    int operator()(const openvdb::Coord& origin, const IdentityDistances::Leaf& distances,
+                   ValueLeaf& value, ColorLeaf& color) const
     {
         ColorBlend<Sampler> colors(mSource, mTarget, mTauColor, mBackground);
         const float ramp = kSdfRampVoxels * mVoxel;
@@ -180,7 +180,7 @@ public:
     void addSamples(uint64_t n) const { mSamples += n; }
 
     /// The kept band (world units) of the leaf at `origin`, or the widest one outside the box.
-    float keepBandAt(const Coord& origin) const
+    float keepBandAt(const openvdb::Coord& origin) const
     {
         return mClasses.leaves.isInside(origin >> size_t(3)) ? bandsAt(origin).keep
                                                              : float(mClasses.maxStretch) * width();
@@ -281,7 +281,7 @@ private:
     std::vector<float> centreBlends(std::vector<Vec3d>& ps, std::vector<Vec3d>& pt) const
     {
         const BlockClasses& c = mClasses;
-        const Coord n = c.leaves.dim();
+        const openvdb::Coord n = c.leaves.dim();
         auto index = [&n](int x, int y, int z) { return (size_t(x) * n.y() + y) * n.z() + z; };
         const size_t count = size_t(n.x()) * n.y() * n.z();
         std::vector<float> blend(count);
@@ -293,7 +293,7 @@ private:
                 for (int y = 0; y < n.y(); ++y)
                     for (int z = 0; z < n.z(); ++z) {
                         const size_t i = index(x, y, z);
-                        const Coord leaf = c.leaves.min().offsetBy(x, y, z);
+                        const openvdb::Coord leaf = c.leaves.min().offsetBy(x, y, z);
                         const Vec3d centre(leaf.x() * 8 + 3.5, leaf.y() * 8 + 3.5,
                                            leaf.z() * 8 + 3.5);
                         mWarp.map(centre, ps[i], pt[i]);
@@ -304,7 +304,8 @@ private:
     }
 
     /// The same from the distances kept across frames (the identity warp).
-    std::vector<float> keptCentreBlends(const CoordBBox& box, IdentityDistances& identity) const
+    std::vector<float> keptCentreBlends(const openvdb::CoordBBox& box,
+                                        IdentityDistances& identity) const
     {
         const auto centres = identity.centres<Sampler>(box, mFarSource, mFarTarget);
         std::vector<float> blend(centres->source.size());

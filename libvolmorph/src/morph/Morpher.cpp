@@ -77,8 +77,6 @@ Morpher::Morpher(VolumeSet source, VolumeSet target, std::vector<FeaturePairSpec
 {
     if (!mSource.density || !mTarget.density || !mSource.color || !mTarget.color)
         throw std::invalid_argument("Morpher: source and target need density and Cd grids");
-    if (mBlend.mode == BlendMode::Sdf && (!mSource.sdf || !mTarget.sdf))
-        throw std::invalid_argument("Morpher: sdf blending needs sdf grids on both sides");
     if (!(mSource.density->transform() == mTarget.density->transform()))
         throw std::invalid_argument("Morpher: source and target must share one transform");
     if (!mOptions.memoryLimitBytes) mOptions.memoryLimitBytes = defaultMemoryLimitBytes();

@@ -200,3 +200,15 @@ TEST(Morph, SdfModeDropsSpecksAndFillsBubbles)
     EXPECT_GT(kept.sdf->tree().getValue(cavity), 0.0f);
     EXPECT_EQ(surfaceMesh(kept).report.components, 3u);
 }
+
+TEST(Morph, SdfModeWithoutSdfGridsIsRefused)
+{
+    const double voxel = 0.05;
+    VolumeSet s = voxelized("sphere.obj", voxel), d = s;
+    d.sdf.reset();
+    BlendSpec blend;
+    blend.mode = BlendMode::Sdf;
+    EXPECT_THROW(Morpher(s, d, {}, WarpSpec(), blend), std::invalid_argument);
+    blend.mode = BlendMode::Density; // density mode reads no sdf
+    EXPECT_NO_THROW(Morpher(s, d, {}, WarpSpec(), blend));
+}
