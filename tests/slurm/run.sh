@@ -52,6 +52,8 @@ munged --force --key-file="$T/munge/munge.key" --socket="$T/munge/munge.sock" --
 
 host=$(hostname -s)
 port=$((20000 + $$ % 20000))
+# A requeued task waits for its old credential to expire (cred_expire, 120 s by default), for KillWait
+# (30 s) and for a scheduler pass (sched_interval, 60 s): 170 s of an idle test at the defaults; 20 s here.
 cat >"$SLURM_CONF" <<EOF
 ClusterName=volmorphtest
 SlurmctldHost=$host
@@ -60,7 +62,8 @@ SlurmdUser=root
 SlurmctldPort=$port
 SlurmdPort=$((port + 1))
 AuthType=auth/munge
-AuthInfo=socket=$T/munge/munge.sock
+AuthInfo=socket=$T/munge/munge.sock,cred_expire=10
+KillWait=5
 CredType=cred/munge
 StateSaveLocation=$T/state
 SlurmdSpoolDir=$T/spool
@@ -74,6 +77,7 @@ JobAcctGatherType=jobacct_gather/none
 AccountingStorageType=accounting_storage/none
 JobCompType=jobcomp/none
 SchedulerType=sched/builtin
+SchedulerParameters=sched_interval=2
 SelectType=select/cons_tres
 SelectTypeParameters=CR_CPU
 ReturnToService=2
