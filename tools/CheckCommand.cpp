@@ -136,6 +136,10 @@ void printSettings(const Scene& scene)
         "render  %dx%d, %d samples, step %s voxels, extinction %s per world unit, albedo %s\n",
         r.width, r.height, r.samples, fmt(r.stepVoxels).c_str(), fmt(r.extinction).c_str(),
         fmt(r.albedo).c_str());
+    if (r.bounces > 0)
+        std::printf("        multiple scattering, %d bounces\n", r.bounces);
+    else
+        std::printf("        single scattering (bounces = 0)\n");
 }
 
 /// The camera, the emission and the lights (with their animation keys).
@@ -157,6 +161,9 @@ void printView(const RenderSpec& r)
         if (l.type == LightType::Directional)
             std::printf("light   directional, travelling %s, colour %s, intensity %s\n",
                         fmt(l.direction).c_str(), fmt(l.color).c_str(), fmt(l.intensity).c_str());
+        else if (l.type == LightType::Environment)
+            std::printf("light   environment, colour %s, intensity %s (radiance)\n",
+                        fmt(l.color).c_str(), fmt(l.intensity).c_str());
         else
             std::printf("light   point at %s, colour %s, intensity %s\n", fmt(l.position).c_str(),
                         fmt(l.color).c_str(), fmt(l.intensity).c_str());

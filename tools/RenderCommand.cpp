@@ -30,12 +30,18 @@ Vec3d vec3(const std::vector<double>& v)
     return Vec3d(v[0], v[1], v[2]);
 }
 
+/// The flags vdb_render also has take its defaults: a 1920x1080 image, one sample per pixel
+/// through its centre, a field of view of 2 atan(41.2136 / (2 x 50)) = 44.8 degrees (its 41.2 mm
+/// aperture and 50 mm focal length), a step of 1 voxel, and its light (toward 0.3,0.3,0, colour
+/// 0.7). The camera is placed to frame the volume unless --translate places it (vdb_render's
+/// default, the origin, is inside most volumes).
 struct RenderVdbArgs {
-    std::string input, output, png, camera = "persp", grid, resolution = "640x360";
-    std::vector<double> translate, lookat, up{0, 1, 0}, light{0.3, 0.7, 0.6}, emission;
-    double fov = 40.0, frameWidth = 0.0, extinction = 40.0, albedo = 0.8, step = 0.5;
+    std::string input, output, png, camera = "persp", grid, resolution = "1920x1080";
+    std::vector<double> translate, lookat, up{0, 1, 0}, light, emission, env;
+    double fov = 2.0 * std::atan(41.2136 / 100.0) * 180.0 / M_PI, frameWidth = 0.0,
+           extinction = 40.0, albedo = 0.8, step = 1.0;
     int shadowCache = 2;
-    int samples = 4, threads = 0;
+    int samples = 1, threads = 0, bounces = 0;
     double memoryLimitGiB = 0.0;
     bool floatExr = false, verbose = false;
 };
@@ -112,6 +118,28 @@ render::Camera vdbCamera(const RenderVdbArgs& args, const openvdb::FloatGrid& de
                           args.frameWidth > 0 ? args.frameWidth : extent, width, height);
 }
 
+/// The flags' lights: --light (a directional light; by default vdb_render's, toward 0.3,0.3,0 with
+/// colour 0.7) unless --env alone is given, and the environment of --env.
+std::vector<render::Light> vdbLights(const RenderVdbArgs& args)
+{
+    std::vector<render::Light> lights;
+    if (!args.light.empty() || args.env.empty()) {
+        const std::vector<double> toward =
+            args.light.empty() ? std::vector<double>{0.3, 0.3, 0.0, 0.7, 0.7, 0.7} : args.light;
+        render::Light light;
+        light.direction = -vec3(toward); // the flag points toward the light, as vdb_render's
+        if (toward.size() == 6) light.color = Vec3d(toward[3], toward[4], toward[5]);
+        lights.push_back(light);
+    }
+    if (!args.env.empty()) {
+        render::Light sky;
+        sky.type = render::Light::Type::Environment;
+        sky.color = vec3(args.env);
+        lights.push_back(sky);
+    }
+    return lights;
+}
+
 int runRenderVdb(const RenderVdbArgs& args)
 {
     int width = 0, height = 0;
@@ -121,9 +149,7 @@ int runRenderVdb(const RenderVdbArgs& args)
     StopSignals signals(interrupter);
     const InputGrids grids = readInputGrids(args);
     const render::Camera camera = vdbCamera(args, *grids.density, width, height);
-    render::Light light;
-    light.direction = -vec3(args.light); // the flag points toward the light, as vdb_render's -light
-    if (args.light.size() == 6) light.color = Vec3d(args.light[3], args.light[4], args.light[5]);
+    const std::vector<render::Light> lights = vdbLights(args);
     render::Medium medium;
     medium.extinction = args.extinction;
     medium.albedo = args.albedo;
@@ -132,11 +158,12 @@ int runRenderVdb(const RenderVdbArgs& args)
     settings.samples = args.samples;
     settings.stepVoxels = args.step;
     settings.shadowCacheVoxels = args.shadowCache;
+    settings.bounces = args.bounces;
     settings.threads = args.threads;
     settings.interrupter = &interrupter;
     const auto start = std::chrono::steady_clock::now();
     const render::Image image =
-        render::renderVolume(*grids.density, grids.color.get(), camera, {light}, medium, settings);
+        render::renderVolume(*grids.density, grids.color.get(), camera, lights, medium, settings);
     const double seconds = secondsSince(start);
     render::ExrOptions exr;
     exr.halfFloat = !args.floatExr;
@@ -249,16 +276,20 @@ Command addRenderVdbCommand(CLI::App& app)
     sub->add_option("--png", a->png, "also write an sRGB PNG preview");
     sub->add_option("--camera", a->camera, "persp or ortho")
         ->check(CLI::IsMember({"persp", "ortho"}));
-    sub->add_option("--translate", a->translate, "camera position X,Y,Z (world units)")
+    sub->add_option(
+           "--translate", a->translate,
+           "camera position X,Y,Z (world units; default: in front of the volume, framing it)")
         ->delimiter(',')
         ->expected(3);
-    sub->add_option("--lookat", a->lookat, "point the camera looks at X,Y,Z")
+    sub->add_option("--lookat", a->lookat,
+                    "point the camera looks at X,Y,Z (default: the volume's centre)")
         ->delimiter(',')
         ->expected(3);
     sub->add_option("--up", a->up, "camera up vector X,Y,Z")->delimiter(',')->expected(3);
     sub->add_option("--fov", a->fov, "horizontal field of view, degrees (perspective)")
         ->check(CLI::Range(0.01, 179.0));
-    sub->add_option("--frame", a->frameWidth, "orthographic frame width, world units")
+    sub->add_option("--frame", a->frameWidth,
+                    "orthographic frame width, world units (default: the volume's extent)")
         ->check(CLI::PositiveNumber);
     sub->add_option("--res", a->resolution, "image size WIDTHxHEIGHT");
     sub->add_option("--extinction", a->extinction, "extinction per world unit at density 1")
@@ -269,9 +300,21 @@ Command addRenderVdbCommand(CLI::App& app)
         ->delimiter(',')
         ->expected(3)
         ->check(CLI::NonNegativeNumber);
-    sub->add_option("--light", a->light, "direction toward the light X,Y,Z[,R,G,B] (as vdb_render)")
+    sub->add_option("--light", a->light,
+                    "direction toward the light X,Y,Z[,R,G,B] (as vdb_render; default "
+                    "0.3,0.3,0,0.7,0.7,0.7 unless --env alone)")
         ->delimiter(',')
         ->expected(3, 6);
+    sub->add_option("--env", a->env,
+                    "environment light: radiance R,G,B from every direction (alone: no --light "
+                    "unless given)")
+        ->delimiter(',')
+        ->expected(3)
+        ->check(CLI::NonNegativeNumber);
+    sub->add_option("--bounces", a->bounces,
+                    "volume scattering events after the first (0: single scattering; more: "
+                    "path tracing)")
+        ->check(CLI::Range(0, 100000));
     sub->add_option("--samples", a->samples, "samples per pixel")->check(CLI::Range(1, 65536));
     sub->add_option("--step", a->step,
                     "longest step of the scattering integral, in voxels (optical depth is exact)")

@@ -32,6 +32,7 @@ SceneRender::SceneRender(const Scene& scene, int threads, int width)
     medium.emission = r.emission;
     settings.samples = r.samples;
     settings.stepVoxels = r.stepVoxels;
+    settings.bounces = r.bounces;
     settings.seed = r.seed;
     settings.threads = threads;
 }
@@ -47,8 +48,9 @@ std::vector<render::Light> SceneRender::lights(int frame) const
     for (const LightSpec& spec : mSpec.lights) {
         const LightSpec l = lightAt(spec, frame);
         render::Light light;
-        light.type = l.type == LightType::Point ? render::Light::Type::Point
-                                                : render::Light::Type::Directional;
+        light.type = l.type == LightType::Point         ? render::Light::Type::Point
+                     : l.type == LightType::Environment ? render::Light::Type::Environment
+                                                        : render::Light::Type::Directional;
         light.direction = l.direction;
         light.position = l.position;
         light.color = l.color;

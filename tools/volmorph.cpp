@@ -13,6 +13,7 @@ int main(int argc, char** argv)
     CLI::App app{"volmorph: feature-based volumetric morphing of meshes through OpenVDB grids"};
     app.set_version_flag("--version", std::string("volmorph ") + volmorph::versionString());
     app.require_subcommand(1);
+    app.option_defaults()->always_capture_default(); // every --help shows each default
     const std::vector<Command> commands = {
         addCheckCommand(app),     addVoxelizeCommand(app), addMorphCommand(app),
         addRenderVdbCommand(app), addRenderCommand(app),   addDiffCommand(app),

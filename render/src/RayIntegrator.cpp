@@ -16,9 +16,32 @@ ThreadReaders::ThreadReaders(const FrameInputs& frame)
       shadowCaches(frame.lights.size()), perRay(frame.lights.size())
 {
     if (frame.color) colors = std::make_unique<ColorReader>(frame.color->tree());
+    if (frame.majorants)
+        majorants = std::make_unique<Majorants::Accessor>(frame.majorants->accessor());
     for (size_t l = 0; l < frame.lights.size(); ++l)
         if (frame.shadows[l].cache)
             shadowCaches[l] = std::make_unique<CacheAccessor>(frame.shadows[l].cache->tree());
+}
+
+double lightArriving(ThreadReaders& readers, size_t l, const Vec3d& ip, const Vec3d& direction,
+                     const Vec3d* directional, Vec3d& phased)
+{
+    const FrameInputs& in = readers.in;
+    const Light& light = in.lights[l];
+    if (light.type == Light::Type::Point) {
+        Vec3d travel = in.density.indexToWorld(ip) - light.position;
+        const double d2 = travel.lengthSqr();
+        travel /= std::sqrt(d2);
+        phased = light.color * (light.intensity / d2 *
+                                henyeyGreenstein(travel.dot(-direction), in.medium.anisotropy));
+        // The cache shares the density's origin, at `factor` times its voxel.
+        return openvdb::tools::BoxSampler::sample(*readers.shadowCaches[l], ip * in.inverseFactor);
+    }
+    phased = directional ? *directional
+                         : light.color * (light.intensity *
+                                          henyeyGreenstein(light.direction.unit().dot(-direction),
+                                                           in.medium.anisotropy));
+    return in.shadows[l].map->lookup(ip);
 }
 
 namespace {
@@ -58,22 +81,8 @@ private:
         if (mR.colors) albedo = mR.colors->at(ip) * mIn.medium.albedo;
         Vec3d source = mIn.medium.emission;
         for (size_t l = 0; l < mIn.lights.size(); ++l) {
-            const Light& light = mIn.lights[l];
-            Vec3d c = mR.perRay[l];
-            double Tl;
-            if (light.type == Light::Type::Point) {
-                Vec3d travel = mIn.density.indexToWorld(ip) - light.position;
-                const double d2 = travel.lengthSqr();
-                travel /= std::sqrt(d2);
-                c = light.color *
-                    (light.intensity / d2 *
-                     henyeyGreenstein(travel.dot(-mRay.direction), mIn.medium.anisotropy));
-                // The cache shares the density's origin, at `factor` times its voxel.
-                Tl =
-                    openvdb::tools::BoxSampler::sample(*mR.shadowCaches[l], ip * mIn.inverseFactor);
-            } else {
-                Tl = mIn.shadows[l].map->lookup(ip);
-            }
+            Vec3d c;
+            const double Tl = lightArriving(mR, l, ip, mRay.direction, &mR.perRay[l], c);
             source += Vec3d(albedo.x() * c.x(), albedo.y() * c.y(), albedo.z() * c.z()) * Tl;
         }
         return source;

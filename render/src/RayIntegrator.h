@@ -8,7 +8,9 @@
 #include <volmorph/render/Camera.h>
 #include <volmorph/render/Renderer.h>
 
+#include "Cell.h"
 #include "GridReaders.h"
+#include "Majorants.h"
 #include "Shadows.h"
 
 #include <memory>
@@ -29,6 +31,16 @@ struct FrameInputs {
     const PaddedLeaves& padded;
     const Intersector& master;
     const std::vector<Shadow>& shadows;
+    // Path tracing (PathTracer.h); unused by the single-scattering estimator.
+    const Majorants* majorants; ///< null unless paths are traced
+    int bounces;                ///< scattering events after the first (RenderSettings::bounces)
+    Vec3d environment;          ///< the environment lights' radiance, summed
+};
+
+/// A piece of a camera ray inside one cell (or constant run), with the optical depth before it.
+struct TracedPiece {
+    Cell cell;
+    double ta, tb, tauBefore;
 };
 
 /// One thread's readers of the frame's grids (accessors keep per-thread caches).
@@ -40,11 +52,20 @@ struct ThreadReaders {
     DensityReader density;
     std::unique_ptr<ColorReader> colors;
     std::vector<std::unique_ptr<CacheAccessor>>
-        shadowCaches;          ///< per light: its point-light grid, or null
-    std::vector<Vec3d> perRay; ///< per light: scratch for one ray
+        shadowCaches;                               ///< per light: its point-light grid, or null
+    std::vector<Vec3d> perRay;                      ///< per light: scratch for one ray
+    std::unique_ptr<Majorants::Accessor> majorants; ///< when paths are traced
+    std::vector<TracedPiece> pieces;                ///< scratch for one camera ray
 
     explicit ThreadReaders(const FrameInputs& frame);
 };
+
+/// What light `l` (directional or point) brings to index point ip for a path travelling along
+/// `direction` (unit): `phased` gets its colour times intensity (over distance squared for a point
+/// light) times the phase function toward -direction, `*directional` instead when given for a
+/// directional light (constant along a ray); returns the transmittance toward the light.
+double lightArriving(ThreadReaders& readers, size_t l, const Vec3d& ip, const Vec3d& direction,
+                     const Vec3d* directional, Vec3d& phased);
 
 /// The radiance L (linear RGB, premultiplied) and the transmittance T along one camera ray.
 struct RaySample {

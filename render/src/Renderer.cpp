@@ -5,6 +5,8 @@
 #include <volmorph/core/Interrupter.h>
 
 #include "GridReaders.h"
+#include "Majorants.h"
+#include "PathTracer.h"
 #include "RayIntegrator.h"
 #include "Sampling.h"
 #include "Shadows.h"
@@ -47,7 +49,9 @@ void renderPixel(ThreadReaders& readers, const Camera& camera, const RenderSetti
         const double jx = random.next(), jy = random.next();
         const double sx = samples == 1 ? 0.5 : ((s % strata) + jx) / strata;
         const double sy = samples == 1 ? 0.5 : ((s / strata) % strata + jy) / strata;
-        const RaySample sample = integrateRay(readers, camera.ray(x + sx, y + sy));
+        const Ray ray = camera.ray(x + sx, y + sy);
+        const RaySample sample =
+            readers.in.majorants ? tracePath(readers, ray, random) : integrateRay(readers, ray);
         r += sample.L.x();
         g += sample.L.y();
         b += sample.L.z();
@@ -93,6 +97,14 @@ void renderFrame(const openvdb::FloatGrid& density, const openvdb::Vec3SGrid* co
         buildShadows(density, padded, *mask, levelSet, lights, sigmaPerVoxel,
                      settings.shadowCacheVoxels, settings.interrupter);
     if (interrupted(settings.interrupter)) throw Interrupted();
+    Vec3d environment(0.0);
+    for (const Light& light : lights)
+        if (light.type == Light::Type::Environment) environment += light.color * light.intensity;
+    std::unique_ptr<const Majorants> majorants;
+    if (settings.tracePaths || settings.bounces > 0 || environment != Vec3d(0.0)) {
+        stage(settings.interrupter, "render: majorants");
+        majorants = std::make_unique<const Majorants>(density, padded, levelSet);
+    }
     const Intersector master(*mask);
     const FrameInputs frame{density,
                             color,
@@ -104,7 +116,10 @@ void renderFrame(const openvdb::FloatGrid& density, const openvdb::Vec3SGrid* co
                             1.0 / double(std::max(1, settings.shadowCacheVoxels)),
                             padded,
                             master,
-                            shadows};
+                            shadows,
+                            majorants.get(),
+                            std::max(0, settings.bounces),
+                            environment};
     stage(settings.interrupter, "render: pixels");
     renderTiles(frame, camera, settings, image);
     stage(settings.interrupter, nullptr);

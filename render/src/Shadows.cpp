@@ -220,7 +220,7 @@ std::vector<Shadow> buildShadows(const FloatGrid& density, const PaddedLeaves& p
             shadows[l].map = std::make_unique<ShadowMap>(
                 density, padded, mask, levelSet, lights[l].direction, sigmaPerVoxel,
                 voxel * std::max(1, shadowCacheVoxels), interrupter);
-        else
+        else if (lights[l].type == Light::Type::Point)
             shadows[l].cache = pointLightCache(density, padded, mask, levelSet, lights[l],
                                                sigmaPerVoxel, shadowCacheVoxels, interrupter);
     }

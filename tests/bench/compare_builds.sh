@@ -19,7 +19,7 @@ root=$(cd "$(dirname "$0")/../.." && pwd)
 absorb=0.0077401   # as render_vs_vdb_render.sh: extinction 1 per world unit, albedo 0.8, voxel 0.0387
 scatter=0.0309604
 vm_args="render-vdb $out/bunny.vdb --translate 0,5,25 --lookat 0,4.8,0 --fov 40 --res 640x360
-    --extinction 1 --albedo 0.8 --light 0.3,0.7,0.6 --samples 1 --grid density --float"
+    --extinction 1 --albedo 0.8 --light 0.3,0.7,0.6 --samples 1 --step 0.5 --grid density --float"
 vdb_args="-translate 0,5,25 -lookat 0,4.8,0 -fov 40 -res 640x360 -absorb $absorb,$absorb,$absorb
     -scatter $scatter,$scatter,$scatter -light 0.3,0.7,0.6,1,1,1 -name density -cutoff 1e-7 -step 1 -shadowstep 3"
 

@@ -31,7 +31,7 @@ scatter=0.0309604  # 1 * 0.8 * 0.0387005
 camera="-translate 0,5,25 -lookat 0,4.8,0 -fov 40 -res 640x360"
 vdb_args="$camera -absorb $absorb,$absorb,$absorb -scatter $scatter,$scatter,$scatter -light 0.3,0.7,0.6,1,1,1 -name density"
 vm="$volmorph render-vdb $out/bunny.vdb --translate 0,5,25 --lookat 0,4.8,0 --fov 40 --res 640x360
-    --extinction 1 --albedo 0.8 --light 0.3,0.7,0.6 --samples 1 --grid density --float"
+    --extinction 1 --albedo 0.8 --light 0.3,0.7,0.6 --samples 1 --step 0.5 --grid density --float"
 
 vdb_render "$out/bunny.vdb" "$out/ref_literal.exr" $vdb_args -cutoff 1e-7 -step 0.05 -shadowstep 20 >/dev/null
 vdb_render "$out/dilated.vdb" "$out/ref_converged.exr" $vdb_args -cutoff 1e-14 -step 0.05 -shadowstep 20 >/dev/null

@@ -119,7 +119,7 @@ struct CameraSpec {
                                  ///< KeyframeTrack interpolates them)
 };
 
-enum class LightType { Directional, Point };
+enum class LightType { Directional, Point, Environment };
 
 /// A light at one key frame: every value, those the key leaves out copied from the light.
 struct LightKey {
@@ -146,6 +146,9 @@ struct RenderSpec {
     double albedo = 0.8;           ///< single-scattering albedo, 0..1
     double anisotropy = 0.0;       ///< Henyey-Greenstein g, -1 < g < 1
     Vec3d emission{0.0, 0.0, 0.0}; ///< radiance emitted per unit optical depth, linear RGB
+    /// Volume scattering events after the first, as Cycles' volume bounces: 0 (the default, the
+    /// fast path) is single scattering; more trace paths (multiple scattering).
+    int bounces = 0;
     unsigned seed = 0;
     CameraSpec camera;
     std::vector<LightSpec> lights; ///< default: one directional light from above-front

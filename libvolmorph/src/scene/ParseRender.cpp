@@ -9,9 +9,9 @@
 namespace volmorph::detail {
 namespace {
 
-const std::vector<std::string> kRenderKeys = {"resolution", "samples",    "step", "extinction",
-                                              "albedo",     "anisotropy", "seed", "camera",
-                                              "lights",     "emission"};
+const std::vector<std::string> kRenderKeys = {"resolution", "samples",    "step",   "extinction",
+                                              "albedo",     "anisotropy", "seed",   "camera",
+                                              "lights",     "emission",   "bounces"};
 const std::vector<std::string> kCameraKeys = {"projection", "eye",   "lookat", "up",
                                               "fov",        "width", "keys"};
 const std::vector<std::string> kCameraKeyKeys = {"frame", "eye", "lookat", "up", "fov", "width"};
@@ -123,6 +123,55 @@ void parseCamera(Reader& r, const toml::node& node, CameraSpec& camera)
     }
 }
 
+/// What a light of `type` is placed by: a directional light's direction, a point light's position,
+/// nothing for an environment. `key` is the name of a key that may place a light.
+std::string misplaced(LightType type, const std::string& key)
+{
+    const bool wanted =
+        key == "direction" ? type == LightType::Directional : type == LightType::Point;
+    if (wanted) return "";
+    switch (type) {
+    case LightType::Directional:
+        return "a directional light has a direction, not a position";
+    case LightType::Point:
+        return "a point light has a position, not a direction";
+    case LightType::Environment:
+        return "an environment light lights from every direction";
+    }
+    return "";
+}
+
+/// The light's type and what places it (direction or position).
+void parsePlacement(Reader& r, const toml::table& t, const toml::node& node,
+                    const std::string& path, LightSpec& light)
+{
+    if (const toml::node* n = t.get("type")) {
+        if (auto s = r.choice(*n, path + ".type", {"directional", "point", "environment"}))
+            light.type = *s == "point"         ? LightType::Point
+                         : *s == "environment" ? LightType::Environment
+                                               : LightType::Directional;
+    } else {
+        r.missing(node, path + ".type", "directional, point or environment");
+    }
+    // The key that places this type first, then the one it must not have.
+    const bool point = light.type == LightType::Point;
+    for (const char* key : {point ? "position" : "direction", point ? "direction" : "position"}) {
+        const toml::node* n = t.get(key);
+        const std::string why = misplaced(light.type, key);
+        if (n && !why.empty()) {
+            r.error(r.at(*n), path + "." + key + ": " + why);
+        } else if (n && light.type == LightType::Directional) {
+            if (auto v = r.direction(*n, path + ".direction")) light.direction = *v;
+        } else if (n) {
+            if (auto v = r.vec3(*n, path + ".position")) light.position = *v;
+        } else if (why.empty()) {
+            r.missing(node, path + "." + key,
+                      light.type == LightType::Directional ? "the way the light travels, [x, y, z]"
+                                                           : "[x, y, z] in world units");
+        }
+    }
+}
+
 void parseLight(Reader& r, const toml::node& node, const std::string& path,
                 std::vector<LightSpec>& lights)
 {
@@ -130,30 +179,7 @@ void parseLight(Reader& r, const toml::node& node, const std::string& path,
     if (!t) return;
     r.checkKeys(*t, path, kLightKeys);
     LightSpec light;
-    if (const toml::node* n = t->get("type")) {
-        if (auto s = r.choice(*n, path + ".type", {"directional", "point"}))
-            light.type = *s == "point" ? LightType::Point : LightType::Directional;
-    } else {
-        r.missing(node, path + ".type", "directional or point");
-    }
-    if (light.type == LightType::Directional) {
-        if (const toml::node* n = t->get("direction")) {
-            if (auto v = r.direction(*n, path + ".direction")) light.direction = *v;
-        } else {
-            r.missing(node, path + ".direction", "the way the light travels, [x, y, z]");
-        }
-        if (const toml::node* n = t->get("position"))
-            r.error(r.at(*n),
-                    path + ".position: a directional light has a direction, not a position");
-    } else {
-        if (const toml::node* n = t->get("position")) {
-            if (auto v = r.vec3(*n, path + ".position")) light.position = *v;
-        } else {
-            r.missing(node, path + ".position", "[x, y, z] in world units");
-        }
-        if (const toml::node* n = t->get("direction"))
-            r.error(r.at(*n), path + ".direction: a point light has a position, not a direction");
-    }
+    parsePlacement(r, *t, node, path, light);
     if (const toml::node* n = t->get("color"))
         if (auto v = r.nonNegativeVec3(*n, path + ".color")) light.color = *v;
     if (const toml::node* n = t->get("intensity"))
@@ -170,15 +196,14 @@ void parseLight(Reader& r, const toml::node& node, const std::string& path,
                 if (const toml::node* e = k.get("direction")) {
                     if (light.type != LightType::Directional)
                         r.error(r.at(*e),
-                                keyPath +
-                                    ".direction: a point light has a position, not a direction");
+                                keyPath + ".direction: " + misplaced(light.type, "direction"));
                     else if (auto v = r.direction(*e, keyPath + ".direction"))
                         key.direction = *v;
                 }
                 if (const toml::node* e = k.get("position")) {
                     if (light.type != LightType::Point)
-                        r.error(r.at(*e), keyPath + ".position: a directional light has a "
-                                                    "direction, not a position");
+                        r.error(r.at(*e),
+                                keyPath + ".position: " + misplaced(light.type, "position"));
                     else if (auto v = r.vec3(*e, keyPath + ".position"))
                         key.position = *v;
                 }
@@ -242,6 +267,8 @@ void parseRender(Reader& r, const toml::node& node, RenderSpec& rs)
     if (const toml::node* n = t->get("seed"))
         if (auto v = r.integerIn(*n, "render.seed", 0, std::numeric_limits<uint32_t>::max()))
             rs.seed = unsigned(*v);
+    if (const toml::node* n = t->get("bounces"))
+        if (auto v = r.integerIn(*n, "render.bounces", 0, 100000)) rs.bounces = int(*v);
     if (const toml::node* n = t->get("emission"))
         if (auto v = r.nonNegativeVec3(*n, "render.emission")) rs.emission = *v;
     if (const toml::node* n = t->get("camera")) parseCamera(r, *n, rs.camera);

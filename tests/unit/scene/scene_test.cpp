@@ -509,3 +509,23 @@ TEST(SceneAnimation, KeyErrorsNameTheirPlace)
         9, 86, "render.lights[1].keys[1].direction: a point light has a position, not a direction");
     expectError(base + "emission = [1, -1, 0]\n", 9, 12, "render.emission");
 }
+
+TEST(Scene, BouncesAndAnEnvironmentLight)
+{
+    const Scene scene = parse(std::string(kMinimal) +
+                              "[render]\nbounces = 16\nlights = [ { type = \"environment\", "
+                              "color = [0.5, 0.6, 1], intensity = 2 } ]\n");
+    EXPECT_EQ(scene.render.bounces, 16);
+    ASSERT_EQ(scene.render.lights.size(), 1u);
+    EXPECT_EQ(scene.render.lights[0].type, LightType::Environment);
+    EXPECT_EQ(scene.render.lights[0].intensity, 2.0);
+    EXPECT_EQ(parse(kMinimal).render.bounces, 0); // the documented default
+    const std::string base = std::string(kMinimal) + "[render]\n";
+    expectError(base + "bounces = -1\n", 9, 11, "render.bounces");
+    expectError(base + "lights = [ { type = \"environment\", direction = [0, -1, 0] } ]\n", 9, 48,
+                "render.lights[1].direction: an environment light lights from every direction");
+    const std::vector<Diagnostic> d = errors(base + "lights = [ { type = \"sky\" } ]\n");
+    ASSERT_FALSE(d.empty());
+    EXPECT_NE(d[0].message.find("directional, point, environment"), std::string::npos)
+        << d[0].str();
+}

@@ -40,8 +40,11 @@
 
 namespace volmorph::render {
 
+/// Units as Cycles': a directional light's color x intensity is the irradiance on a surface facing
+/// it (sun strength); a point light's is its intensity (irradiance times distance squared); an
+/// environment's is the radiance arriving from every direction (background strength).
 struct Light {
-    enum class Type { Directional, Point };
+    enum class Type { Directional, Point, Environment };
     Type type = Type::Directional;
     Vec3d direction{0, -1, 0}; ///< directional: the way the light travels (normalized on use)
     Vec3d position{0, 0, 0};   ///< point: world units; irradiance falls off with distance squared
@@ -65,6 +68,12 @@ struct RenderSettings {
     int samples = 4;           ///< per pixel, stratified and jittered; 1 = through the pixel centre
     double stepVoxels = 0.5;   ///< longest step of the scattering integral along a primary ray
     int shadowCacheVoxels = 2; ///< cache spacing, in voxels (1 = every voxel)
+    /// Scattering events after the first, as Cycles' volume bounces. 0 with no environment light:
+    /// the single-scattering estimator above. Otherwise each sample traces a path (PathTracer.h in
+    /// render/src: null-scattering path tracing against a majorant grid); the alpha is the same
+    /// exact 1 - T either way.
+    int bounces = 0;
+    bool tracePaths = false; ///< trace paths also for bounces 0 without environment (comparisons)
     unsigned seed = 0;
     int frame = 0;   ///< part of the sampling seed
     int threads = 0; ///< 0 = all cores
