@@ -12,9 +12,9 @@
 namespace volmorph::render {
 
 /// Block (i, j, k) of the majorant grid covers the index-space points [8i, 8i + 8)^3 of the density
-/// grid. A trilinear sample at such a point reads the voxels [8i, 8i + 8]^3: the block and one layer
-/// of its +x, +y and +z neighbours, so a block's majorant is the largest density over the block
-/// and those seven neighbours (negative fog densities count as 0; a level set's density is 1
+/// grid. A trilinear sample at such a point reads the voxels [8i, 8i + 8]^3: the block and one
+/// layer of its +x, +y and +z neighbours, so a block's majorant is the largest density over the
+/// block and those seven neighbours (negative fog densities count as 0; a level set's density is 1
 /// where its distance is negative). Dense inside the density's tree: its tiles are split into
 /// blocks (a 128^3 tile, the largest a volmorph grid has, is 4096 blocks).
 class Majorants {

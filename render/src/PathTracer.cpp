@@ -10,7 +10,10 @@
 namespace volmorph::render {
 namespace {
 
-Vec3d times(const Vec3d& a, const Vec3d& b) { return Vec3d(a.x() * b.x(), a.y() * b.y(), a.z() * b.z()); }
+Vec3d times(const Vec3d& a, const Vec3d& b)
+{
+    return Vec3d(a.x() * b.x(), a.y() * b.y(), a.z() * b.z());
+}
 
 /// A direction drawn from the Henyey-Greenstein phase function around the travel direction `d`
 /// (unit): cos(d, result) has density proportional to HG(g), by inverting its distribution.
@@ -29,7 +32,8 @@ Vec3d sampleHenyeyGreenstein(const Vec3d& d, double g, double u1, double u2)
     const double sign = std::copysign(1.0, d.z()), a = -1.0 / (sign + d.z()), b = d.x() * d.y() * a;
     const Vec3d e1(1.0 + sign * d.x() * d.x() * a, sign * b, -sign * d.x());
     const Vec3d e2(b, sign + d.y() * d.y() * a, -d.y());
-    return (e1 * (sinTheta * std::cos(phi)) + e2 * (sinTheta * std::sin(phi)) + d * cosTheta).unit();
+    return (e1 * (sinTheta * std::cos(phi)) + e2 * (sinTheta * std::sin(phi)) + d * cosTheta)
+        .unit();
 }
 
 /// The camera ray's walk, piece by piece, with the optical depth before each piece, until the ray
@@ -42,8 +46,8 @@ double walkPrimary(ThreadReaders& r, const Medium1D& line)
     double tau = 0.0, t0 = 0.0, t1 = 0.0;
     auto visit = [&](const Cell& cell, double ta, double tb) {
         const double rho = in.levelSet ? 1.0 : double(cell.hi);
-        const double piece = in.sigmaPerVoxel *
-                             (cell.block ? rho * (tb - ta) : line.mass(cell, ta, tb));
+        const double piece =
+            in.sigmaPerVoxel * (cell.block ? rho * (tb - ta) : line.mass(cell, ta, tb));
         r.pieces.push_back(TracedPiece{cell, ta, tb, tau});
         tau += piece;
         return tau < kMaxOpticalDepth;
@@ -66,7 +70,9 @@ double invertPrimary(const ThreadReaders& r, const Medium1D& line, double target
         return p.ta + std::clamp(want / rho, 0.0, length);
     }
     const Piece poly(line, p.cell, p.ta);
-    auto mass = [&](double s) { return poly.exact ? poly.mass(s) : line.mass(p.cell, p.ta, p.ta + s); };
+    auto mass = [&](double s) {
+        return poly.exact ? poly.mass(s) : line.mass(p.cell, p.ta, p.ta + s);
+    };
     double lo = 0.0, hi = length; // the mass is non-decreasing in s: bisection
     for (int i = 0; i < 48 && hi - lo > 1e-9; ++i) {
         const double mid = 0.5 * (lo + hi);
@@ -91,7 +97,8 @@ public:
             L += times(beta, directLight(ip, dir));
             if (vertex == mIn.bounces && mIn.environment == Vec3d(0.0)) break;
             if (vertex >= 2 && !survives(beta)) break;
-            dir = sampleHenyeyGreenstein(dir, mIn.medium.anisotropy, mRandom.next(), mRandom.next());
+            dir =
+                sampleHenyeyGreenstein(dir, mIn.medium.anisotropy, mRandom.next(), mRandom.next());
             if (!track(ip, dir)) {
                 L += times(beta, mIn.environment);
                 break;

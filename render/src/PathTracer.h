@@ -1,5 +1,6 @@
-// One camera ray's radiance by volumetric path tracing: multiple scattering (RenderSettings::bounces)
-// and environment light. The unbiased counterpart of RayIntegrator's single-scattering estimator.
+// One camera ray's radiance by volumetric path tracing: multiple scattering
+// (RenderSettings::bounces) and environment light. The unbiased counterpart of RayIntegrator's
+// single-scattering estimator.
 //
 // The camera ray's first collision is sampled exactly, by inverting its optical depth, which the
 // cells' closed forms give (Cell.h): a point with density proportional to sigma_t T along the ray,

@@ -13,6 +13,7 @@ namespace volmorph::render {
 
 ThreadReaders::ThreadReaders(const FrameInputs& frame)
     : in(frame), inter(frame.master), density(frame.density.tree(), frame.padded),
+      shadowInter(frame.master), shadowDensity(frame.density.tree(), frame.padded),
       shadowCaches(frame.lights.size()), perRay(frame.lights.size())
 {
     if (frame.color) colors = std::make_unique<ColorReader>(frame.color->tree());
@@ -23,11 +24,33 @@ ThreadReaders::ThreadReaders(const FrameInputs& frame)
             shadowCaches[l] = std::make_unique<CacheAccessor>(frame.shadows[l].cache->tree());
 }
 
+namespace {
+
+/// The exact transmittance from index point ip toward `light` (no shadow map or cache: the march
+/// through every cell on the way).
+double exactTransmittance(ThreadReaders& readers, const Light& light, const Vec3d& ip)
+{
+    const FrameInputs& in = readers.in;
+    const Vec3d p = in.density.indexToWorld(ip);
+    Vec3d toward = -light.direction.unit();
+    double distance = 1e30;
+    if (light.type == Light::Type::Point) {
+        toward = light.position - p;
+        distance = toward.length();
+        toward /= distance;
+    }
+    return std::exp(-opticalDepth(readers.shadowInter, in.levelSet, readers.shadowDensity, p,
+                                  toward, distance, in.sigmaPerVoxel));
+}
+
+} // namespace
+
 double lightArriving(ThreadReaders& readers, size_t l, const Vec3d& ip, const Vec3d& direction,
                      const Vec3d* directional, Vec3d& phased)
 {
     const FrameInputs& in = readers.in;
     const Light& light = in.lights[l];
+    const bool exact = !in.shadows[l].map && !in.shadows[l].cache;
     if (light.type == Light::Type::Point) {
         Vec3d travel = in.density.indexToWorld(ip) - light.position;
         const double d2 = travel.lengthSqr();
@@ -35,13 +58,15 @@ double lightArriving(ThreadReaders& readers, size_t l, const Vec3d& ip, const Ve
         phased = light.color * (light.intensity / d2 *
                                 henyeyGreenstein(travel.dot(-direction), in.medium.anisotropy));
         // The cache shares the density's origin, at `factor` times its voxel.
-        return openvdb::tools::BoxSampler::sample(*readers.shadowCaches[l], ip * in.inverseFactor);
+        return exact ? exactTransmittance(readers, light, ip)
+                     : openvdb::tools::BoxSampler::sample(*readers.shadowCaches[l],
+                                                          ip * in.inverseFactor);
     }
     phased = directional ? *directional
                          : light.color * (light.intensity *
                                           henyeyGreenstein(light.direction.unit().dot(-direction),
                                                            in.medium.anisotropy));
-    return in.shadows[l].map->lookup(ip);
+    return exact ? exactTransmittance(readers, light, ip) : in.shadows[l].map->lookup(ip);
 }
 
 namespace {

@@ -50,6 +50,8 @@ struct ThreadReaders {
     const FrameInputs& in;
     Intersector inter;
     DensityReader density;
+    Intersector shadowInter;     ///< exact transmittance toward lights (shadowCacheVoxels 0)
+    DensityReader shadowDensity; ///< the same
     std::unique_ptr<ColorReader> colors;
     std::vector<std::unique_ptr<CacheAccessor>>
         shadowCaches;                               ///< per light: its point-light grid, or null

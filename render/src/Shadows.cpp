@@ -216,6 +216,7 @@ std::vector<Shadow> buildShadows(const FloatGrid& density, const PaddedLeaves& p
     std::vector<Shadow> shadows(lights.size());
     for (size_t l = 0; l < lights.size(); ++l) {
         if (interrupter && interrupter->wasInterrupted()) break;
+        if (shadowCacheVoxels <= 0) break; // exact transmittance per sample: nothing to build
         if (lights[l].type == Light::Type::Directional)
             shadows[l].map = std::make_unique<ShadowMap>(
                 density, padded, mask, levelSet, lights[l].direction, sigmaPerVoxel,

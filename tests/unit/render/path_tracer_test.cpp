@@ -56,9 +56,9 @@ TEST(PathTracer, WhiteFurnace)
     settings.samples = 2;
     settings.bounces = 10000;
     for (double thickness : {0.5, 10.0}) { // through the centre: extinction times the diameter 1
-        const render::Image image = render::renderVolume(
-            *sphere, nullptr, orthoDown(1.2, pixels), {environment(1.0)}, body(thickness, 1.0),
-            settings);
+        const render::Image image =
+            render::renderVolume(*sphere, nullptr, orthoDown(1.2, pixels), {environment(1.0)},
+                                 body(thickness, 1.0), settings);
         double sum = 0.0, worst = 0.0;
         int counted = 0;
         for (int y = 0; y < pixels; ++y)
@@ -105,8 +105,8 @@ TEST(PathTracer, ZeroBouncesAgreeWithTheSingleScatteringEstimator)
         for (int x = 0; x < pixels; ++x) {
             sumMarched += marched.at(x, y)[1];
             sumTraced += traced.at(x, y)[1];
-            worstAlpha = std::max(worstAlpha,
-                                  double(std::abs(marched.at(x, y)[3] - traced.at(x, y)[3])));
+            worstAlpha =
+                std::max(worstAlpha, double(std::abs(marched.at(x, y)[3] - traced.at(x, y)[3])));
         }
     std::printf("single scattering: marched %.5f, traced %.5f (mean G), alpha diff %.1e\n",
                 sumMarched / (pixels * pixels), sumTraced / (pixels * pixels), worstAlpha);
@@ -126,8 +126,8 @@ TEST(PathTracer, MultipleScatteringBrightensAndStaysBelowTheFurnace)
     double previous = 0.0;
     for (int bounces : {0, 1, 4, 64}) {
         settings.bounces = bounces;
-        const render::Image image = render::renderVolume(
-            *sphere, nullptr, orthoDown(1.2, pixels), {environment(1.0)}, medium, settings);
+        const render::Image image = render::renderVolume(*sphere, nullptr, orthoDown(1.2, pixels),
+                                                         {environment(1.0)}, medium, settings);
         double sum = 0.0;
         for (int y = 0; y < pixels; ++y)
             for (int x = 0; x < pixels; ++x) {
@@ -190,9 +190,8 @@ TEST(PathTracer, SkySingleScatteringMatchesQuadrature)
     const double sigma = 4.0, albedo = 0.7;
     render::RenderSettings settings;
     settings.samples = 65536;
-    const render::Image image = render::renderVolume(*ball(128), nullptr, orthoDown(0.01, 1),
-                                                     {environment(1.0)}, body(sigma, albedo),
-                                                     settings);
+    const render::Image image = render::renderVolume(
+        *ball(128), nullptr, orthoDown(0.01, 1), {environment(1.0)}, body(sigma, albedo), settings);
     const double expected = skySingleScatteringOnAxis(0.5, sigma, albedo);
     std::printf("sky single scattering on the axis: traced %.5f, quadrature %.5f\n",
                 image.at(0, 0)[0], expected);

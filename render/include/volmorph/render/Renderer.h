@@ -65,9 +65,11 @@ struct Medium {
 };
 
 struct RenderSettings {
-    int samples = 4;           ///< per pixel, stratified and jittered; 1 = through the pixel centre
-    double stepVoxels = 0.5;   ///< longest step of the scattering integral along a primary ray
-    int shadowCacheVoxels = 2; ///< cache spacing, in voxels (1 = every voxel)
+    int samples = 4;         ///< per pixel, stratified and jittered; 1 = through the pixel centre
+    double stepVoxels = 0.5; ///< longest step of the scattering integral along a primary ray
+    /// Shadow map and point-light grid spacing, in voxels (1 = every voxel); 0: no cache, the exact
+    /// transmittance toward each light marched per sample (the reference the caches are judged by).
+    int shadowCacheVoxels = 2;
     /// Scattering events after the first, as Cycles' volume bounces. 0 with no environment light:
     /// the single-scattering estimator above. Otherwise each sample traces a path (PathTracer.h in
     /// render/src: null-scattering path tracing against a majorant grid); the alpha is the same

@@ -1,0 +1,125 @@
+// How far an image is from a reference render, and how much of the difference is striation at the
+// voxel scale: the difference of relative luminance Y (Rec. 709 weights; 1 = white) over the pixels
+// the reference covers (alpha above MIN_ALPHA, default 0.1), mean and 99th percentile, and the
+// difference image's power at periods from 2 pixels to 3 voxels in any direction (a 2D DFT). The
+// shadow cache's lattice lies in the light's frame, so its stripes run at any angle. Used by
+// striations.sh.
+// usage: volmorph_bench_striation_power IMAGE.exr REFERENCE.exr PIXELS_PER_VOXEL [MIN_ALPHA]
+#include <OpenImageIO/imagebuf.h>
+
+#include <algorithm>
+#include <cmath>
+#include <complex>
+#include <cstdio>
+#include <cstdlib>
+#include <string>
+#include <vector>
+
+namespace {
+
+struct Plane {
+    int width = 0, height = 0;
+    std::vector<float> rgba;
+};
+
+bool load(const std::string& path, Plane& plane)
+{
+    OIIO::ImageBuf buf(path);
+    if (!buf.read(0, 0, true, OIIO::TypeDesc::FLOAT) || buf.nchannels() < 4) {
+        std::fprintf(stderr, "%s: cannot read an RGBA image\n", path.c_str());
+        return false;
+    }
+    plane.width = buf.spec().width;
+    plane.height = buf.spec().height;
+    plane.rgba.resize(size_t(plane.width) * plane.height * 4);
+    buf.get_pixels(OIIO::ROI(0, plane.width, 0, plane.height, 0, 1, 0, 4), OIIO::TypeDesc::FLOAT,
+                   plane.rgba.data());
+    return true;
+}
+
+double luminance(const float* p)
+{
+    return 0.2126 * p[0] + 0.7152 * p[1] + 0.0722 * p[2];
+}
+
+/// The power of `diff` (its mean square, by Parseval) carried by spatial frequencies whose period
+/// lies between `shortest` and `longest` pixels in any direction: a 2D DFT, rows then columns.
+double bandPower(const std::vector<double>& diff, int width, int height, double shortest,
+                 double longest)
+{
+    using C = std::complex<double>;
+    auto twiddles = [](int n) {
+        std::vector<C> w(static_cast<size_t>(n), C(0.0));
+        for (int k = 0; k < n; ++k) w[size_t(k)] = std::polar(1.0, -2.0 * M_PI * k / n);
+        return w;
+    };
+    const std::vector<C> wx = twiddles(width), wy = twiddles(height);
+    std::vector<C> rows(size_t(width) * height); // [y][kx]
+    for (int y = 0; y < height; ++y)
+        for (int kx = 0; kx < width; ++kx) {
+            C z(0.0);
+            for (int x = 0; x < width; ++x)
+                z += diff[size_t(y) * width + x] * wx[size_t((size_t(kx) * x) % width)];
+            rows[size_t(y) * width + kx] = z;
+        }
+    const double fMin = 1.0 / longest, fMax = 1.0 / shortest, n = double(width) * height;
+    double power = 0.0;
+    for (int kx = 0; kx < width; ++kx)
+        for (int ky = 0; ky < height; ++ky) {
+            const double fx = double(kx <= width / 2 ? kx : kx - width) / width;
+            const double fy = double(ky <= height / 2 ? ky : ky - height) / height;
+            const double f = std::hypot(fx, fy);
+            if (f < fMin || f > fMax) continue;
+            C z(0.0);
+            for (int y = 0; y < height; ++y)
+                z += rows[size_t(y) * width + kx] * wy[size_t((size_t(ky) * y) % height)];
+            power += std::norm(z) / (n * n);
+        }
+    return power;
+}
+
+} // namespace
+
+int main(int argc, char** argv)
+{
+    if (argc < 4) {
+        std::fprintf(stderr, "usage: %s IMAGE.exr REFERENCE.exr PIXELS_PER_VOXEL [MIN_ALPHA]\n",
+                     argv[0]);
+        return 2;
+    }
+    Plane image, reference;
+    if (!load(argv[1], image) || !load(argv[2], reference)) return 1;
+    if (image.width != reference.width || image.height != reference.height) {
+        std::fprintf(stderr, "the images differ in size\n");
+        return 1;
+    }
+    // Periods from 2 pixels (Nyquist) to 3 voxels: the shadow cache's lattice and its harmonics.
+    const double pixelsPerVoxel = std::atof(argv[3]), minAlpha = argc > 4 ? std::atof(argv[4]) : 0.1;
+    const int w = image.width, h = image.height;
+    std::vector<double> absolute, diff(size_t(w) * h, 0.0);
+    double meanY = 0.0;
+    for (size_t i = 0; i < diff.size(); ++i) {
+        const float* a = &image.rgba[4 * i];
+        const float* b = &reference.rgba[4 * i];
+        diff[i] = luminance(a) - luminance(b);
+        if (b[3] > minAlpha) {
+            absolute.push_back(std::abs(diff[i]));
+            meanY += luminance(b);
+        }
+    }
+    if (absolute.empty()) {
+        std::fprintf(stderr, "no pixel of the reference has alpha above %g\n", minAlpha);
+        return 1;
+    }
+    meanY /= double(absolute.size());
+    std::sort(absolute.begin(), absolute.end());
+    double mean = 0.0;
+    for (double r : absolute) mean += r;
+    mean /= double(absolute.size());
+    const double p99 = absolute[size_t(0.99 * double(absolute.size() - 1))];
+    const double power = bandPower(diff, w, h, 2.0, 3.0 * pixelsPerVoxel);
+    std::printf("pixels %zu (mean Y %.4f)  |dY|: mean %.5f p99 %.5f  band power (2 px to 3 voxels) "
+                "%.3e\n",
+                absolute.size(), meanY, mean, p99, power);
+    return 0;
+}
