@@ -22,6 +22,18 @@ public:
         const Key* a;
         const Key* b;
         double u;
+
+        /// The value of one member of the keys at the frame, linear between them.
+        template <typename T>
+        T operator()(T Key::*member) const
+        {
+            return lerp(a->*member, b->*member, u);
+        }
+        /// The same for a direction, renormalized.
+        Vec3d direction(Vec3d Key::*member) const
+        {
+            return lerpDirection(a->*member, b->*member, u);
+        }
     };
     Span at(int frame) const
     {
@@ -69,25 +81,23 @@ Spec atFrame(const Spec& spec, int frame, const Interpolate& interpolate)
 /// The camera at `frame`: its keys interpolated, up renormalized.
 inline CameraSpec cameraAt(const CameraSpec& camera, int frame)
 {
-    using T = KeyframeTrack<CameraKey>;
-    return atFrame(camera, frame, [](CameraSpec& c, const T::Span& s) {
-        c.eye = T::lerp(s.a->eye, s.b->eye, s.u);
-        c.lookat = T::lerp(s.a->lookat, s.b->lookat, s.u);
-        c.up = T::lerpDirection(s.a->up, s.b->up, s.u);
-        c.fovDegrees = T::lerp(s.a->fovDegrees, s.b->fovDegrees, s.u);
-        c.orthoWidth = T::lerp(s.a->orthoWidth, s.b->orthoWidth, s.u);
+    return atFrame(camera, frame, [](CameraSpec& c, const KeyframeTrack<CameraKey>::Span& at) {
+        c.eye = at(&CameraKey::eye);
+        c.lookat = at(&CameraKey::lookat);
+        c.up = at.direction(&CameraKey::up);
+        c.fovDegrees = at(&CameraKey::fovDegrees);
+        c.orthoWidth = at(&CameraKey::orthoWidth);
     });
 }
 
 /// The light at `frame`: its keys interpolated, direction renormalized.
 inline LightSpec lightAt(const LightSpec& light, int frame)
 {
-    using T = KeyframeTrack<LightKey>;
-    return atFrame(light, frame, [](LightSpec& l, const T::Span& s) {
-        l.direction = T::lerpDirection(s.a->direction, s.b->direction, s.u);
-        l.position = T::lerp(s.a->position, s.b->position, s.u);
-        l.color = T::lerp(s.a->color, s.b->color, s.u);
-        l.intensity = T::lerp(s.a->intensity, s.b->intensity, s.u);
+    return atFrame(light, frame, [](LightSpec& l, const KeyframeTrack<LightKey>::Span& at) {
+        l.direction = at.direction(&LightKey::direction);
+        l.position = at(&LightKey::position);
+        l.color = at(&LightKey::color);
+        l.intensity = at(&LightKey::intensity);
     });
 }
 

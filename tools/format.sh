@@ -5,7 +5,7 @@ set -eu
 cd "$(dirname "$0")/.."
 command -v clang-format >/dev/null 2>&1 || { echo "clang-format not installed: skipped"; exit 77; }
 [ -d .git ] || git rev-parse --git-dir >/dev/null 2>&1 || { echo "not a git checkout: skipped"; exit 77; }
-files=$(git ls-files '*.cpp' '*.h')
+files=$(git ls-files --cached --others --exclude-standard '*.cpp' '*.h') # new files too
 if [ "${1:-}" = "--check" ]; then
     bad=""
     for f in $files; do clang-format "$f" | cmp -s - "$f" || bad="$bad $f"; done

@@ -13,7 +13,7 @@ build=${1:-build}
 across_list=${*:-125 500}
 src=$(cd "$(dirname "$0")/../.." && pwd)
 vm=$build/bin/volmorph
-power=$build/tests/bench/volmorph_bench_striation_power
+power=$build/tests/bench/volmorph_bench_image_compare
 out=$(mktemp -d)
 trap 'rm -rf "$out"' EXIT
 

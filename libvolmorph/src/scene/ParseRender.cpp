@@ -141,6 +141,23 @@ std::string misplaced(LightType type, const std::string& key)
     return "";
 }
 
+/// Reads `key` ("direction" or "position") at `n` into `direction` or `position`, or reports that
+/// a light of `type` has no such key.
+void readPlacement(Reader& r, const toml::node& n, const std::string& path, const std::string& key,
+                   LightType type, Vec3d& direction, Vec3d& position)
+{
+    const std::string why = misplaced(type, key);
+    if (!why.empty()) {
+        r.error(r.at(n), path + "." + key + ": " + why);
+        return;
+    }
+    if (key == "direction") {
+        if (auto v = r.direction(n, path + ".direction")) direction = *v;
+    } else if (auto v = r.vec3(n, path + ".position")) {
+        position = *v;
+    }
+}
+
 /// The light's type and what places it (direction or position).
 void parsePlacement(Reader& r, const toml::table& t, const toml::node& node,
                     const std::string& path, LightSpec& light)
@@ -156,19 +173,11 @@ void parsePlacement(Reader& r, const toml::table& t, const toml::node& node,
     // The key that places this type first, then the one it must not have.
     const bool point = light.type == LightType::Point;
     for (const char* key : {point ? "position" : "direction", point ? "direction" : "position"}) {
-        const toml::node* n = t.get(key);
-        const std::string why = misplaced(light.type, key);
-        if (n && !why.empty()) {
-            r.error(r.at(*n), path + "." + key + ": " + why);
-        } else if (n && light.type == LightType::Directional) {
-            if (auto v = r.direction(*n, path + ".direction")) light.direction = *v;
-        } else if (n) {
-            if (auto v = r.vec3(*n, path + ".position")) light.position = *v;
-        } else if (why.empty()) {
+        if (const toml::node* n = t.get(key))
+            readPlacement(r, *n, path, key, light.type, light.direction, light.position);
+        else if (misplaced(light.type, key).empty())
             r.missing(node, path + "." + key,
-                      light.type == LightType::Directional ? "the way the light travels, [x, y, z]"
-                                                           : "[x, y, z] in world units");
-        }
+                      point ? "[x, y, z] in world units" : "the way the light travels, [x, y, z]");
     }
 }
 
@@ -193,20 +202,10 @@ void parseLight(Reader& r, const toml::node& node, const std::string& path,
                 int frame) {
                 r.checkKeys(k, keyPath, kLightKeyKeys);
                 LightKey key{frame, light.direction, light.position, light.color, light.intensity};
-                if (const toml::node* e = k.get("direction")) {
-                    if (light.type != LightType::Directional)
-                        r.error(r.at(*e),
-                                keyPath + ".direction: " + misplaced(light.type, "direction"));
-                    else if (auto v = r.direction(*e, keyPath + ".direction"))
-                        key.direction = *v;
-                }
-                if (const toml::node* e = k.get("position")) {
-                    if (light.type != LightType::Point)
-                        r.error(r.at(*e),
-                                keyPath + ".position: " + misplaced(light.type, "position"));
-                    else if (auto v = r.vec3(*e, keyPath + ".position"))
-                        key.position = *v;
-                }
+                for (const char* placement : {"direction", "position"})
+                    if (const toml::node* e = k.get(placement))
+                        readPlacement(r, *e, keyPath, placement, light.type, key.direction,
+                                      key.position);
                 if (const toml::node* e = k.get("color"))
                     if (auto v = r.nonNegativeVec3(*e, keyPath + ".color")) key.color = *v;
                 if (const toml::node* e = k.get("intensity"))

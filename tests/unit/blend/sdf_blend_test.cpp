@@ -33,12 +33,8 @@ TEST(Morph, SdfModeReproducesTheEndSurfaces)
     const Scene scene =
         loadScene(std::filesystem::path(VOLMORPH_SOURCE_DIR) / "scenes" / "bunny-to-knot.toml");
     ASSERT_EQ(scene.blend.mode, BlendMode::Sdf);
-    ObjectTransform xf;
-    xf.scale = Vec3d(0.1);
-    ObjectTransform up;
-    up.translate = Vec3d(0, 0.5, 0);
     const double voxel = 0.016;
-    const VolumeSet s = voxelized("bunny.obj", voxel, xf), d = voxelized("knot1.off", voxel, up);
+    const auto [s, d] = defaultSceneObjects(voxel);
     const Morpher morpher(s, d, scene.pairs, scene.warp, scene.blend);
     const VolumeSet first = morpher.frame(0.0), last = morpher.frame(1.0);
     ASSERT_TRUE(first.sdf && last.sdf);
@@ -80,10 +76,8 @@ long eulerCharacteristic(const Mesh& mesh)
 TEST(Morph, SdfModeShrinksConcentricSpheresLinearly)
 {
     const double voxel = 0.01;
-    ObjectTransform half;
-    half.scale = Vec3d(0.5);
     const VolumeSet big = voxelized("sphere.obj", voxel),
-                    small = voxelized("sphere.obj", voxel, half);
+                    small = voxelized("sphere.obj", voxel, placed(Vec3d(0.0), 0.5));
     BlendSpec blend;
     blend.mode = BlendMode::Sdf;
     const Morpher morpher(big, small, {}, WarpSpec{}, blend);

@@ -7,10 +7,8 @@ using namespace volmorph::test;
 TEST(Morph, InBetweenExportsAsAClosedColouredMesh)
 {
     const double voxel = 0.02;
-    ObjectTransform moved;
-    moved.translate = Vec3d(0.6, 0, 0);
-    moved.scale = Vec3d(0.8);
-    const VolumeSet s = voxelized("sphere.obj", voxel), d = voxelized("cube.obj", voxel, moved);
+    const VolumeSet s = voxelized("sphere.obj", voxel),
+                    d = voxelized("cube.obj", voxel, placed(Vec3d(0.6, 0, 0), 0.8));
     BlendSpec blend;
     blend.mode = BlendMode::Sdf;
     const auto p = pair(FeatureType::Box, element(Vec3d(0.0)),

@@ -8,9 +8,8 @@ using namespace volmorph::test;
 TEST(Morph, PointPairTranslatesTheSphereLinearly)
 {
     const double voxel = 0.04;
-    ObjectTransform moved;
-    moved.translate = Vec3d(1, 0, 0);
-    const VolumeSet s = voxelized("sphere.obj", voxel), d = voxelized("sphere.obj", voxel, moved);
+    const VolumeSet s = voxelized("sphere.obj", voxel),
+                    d = voxelized("sphere.obj", voxel, placed(Vec3d(1, 0, 0)));
     const Morpher morpher(s, d,
                           {pair(FeatureType::Point, element(Vec3d(0.0)), element(Vec3d(1, 0, 0)))},
                           WarpSpec{}, BlendSpec{});
@@ -46,9 +45,8 @@ TEST(Morph, ScalingPairScalesTheVolumeCubically)
 {
     // Both sides warped to the same sphere scaled by 1 + t, in either blend mode.
     const double voxel = 0.02;
-    ObjectTransform twice;
-    twice.scale = Vec3d(2.0);
-    const VolumeSet s = voxelized("sphere.obj", voxel), d = voxelized("sphere.obj", voxel, twice);
+    const VolumeSet s = voxelized("sphere.obj", voxel),
+                    d = voxelized("sphere.obj", voxel, placed(Vec3d(0.0), 2.0));
     const auto p = pair(FeatureType::Box, element(Vec3d(0.0)),
                         element(Vec3d(0.0), Vec3d(1, 0, 0), Vec3d(0, 1, 0), Vec3d(2.0)));
     const double v0 = moments(*s.density).mass;
@@ -78,13 +76,7 @@ TEST(Morph, IdenticalSidesGiveTheSourceAtEveryFrame)
 
 TEST(Morph, EndsAreSourceAndTarget)
 {
-    ObjectTransform xf;
-    xf.scale = Vec3d(0.1);
-    const double voxel = 0.02;
-    const VolumeSet s = voxelized("bunny.obj", voxel, xf);
-    ObjectTransform up;
-    up.translate = Vec3d(0, 0.5, 0);
-    const VolumeSet d = voxelized("knot1.off", voxel, up);
+    const auto [s, d] = defaultSceneObjects(0.02);
     const Scene scene =
         loadScene(std::filesystem::path(VOLMORPH_SOURCE_DIR) / "scenes" / "bunny-to-knot.toml");
     BlendSpec blend = scene.blend;
@@ -99,10 +91,7 @@ namespace {
 /// The unit cube scaled by 0.7 and moved by `translate` (world units), voxelized.
 VolumeSet smallCubeAt(const Vec3d& translate, double voxel)
 {
-    ObjectTransform xf;
-    xf.translate = translate;
-    xf.scale = Vec3d(0.7);
-    return voxelized("cube.obj", voxel, xf);
+    return voxelized("cube.obj", voxel, placed(translate, 0.7));
 }
 
 } // namespace

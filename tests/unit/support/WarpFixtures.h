@@ -56,12 +56,31 @@ inline FeaturePairSpec pair(FeatureType type, const FeatureElement& s, const Fea
     return p;
 }
 
+/// A mesh's placement: scaled by `scale` about the origin, then moved by `translate` (world units).
+inline ObjectTransform placed(const Vec3d& translate, double scale = 1.0)
+{
+    ObjectTransform xf;
+    xf.translate = translate;
+    xf.scale = Vec3d(scale);
+    return xf;
+}
+
 inline VolumeSet voxelized(const std::string& mesh, double voxelSize,
                            const ObjectTransform& xf = {})
 {
     VoxelizeOptions o;
     o.voxelSize = voxelSize;
     return voxelize(importMesh(kMeshes / mesh, xf), o);
+}
+
+/// The default scene's two objects (scenes/bunny-to-knot.toml), voxelized.
+struct VolumePair {
+    VolumeSet source, target;
+};
+inline VolumePair defaultSceneObjects(double voxelSize)
+{
+    return {voxelized("bunny.obj", voxelSize, placed(Vec3d(0.0), 0.1)),
+            voxelized("knot1.off", voxelSize, placed(Vec3d(0, 0.5, 0)))};
 }
 
 struct Moments {

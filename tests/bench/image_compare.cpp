@@ -1,10 +1,12 @@
-// How far an image is from a reference render, and how much of the difference is striation at the
-// voxel scale: the difference of relative luminance Y (Rec. 709 weights; 1 = white) over the pixels
-// the reference covers (alpha above MIN_ALPHA, default 0.1), mean and 99th percentile, and the
-// difference image's power at periods from 2 pixels to 3 voxels in any direction (a 2D DFT). The
-// shadow cache's lattice lies in the light's frame, so its stripes run at any angle. Used by
-// striations.sh.
-// usage: volmorph_bench_striation_power IMAGE.exr REFERENCE.exr PIXELS_PER_VOXEL [MIN_ALPHA]
+// How far an image is from a reference render, over the pixels the reference covers (alpha above
+// MIN_ALPHA, default 0.1):
+// - the difference of relative luminance Y (Rec. 709 weights; 1 = white), mean and 99th percentile;
+// - the relative RGB difference, sum |a - b| / sum b over the three channels of every covered pixel
+//   (noise and bias), and the relative bias sum a / sum b - 1;
+// - the difference image's power at periods from 2 pixels to 3 voxels in any direction (a 2D DFT):
+//   the shadow cache's lattice lies in the light's frame, so its stripes run at any angle.
+// Used by striations.sh and cycles_compare.sh.
+// usage: volmorph_bench_image_compare IMAGE.exr REFERENCE.exr PIXELS_PER_VOXEL [MIN_ALPHA]
 #include <OpenImageIO/imagebuf.h>
 
 #include <algorithm>
@@ -94,10 +96,11 @@ int main(int argc, char** argv)
         return 1;
     }
     // Periods from 2 pixels (Nyquist) to 3 voxels: the shadow cache's lattice and its harmonics.
-    const double pixelsPerVoxel = std::atof(argv[3]), minAlpha = argc > 4 ? std::atof(argv[4]) : 0.1;
+    const double pixelsPerVoxel = std::atof(argv[3]),
+                 minAlpha = argc > 4 ? std::atof(argv[4]) : 0.1;
     const int w = image.width, h = image.height;
     std::vector<double> absolute, diff(size_t(w) * h, 0.0);
-    double meanY = 0.0;
+    double meanY = 0.0, absRgb = 0.0, sumA = 0.0, sumB = 0.0;
     for (size_t i = 0; i < diff.size(); ++i) {
         const float* a = &image.rgba[4 * i];
         const float* b = &reference.rgba[4 * i];
@@ -105,6 +108,11 @@ int main(int argc, char** argv)
         if (b[3] > minAlpha) {
             absolute.push_back(std::abs(diff[i]));
             meanY += luminance(b);
+            for (int c = 0; c < 3; ++c) {
+                absRgb += std::abs(double(a[c]) - double(b[c]));
+                sumA += a[c];
+                sumB += b[c];
+            }
         }
     }
     if (absolute.empty()) {
@@ -118,8 +126,8 @@ int main(int argc, char** argv)
     mean /= double(absolute.size());
     const double p99 = absolute[size_t(0.99 * double(absolute.size() - 1))];
     const double power = bandPower(diff, w, h, 2.0, 3.0 * pixelsPerVoxel);
-    std::printf("pixels %zu (mean Y %.4f)  |dY|: mean %.5f p99 %.5f  band power (2 px to 3 voxels) "
-                "%.3e\n",
-                absolute.size(), meanY, mean, p99, power);
+    std::printf("pixels %zu (mean Y %.4f)  |dY|: mean %.5f p99 %.5f  relative RGB: difference %.4f "
+                "bias %+.4f  band power (2 px to 3 voxels) %.3e\n",
+                absolute.size(), meanY, mean, p99, absRgb / sumB, sumA / sumB - 1.0, power);
     return 0;
 }

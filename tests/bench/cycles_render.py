@@ -1,0 +1,172 @@
+"""Renders a .vdb with Blender Cycles as volmorph's render-vdb would: the anchor of issue 33.
+
+usage: blender -b --factory-startup --python tests/bench/cycles_render.py -- IN.vdb OUT.exr
+           --voxel V --eye X,Y,Z --lookat X,Y,Z --fov DEG --res WxH --extinction S --albedo A
+           [--color-grid Cd] [--sun DX,DY,DZ,STRENGTH[,R,G,B]] [--sky R,G,B] [--bounces N]
+           [--samples N] [--step-rate R] [--threads N]
+
+Every vector is in volmorph's frame (y up, world units); the sun's direction is the way its light
+travels, its strength the irradiance (Cycles' sun strength, as volmorph's intensity). As NOTES.md
+says: Blender places OpenVDB voxel (i, j, k) at (i + 0.5) voxel sizes, so the volume moves by half a
+voxel back; Blender is z up, so the volume and every vector turn 90 degrees about x. The medium is a
+Principled Volume whose Density multiplies the grid (extinction per world unit), Color is the
+albedo (times the colour grid when given) and Absorption Color is black: extinction = Density,
+albedo = Color. Linear interpolation, a box pixel filter one pixel wide (volmorph's stratified
+samples), a transparent film (RGB premultiplied, A = coverage), no denoising, float EXR.
+"""
+import argparse
+import math
+import sys
+import time
+
+import bpy
+import mathutils
+
+
+def vec(text, n=3):
+    values = [float(v) for v in text.split(",")]
+    if len(values) < n:
+        raise SystemExit("expected %d numbers, got %r" % (n, text))
+    return values
+
+
+def to_blender(v):
+    """y-up (x, y, z) -> z-up (x, -z, y): a turn of 90 degrees about x."""
+    return mathutils.Vector((v[0], -v[2], v[1]))
+
+
+def parse():
+    argv = sys.argv[sys.argv.index("--") + 1:] if "--" in sys.argv else []
+    p = argparse.ArgumentParser()
+    p.add_argument("vdb")
+    p.add_argument("out")
+    p.add_argument("--voxel", type=float, required=True)
+    p.add_argument("--grid", default="density")
+    p.add_argument("--color-grid", default="")
+    p.add_argument("--eye", required=True)
+    p.add_argument("--lookat", required=True)
+    p.add_argument("--fov", type=float, default=40.0)
+    p.add_argument("--res", default="640x360")
+    p.add_argument("--extinction", type=float, required=True)
+    p.add_argument("--albedo", type=float, default=0.8)
+    p.add_argument("--anisotropy", type=float, default=0.0)
+    p.add_argument("--sun", default="")
+    p.add_argument("--sky", default="")
+    p.add_argument("--bounces", type=int, default=16)
+    p.add_argument("--samples", type=int, default=64)
+    p.add_argument("--step-rate", type=float, default=0.1)
+    p.add_argument("--threads", type=int, default=2)
+    return p.parse_args(argv)
+
+
+def volume_object(args):
+    bpy.ops.object.volume_import(filepath=args.vdb, align="WORLD", location=(0, 0, 0))
+    obj = bpy.context.selected_objects[0]
+    obj.rotation_euler = (math.pi / 2, 0.0, 0.0)
+    obj.location = to_blender([-0.5 * args.voxel] * 3)
+    mat = bpy.data.materials.new("medium")
+    mat.use_nodes = True
+    mat.cycles.volume_interpolation = "LINEAR"
+    nodes, links = mat.node_tree.nodes, mat.node_tree.links
+    nodes.clear()
+    out = nodes.new("ShaderNodeOutputMaterial")
+    pv = nodes.new("ShaderNodeVolumePrincipled")
+    pv.inputs["Density"].default_value = args.extinction
+    pv.inputs["Density Attribute"].default_value = args.grid
+    pv.inputs["Absorption Color"].default_value = (0.0, 0.0, 0.0, 1.0)
+    pv.inputs["Anisotropy"].default_value = args.anisotropy
+    a = args.albedo
+    if args.color_grid:
+        attr = nodes.new("ShaderNodeAttribute")
+        attr.attribute_name = args.color_grid
+        mix = nodes.new("ShaderNodeMixRGB")
+        mix.blend_type = "MULTIPLY"
+        mix.inputs["Fac"].default_value = 1.0
+        mix.inputs["Color2"].default_value = (a, a, a, 1.0)
+        links.new(attr.outputs["Color"], mix.inputs["Color1"])
+        links.new(mix.outputs["Color"], pv.inputs["Color"])
+    else:
+        pv.inputs["Color"].default_value = (a, a, a, 1.0)
+    links.new(pv.outputs["Volume"], out.inputs["Volume"])
+    obj.data.materials.append(mat)
+
+
+def camera(args, width):
+    cam = bpy.data.cameras.new("camera")
+    cam.sensor_fit = "HORIZONTAL"
+    cam.angle = math.radians(args.fov)
+    cam.clip_start = 1e-3
+    obj = bpy.data.objects.new("camera", cam)
+    bpy.context.scene.collection.objects.link(obj)
+    eye, lookat = to_blender(vec(args.eye)), to_blender(vec(args.lookat))
+    obj.location = eye
+    obj.rotation_euler = (lookat - eye).to_track_quat("-Z", "Y").to_euler()
+    bpy.context.scene.camera = obj
+
+
+def lights(args):
+    if args.sun:
+        s = vec(args.sun, 4)
+        sun = bpy.data.lights.new("sun", "SUN")
+        sun.energy = s[3]
+        sun.angle = 0.0
+        if len(s) >= 7:
+            sun.color = s[4:7]
+        obj = bpy.data.objects.new("sun", sun)
+        bpy.context.scene.collection.objects.link(obj)
+        obj.rotation_euler = to_blender(s[:3]).to_track_quat("-Z", "Y").to_euler()
+    world = bpy.data.worlds.new("world")
+    world.use_nodes = True
+    bg = world.node_tree.nodes["Background"]
+    sky = vec(args.sky) if args.sky else [0.0, 0.0, 0.0]
+    bg.inputs["Color"].default_value = (sky[0], sky[1], sky[2], 1.0)
+    bg.inputs["Strength"].default_value = 1.0
+    bpy.context.scene.world = world
+
+
+def settings(args):
+    scene = bpy.context.scene
+    scene.render.engine = "CYCLES"
+    c = scene.cycles
+    c.device = "CPU"
+    c.samples = args.samples
+    c.use_adaptive_sampling = False
+    c.use_denoising = False
+    c.max_bounces = args.bounces + 1
+    c.volume_bounces = args.bounces
+    c.diffuse_bounces = c.glossy_bounces = c.transmission_bounces = 0
+    # A volume's boundary is a transparent surface to Cycles' shadow rays: with no transparent
+    # bounces the sun would never reach the inside.
+    c.transparent_max_bounces = 256
+    c.volume_step_rate = args.step_rate
+    c.volume_max_steps = 100000
+    c.pixel_filter_type = "BOX"
+    c.filter_width = 1.0
+    c.seed = 0
+    scene.render.film_transparent = True
+    w, h = (int(v) for v in args.res.split("x"))
+    scene.render.resolution_x, scene.render.resolution_y = w, h
+    scene.render.resolution_percentage = 100
+    scene.render.threads_mode = "FIXED"
+    scene.render.threads = args.threads
+    scene.view_settings.view_transform = "Standard"
+    scene.render.image_settings.file_format = "OPEN_EXR"
+    scene.render.image_settings.color_mode = "RGBA"
+    scene.render.image_settings.color_depth = "32"
+    scene.render.filepath = args.out
+    return w
+
+
+def main():
+    args = parse()
+    bpy.ops.wm.read_factory_settings(use_empty=True)
+    width = settings(args)
+    volume_object(args)
+    camera(args, width)
+    lights(args)
+    start = time.time()
+    bpy.ops.render.render(write_still=True)
+    print("cycles: rendered %s in %.2f s" % (args.out, time.time() - start))
+
+
+main()
