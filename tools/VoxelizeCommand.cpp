@@ -27,7 +27,12 @@ struct VoxelizeArgs {
 
 int runVoxelize(const VoxelizeArgs& args)
 {
+    // Signals are caught from the start: one arriving while the mesh is read (Assimp cannot be
+    // asked to stop) ends the command right after it, with status 130 like any other.
+    Interrupter interrupter(!args.quiet && isatty(fileno(stderr)));
+    StopSignals signals(interrupter);
     const Mesh mesh = importMesh(args.mesh);
+    if (interrupter.stopRequested()) throw Interrupted();
     VoxelizeOptions options;
     options.voxelSize = args.voxelSize;
     if (args.resolution) options.resolution = *args.resolution;
@@ -43,8 +48,6 @@ int runVoxelize(const VoxelizeArgs& args)
     if (!std::filesystem::is_directory(folder, ec))
         throw UserError(SourceLocation{args.output}, "the output folder does not exist");
 
-    Interrupter interrupter(!args.quiet && isatty(fileno(stderr)));
-    StopSignals signals(interrupter);
     VoxelizeStats stats;
     const auto start = std::chrono::steady_clock::now();
     const VolumeSet volumes = voxelize(mesh, options, &interrupter, &stats);
