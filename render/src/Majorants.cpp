@@ -72,21 +72,12 @@ MajorantWalk::MajorantWalk(const Majorants& majorants, Majorants::Accessor& acc,
                            const Vec3d& dir, double t)
     : mAcc(acc), mBlockRay{eye / 8.0, dir / 8.0, false}
 {
+    // The ray's span inside the blocks' box (index space), by OpenVDB's slab test.
     const CoordBBox& b = majorants.bounds();
-    mT = t;
-    mEnd = b.empty() ? t : std::numeric_limits<double>::infinity();
-    // The ray's span inside the blocks' box (index space, slabs).
-    for (int a = 0; a < 3 && mT < mEnd; ++a) {
-        const double lo = 8.0 * b.min()[a], hi = 8.0 * (b.max()[a] + 1);
-        if (dir[a] == 0.0) {
-            if (eye[a] < lo || eye[a] >= hi) mEnd = mT;
-            continue;
-        }
-        double ta = (lo - eye[a]) / dir[a], tb = (hi - eye[a]) / dir[a];
-        if (ta > tb) std::swap(ta, tb);
-        mT = std::max(mT, ta);
-        mEnd = std::min(mEnd, tb);
-    }
+    const VdbRay ray(eye, dir, t, std::numeric_limits<double>::max());
+    const openvdb::math::BBox<Vec3d> box(b.min().asVec3d() * 8.0,
+                                         (b.max().asVec3d() + Vec3d(1.0)) * 8.0);
+    if (b.empty() || !ray.intersects(box, mT, mEnd)) mT = mEnd = t;
     if (mT < mEnd) mDda.start(mBlockRay, mT);
 }
 

@@ -10,11 +10,6 @@
 namespace volmorph::render {
 namespace {
 
-Vec3d times(const Vec3d& a, const Vec3d& b)
-{
-    return Vec3d(a.x() * b.x(), a.y() * b.y(), a.z() * b.z());
-}
-
 /// A direction drawn from the Henyey-Greenstein phase function around the travel direction `d`
 /// (unit): cos(d, result) has density proportional to HG(g), by inverting its distribution.
 Vec3d sampleHenyeyGreenstein(const Vec3d& d, double g, double u1, double u2)
@@ -91,16 +86,16 @@ public:
     {
         Vec3d L(0.0), beta(1.0);
         for (int vertex = 0;; ++vertex) {
-            L += times(beta, mIn.medium.emission);
-            beta = times(beta, albedoAt(ip));
+            L += beta * mIn.medium.emission;
+            beta = beta * albedoAt(ip);
             if (beta.x() <= 0.0 && beta.y() <= 0.0 && beta.z() <= 0.0) break;
-            L += times(beta, directLight(ip, dir));
+            L += beta * directLight(ip, dir);
             if (vertex == mIn.bounces && mIn.environment == Vec3d(0.0)) break;
             if (vertex >= 2 && !survives(beta)) break;
             dir =
                 sampleHenyeyGreenstein(dir, mIn.medium.anisotropy, mRandom.next(), mRandom.next());
             if (!track(ip, dir)) {
-                L += times(beta, mIn.environment);
+                L += beta * mIn.environment;
                 break;
             }
             if (vertex == mIn.bounces) break;
