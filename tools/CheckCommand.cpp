@@ -137,9 +137,13 @@ void printSettings(const Scene& scene)
         r.width, r.height, r.samples, fmt(r.stepVoxels).c_str(), fmt(r.extinction).c_str(),
         fmt(r.albedo).c_str());
     if (r.bounces > 0)
-        std::printf("        multiple scattering, %d bounces\n", r.bounces);
+        std::printf("        multiple scattering, %d bounces", r.bounces);
     else
-        std::printf("        single scattering (bounces = 0)\n");
+        std::printf("        single scattering (bounces = 0)");
+    if (r.shadowCacheVoxels > 0)
+        std::printf("; shadow caches every %d voxels\n", r.shadowCacheVoxels);
+    else
+        std::printf("; exact transmittance toward lights\n");
 }
 
 /// The camera, the emission and the lights (with their animation keys).

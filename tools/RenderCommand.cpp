@@ -40,7 +40,7 @@ struct RenderVdbArgs {
     std::vector<double> translate, lookat, up{0, 1, 0}, light, emission, env;
     double fov = 2.0 * std::atan(41.2136 / 100.0) * 180.0 / M_PI, frameWidth = 0.0,
            extinction = 40.0, albedo = 0.8, step = 1.0;
-    int shadowCache = 2;
+    int shadowCache = 1;
     int samples = 1, threads = 0, bounces = 0;
     double memoryLimitGiB = 0.0;
     bool floatExr = false, verbose = false;

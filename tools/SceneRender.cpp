@@ -32,6 +32,7 @@ SceneRender::SceneRender(const Scene& scene, int threads, int width)
     medium.emission = r.emission;
     settings.samples = r.samples;
     settings.stepVoxels = r.stepVoxels;
+    settings.shadowCacheVoxels = r.shadowCacheVoxels;
     settings.bounces = r.bounces;
     settings.seed = r.seed;
     settings.threads = threads;

@@ -2,7 +2,7 @@
 # Striations from the shadow cache (issue 33): the default scene's frame 12, morphed at ACROSS voxels
 # across, rendered by render-vdb through an orthographic window 100 voxels wide at the object's
 # centre (4 pixels per voxel, one ray through each pixel centre, so nothing but the transmittance
-# differs) with the scene's medium and sun, at shadow-cache spacings 2 (the old default) and 1,
+# differs) with the scene's medium and sun, at shadow-cache spacings 2 (the old default) and 1 (the default),
 # against the exact transmittance per sample (--shadow-cache 0). Prints each render's time and, per
 # spacing, the difference of relative luminance Y to the exact render (mean, 99th percentile over
 # pixels with alpha > 0.1) and the difference's power at periods from 2 pixels to 3 voxels.

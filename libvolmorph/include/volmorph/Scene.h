@@ -149,6 +149,8 @@ struct RenderSpec {
     /// Volume scattering events after the first, as Cycles' volume bounces: 0 (the default, the
     /// fast path) is single scattering; more trace paths (multiple scattering).
     int bounces = 0;
+    /// Spacing of the transmittance caches toward lights, in voxels; 0: exact per sample.
+    int shadowCacheVoxels = 1;
     unsigned seed = 0;
     CameraSpec camera;
     std::vector<LightSpec> lights; ///< default: one directional light from above-front

@@ -9,9 +9,9 @@
 namespace volmorph::detail {
 namespace {
 
-const std::vector<std::string> kRenderKeys = {"resolution", "samples",    "step",   "extinction",
-                                              "albedo",     "anisotropy", "seed",   "camera",
-                                              "lights",     "emission",   "bounces"};
+const std::vector<std::string> kRenderKeys = {
+    "resolution", "samples", "step",   "extinction", "albedo",  "anisotropy",
+    "seed",       "camera",  "lights", "emission",   "bounces", "shadow_cache"};
 const std::vector<std::string> kCameraKeys = {"projection", "eye",   "lookat", "up",
                                               "fov",        "width", "keys"};
 const std::vector<std::string> kCameraKeyKeys = {"frame", "eye", "lookat", "up", "fov", "width"};
@@ -268,6 +268,8 @@ void parseRender(Reader& r, const toml::node& node, RenderSpec& rs)
             rs.seed = unsigned(*v);
     if (const toml::node* n = t->get("bounces"))
         if (auto v = r.integerIn(*n, "render.bounces", 0, 100000)) rs.bounces = int(*v);
+    if (const toml::node* n = t->get("shadow_cache"))
+        if (auto v = r.integerIn(*n, "render.shadow_cache", 0, 16)) rs.shadowCacheVoxels = int(*v);
     if (const toml::node* n = t->get("emission"))
         if (auto v = r.nonNegativeVec3(*n, "render.emission")) rs.emission = *v;
     if (const toml::node* n = t->get("camera")) parseCamera(r, *n, rs.camera);

@@ -529,3 +529,13 @@ TEST(Scene, BouncesAndAnEnvironmentLight)
     EXPECT_NE(d[0].message.find("directional, point, environment"), std::string::npos)
         << d[0].str();
 }
+
+TEST(Scene, ShadowCacheSpacing)
+{
+    EXPECT_EQ(parse(kMinimal).render.shadowCacheVoxels, 1); // the documented default
+    const std::string base = std::string(kMinimal) + "[render]\n";
+    EXPECT_EQ(parse(base + "shadow_cache = 0\n").render.shadowCacheVoxels, 0); // exact
+    EXPECT_EQ(parse(base + "shadow_cache = 3\n").render.shadowCacheVoxels, 3);
+    expectError(base + "shadow_cache = 17\n", 9, 16, "render.shadow_cache");
+    expectError(base + "shadow_cache = 1.5\n", 9, 16, "render.shadow_cache");
+}

@@ -69,7 +69,10 @@ struct RenderSettings {
     double stepVoxels = 0.5; ///< longest step of the scattering integral along a primary ray
     /// Shadow map and point-light grid spacing, in voxels (1 = every voxel); 0: no cache, the exact
     /// transmittance toward each light marched per sample (the reference the caches are judged by).
-    int shadowCacheVoxels = 2;
+    /// 1 by default: at 2 a lit surface came out 6% too bright against Cycles and exact marching,
+    /// with voxel-aligned striations; at 1 it is within 1% for a 16-bounce frame, for the same
+    /// time at 125 voxels across (BENCHMARKS.md, "The look, part 1").
+    int shadowCacheVoxels = 1;
     /// Scattering events after the first, as Cycles' volume bounces. 0 with no environment light:
     /// the single-scattering estimator above. Otherwise each sample traces a path (PathTracer.h in
     /// render/src: null-scattering path tracing against a majorant grid); the alpha is the same
