@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 namespace volmorph::render {
 namespace {
@@ -111,17 +112,58 @@ private:
     }
 
     /// Next-event estimation: every directional and point light's radiance scattered at ip toward
-    /// -dir, through the medium's transmittance toward the light.
+    /// -dir, through the medium's transmittance toward the light (ratio tracking: no shadow map,
+    /// no bias).
     Vec3d directLight(const Vec3d& ip, const Vec3d& dir)
     {
         Vec3d sum(0.0);
         for (size_t l = 0; l < mIn.lights.size(); ++l) {
-            if (mIn.lights[l].type == Light::Type::Environment) continue;
-            Vec3d phased;
-            const double T = lightArriving(mR, l, ip, dir, nullptr, phased);
-            sum += phased * T;
+            const Light& light = mIn.lights[l];
+            if (light.type == Light::Type::Environment) continue;
+            const double T = ratioTracking(ip, light);
+            if (T > 0.0) sum += lightPhased(mIn, l, ip, dir) * T;
         }
         return sum;
+    }
+
+    /// The transmittance from index point ip toward `light`, unbiased, by ratio tracking against
+    /// the majorants (Novak et al. 2014, as pbrt-v4): tentative collisions at the majorant's rate,
+    /// each multiplying the estimate by the chance that it is null, 1 - sigma_t / sigma_majorant.
+    /// Below 0.1 the estimate plays Russian roulette (survives with chance 1/2, doubled).
+    double ratioTracking(const Vec3d& ip, const Light& light)
+    {
+        const Vec3d p = mIn.density.indexToWorld(ip);
+        Vec3d toward = -light.direction.unit();
+        double distance = std::numeric_limits<double>::infinity(); // world units
+        if (light.type == Light::Type::Point) {
+            toward = light.position - p;
+            distance = toward.length();
+            toward /= distance;
+        }
+        Vec3d dir = mIn.density.worldToIndex(p + toward) - ip; // index units per world unit
+        const double scale = dir.length();
+        dir /= scale;
+        const double tMax = distance * scale; // voxels
+        MajorantWalk walk(*mIn.majorants, *mR.majorants, ip, dir, 0.0);
+        double T = 1.0, t0, t1;
+        float majorant;
+        while (walk.next(t0, t1, majorant) && t0 < tMax) {
+            if (majorant <= 0.0f) continue;
+            const double end = std::min(t1, tMax),
+                         sigmaMajorant = mIn.sigmaPerVoxel * double(majorant);
+            for (double t = t0;;) {
+                t -= std::log1p(-mRandom.next()) / sigmaMajorant;
+                if (t >= end) break;
+                const double sigma =
+                    mIn.sigmaPerVoxel * densityAt(mR.density, ip + dir * t, mIn.levelSet);
+                T *= 1.0 - sigma / sigmaMajorant;
+                if (T < 0.1) {
+                    if (mRandom.next() >= 0.5) return 0.0;
+                    T *= 2.0;
+                }
+            }
+        }
+        return T;
     }
 
     /// Russian roulette on the throughput's largest channel: false ends the path; a survivor's

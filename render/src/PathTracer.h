@@ -11,8 +11,8 @@
 // collisions at the majorant's rate, each real with probability sigma_t / sigma_majorant.
 //
 // At every real collision: emission, then the albedo (times the colour grid) scales the path's
-// throughput; next-event estimation toward every directional and point light (their transmittance
-// from the same shadow maps and caches the single-scattering estimator reads); then a new
+// throughput; next-event estimation toward every directional and point light, its transmittance
+// by ratio tracking against the same majorants (unbiased: no shadow map is built); then a new
 // direction from the Henyey-Greenstein phase function (sampled exactly, so its weight is 1). A path
 // that leaves the volume after a collision gathers the environment's radiance. A camera ray that
 // leaves without a collision shows the background, which is transparent (RGB premultiplied, A =

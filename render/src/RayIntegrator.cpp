@@ -45,28 +45,33 @@ double exactTransmittance(ThreadReaders& readers, const Light& light, const Vec3
 
 } // namespace
 
+Vec3d lightPhased(const FrameInputs& in, size_t l, const Vec3d& ip, const Vec3d& direction)
+{
+    const Light& light = in.lights[l];
+    if (light.type == Light::Type::Point) {
+        Vec3d travel = in.density.indexToWorld(ip) - light.position;
+        const double d2 = travel.lengthSqr();
+        travel /= std::sqrt(d2);
+        return light.color * (light.intensity / d2 *
+                              henyeyGreenstein(travel.dot(-direction), in.medium.anisotropy));
+    }
+    return light.color * (light.intensity * henyeyGreenstein(light.direction.unit().dot(-direction),
+                                                             in.medium.anisotropy));
+}
+
 double lightArriving(ThreadReaders& readers, size_t l, const Vec3d& ip, const Vec3d& direction,
                      const Vec3d* directional, Vec3d& phased)
 {
     const FrameInputs& in = readers.in;
     const Light& light = in.lights[l];
     const bool exact = !in.shadows[l].map && !in.shadows[l].cache;
-    if (light.type == Light::Type::Point) {
-        Vec3d travel = in.density.indexToWorld(ip) - light.position;
-        const double d2 = travel.lengthSqr();
-        travel /= std::sqrt(d2);
-        phased = light.color * (light.intensity / d2 *
-                                henyeyGreenstein(travel.dot(-direction), in.medium.anisotropy));
-        // The cache shares the density's origin, at `factor` times its voxel.
-        return exact ? exactTransmittance(readers, light, ip)
-                     : openvdb::tools::BoxSampler::sample(*readers.shadowCaches[l],
-                                                          ip * in.inverseFactor);
-    }
-    phased = directional ? *directional
-                         : light.color * (light.intensity *
-                                          henyeyGreenstein(light.direction.unit().dot(-direction),
-                                                           in.medium.anisotropy));
-    return exact ? exactTransmittance(readers, light, ip) : in.shadows[l].map->lookup(ip);
+    phased = directional && light.type != Light::Type::Point ? *directional
+                                                             : lightPhased(in, l, ip, direction);
+    if (exact) return exactTransmittance(readers, light, ip);
+    // The point light's cache shares the density's origin, at `factor` times its voxel.
+    return light.type == Light::Type::Point
+               ? openvdb::tools::BoxSampler::sample(*readers.shadowCaches[l], ip * in.inverseFactor)
+               : in.shadows[l].map->lookup(ip);
 }
 
 namespace {

@@ -62,10 +62,14 @@ struct ThreadReaders {
     explicit ThreadReaders(const FrameInputs& frame);
 };
 
+/// Light `l`'s (directional or point) colour times intensity, over the squared distance for a point
+/// light, times the phase function at index point ip from the light toward -direction (unit).
+Vec3d lightPhased(const FrameInputs& in, size_t l, const Vec3d& ip, const Vec3d& direction);
+
 /// What light `l` (directional or point) brings to index point ip for a path travelling along
-/// `direction` (unit): `phased` gets its colour times intensity (over distance squared for a point
-/// light) times the phase function toward -direction, `*directional` instead when given for a
-/// directional light (constant along a ray); returns the transmittance toward the light.
+/// `direction` (unit): `phased` gets lightPhased, or `*directional` when given for a directional
+/// light (constant along a ray); returns the transmittance toward the light, from its shadow map
+/// or cache, or marched exactly when it has none.
 double lightArriving(ThreadReaders& readers, size_t l, const Vec3d& ip, const Vec3d& direction,
                      const Vec3d* directional, Vec3d& phased);
 

@@ -92,19 +92,23 @@ void renderFrame(const openvdb::FloatGrid& density, const openvdb::Vec3SGrid* co
     const openvdb::BoolGrid::Ptr mask = rayMask(density, levelSet);
     const PaddedLeaves padded(density.tree());
     if (interrupted(settings.interrupter)) throw Interrupted();
-    stage(settings.interrupter, "render: shadows");
-    const std::vector<Shadow> shadows =
-        buildShadows(density, padded, *mask, levelSet, lights, sigmaPerVoxel,
-                     settings.shadowCacheVoxels, settings.interrupter);
-    if (interrupted(settings.interrupter)) throw Interrupted();
     Vec3d environment(0.0);
     for (const Light& light : lights)
         if (light.type == Light::Type::Environment) environment += light.color * light.intensity;
+    // Paths find their transmittance toward the lights by ratio tracking against the majorants;
+    // the single-scattering estimator reads shadow maps.
+    const bool paths = settings.tracePaths || settings.bounces > 0 || environment != Vec3d(0.0);
+    std::vector<Shadow> shadows(lights.size());
     std::unique_ptr<const Majorants> majorants;
-    if (settings.tracePaths || settings.bounces > 0 || environment != Vec3d(0.0)) {
+    if (paths) {
         stage(settings.interrupter, "render: majorants");
         majorants = std::make_unique<const Majorants>(density, padded, levelSet);
+    } else {
+        stage(settings.interrupter, "render: shadows");
+        shadows = buildShadows(density, padded, *mask, levelSet, lights, sigmaPerVoxel,
+                               settings.shadowCacheVoxels, settings.interrupter);
     }
+    if (interrupted(settings.interrupter)) throw Interrupted();
     const Intersector master(*mask);
     const FrameInputs frame{density,
                             color,

@@ -3,6 +3,8 @@
 // - the difference of relative luminance Y (Rec. 709 weights; 1 = white), mean and 99th percentile;
 // - the relative RGB difference, sum |a - b| / sum b over the three channels of every covered pixel
 //   (noise and bias), and the relative bias sum a / sum b - 1;
+// - the relative RMSE: the root mean square of a - b over those channels, over the mean of b (the
+//   noise measure of equal-RMSE speed comparisons);
 // - the difference image's power at periods from 2 pixels to 3 voxels in any direction (a 2D DFT):
 //   the shadow cache's lattice lies in the light's frame, so its stripes run at any angle.
 // Used by striations.sh and cycles_compare.sh.
@@ -89,7 +91,7 @@ int main(int argc, char** argv)
                  minAlpha = argc > 4 ? std::atof(argv[4]) : 0.1;
     const int w = image.width, h = image.height;
     std::vector<double> absolute, diff(size_t(w) * h, 0.0);
-    double meanY = 0.0, absRgb = 0.0, sumA = 0.0, sumB = 0.0;
+    double meanY = 0.0, absRgb = 0.0, sumA = 0.0, sumB = 0.0, squares = 0.0;
     for (size_t i = 0; i < diff.size(); ++i) {
         const float* a = &image.rgba[4 * i];
         const float* b = &reference.rgba[4 * i];
@@ -99,6 +101,7 @@ int main(int argc, char** argv)
             meanY += luminance(b);
             for (int c = 0; c < 3; ++c) {
                 absRgb += std::abs(double(a[c]) - double(b[c]));
+                squares += (double(a[c]) - double(b[c])) * (double(a[c]) - double(b[c]));
                 sumA += a[c];
                 sumB += b[c];
             }
@@ -115,8 +118,10 @@ int main(int argc, char** argv)
     mean /= double(absolute.size());
     const double p99 = absolute[size_t(0.99 * double(absolute.size() - 1))];
     const double power = bandPower(diff, w, h, 2.0, 3.0 * pixelsPerVoxel);
+    const double rmse = std::sqrt(squares / (3.0 * double(absolute.size()))) /
+                        (sumB / (3.0 * double(absolute.size())));
     std::printf("pixels %zu (mean Y %.4f)  |dY|: mean %.5f p99 %.5f  relative RGB: difference %.4f "
-                "bias %+.4f  band power (2 px to 3 voxels) %.3e\n",
-                absolute.size(), meanY, mean, p99, absRgb / sumB, sumA / sumB - 1.0, power);
+                "bias %+.4f rmse %.4f  band power (2 px to 3 voxels) %.3e\n",
+                absolute.size(), meanY, mean, p99, absRgb / sumB, sumA / sumB - 1.0, rmse, power);
     return 0;
 }

@@ -85,19 +85,25 @@ TEST(PathTracer, WhiteFurnace)
 TEST(PathTracer, ZeroBouncesAgreeWithTheSingleScatteringEstimator)
 {
     // A second method: one scattering event per path (bounces 0), traced, against the deterministic
-    // single-scattering march, under one directional light. Alpha is the same exact 1 - T.
+    // single-scattering march, under one directional light. Alpha is the same exact 1 - T. The
+    // march reads the exact transmittance toward the light (no shadow map), the paths estimate it
+    // by ratio tracking: both without bias.
     const int pixels = 32;
     const auto sphere = ball(64);
     render::Light sun;
     sun.direction = Vec3d(-1, -1, -0.5);
     sun.intensity = 3.0;
     render::RenderSettings settings;
-    settings.samples = 1024;
-    settings.shadowCacheVoxels = 1;
+    settings.samples = 16; // the march is deterministic but for the pixel jitter
+    settings.shadowCacheVoxels = 0;
     const render::Medium medium = body(4.0, 0.8);
     const render::Image marched =
         render::renderVolume(*sphere, nullptr, orthoDown(1.2, pixels), {sun}, medium, settings);
     settings.tracePaths = true;
+    // The same pixel positions as the march: the same alpha.
+    const render::Image tracedFew =
+        render::renderVolume(*sphere, nullptr, orthoDown(1.2, pixels), {sun}, medium, settings);
+    settings.samples = 1024;
     const render::Image traced =
         render::renderVolume(*sphere, nullptr, orthoDown(1.2, pixels), {sun}, medium, settings);
     double sumMarched = 0.0, sumTraced = 0.0, worstAlpha = 0.0;
@@ -106,7 +112,7 @@ TEST(PathTracer, ZeroBouncesAgreeWithTheSingleScatteringEstimator)
             sumMarched += marched.at(x, y)[1];
             sumTraced += traced.at(x, y)[1];
             worstAlpha =
-                std::max(worstAlpha, double(std::abs(marched.at(x, y)[3] - traced.at(x, y)[3])));
+                std::max(worstAlpha, double(std::abs(marched.at(x, y)[3] - tracedFew.at(x, y)[3])));
         }
     std::printf("single scattering: marched %.5f, traced %.5f (mean G), alpha diff %.1e\n",
                 sumMarched / (pixels * pixels), sumTraced / (pixels * pixels), worstAlpha);

@@ -67,8 +67,10 @@ struct Medium {
 struct RenderSettings {
     int samples = 4;         ///< per pixel, stratified and jittered; 1 = through the pixel centre
     double stepVoxels = 0.5; ///< longest step of the scattering integral along a primary ray
-    /// Shadow map and point-light grid spacing, in voxels (1 = every voxel); 0: no cache, the exact
-    /// transmittance toward each light marched per sample (the reference the caches are judged by).
+    /// The single-scattering estimator's shadow map and point-light grid spacing, in voxels (1 =
+    /// every voxel); 0: no cache, the exact transmittance toward each light marched per sample (the
+    /// reference the caches are judged by). Traced paths need none: they estimate the
+    /// transmittance toward lights by ratio tracking, without bias.
     /// 1 by default: at 2 a lit surface came out 6% too bright against Cycles and exact marching,
     /// with voxel-aligned striations; at 1 it is within 1% for a 16-bounce frame, for the same
     /// time at 125 voxels across (BENCHMARKS.md, "The look, part 1").
