@@ -29,7 +29,7 @@ now() { date +%s.%N; }
 polls=$(awk -v l="$limit" 'BEGIN { printf "%d", 3000 * (l > 1 ? l : 1) }')
 wait_for() {
     i=0
-    until grep -q "$1" "$dir/err"; do
+    until grep -qs "$1" "$dir/err"; do
         kill -0 "$pid" 2>/dev/null || fail "the command ended before \"$1\""
         i=$((i + 1))
         [ $i -lt "$polls" ] || fail "\"$1\" never came"
@@ -66,6 +66,7 @@ kill -0 "$pid" 2>/dev/null || fail "render-vdb had finished before the signal; n
 stop TERM "render-vdb at 1920x1080, 256 samples"
 
 # 2. While the shadow maps are built.
+rm -f "$dir/err"
 "$volmorph" render-vdb "$dir/bunny.vdb" --grid density -o "$dir/out/frame.exr" --res 64x36 --samples 1 \
     --shadow-cache 1 -v 2>"$dir/err" >/dev/null &
 pid=$!
@@ -85,6 +86,9 @@ for command in render morph preview; do
         morph) set -- morph "$dir/scene.toml" --frames 1 -o "$dir/out/f.####.vdb" ;;
         preview) set -- preview "$dir/scene.toml" --frame 1 -o "$dir/out/preview.png" ;;
     esac
+    # The last command's log goes first: wait_for could otherwise read it before the shell truncates
+    # the file for this one, and signal a process that has no handler yet (exit 143).
+    rm -f "$dir/err"
     "$volmorph" "$@" -v 2>"$dir/err" >/dev/null &
     pid=$!
     wait_for "frame 1: morph"
