@@ -5,6 +5,7 @@
 #include <volmorph/Schedule.h>
 #include <volmorph/Voxelize.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <memory>
@@ -140,7 +141,14 @@ void printSettings(const Scene& scene)
         std::printf("        multiple scattering, %d bounces", r.bounces);
     else
         std::printf("        single scattering (bounces = 0)");
-    if (r.shadowCacheVoxels > 0)
+    const bool paths = r.bounces > 0 || std::any_of(r.lights.begin(), r.lights.end(), [](auto& l) {
+                           return l.type == LightType::Environment;
+                       });
+    if (paths)
+        std::printf("; paths, ratio tracking toward lights\n");
+    else if (r.shadowCacheVoxels == 1)
+        std::printf("; shadow caches every voxel\n");
+    else if (r.shadowCacheVoxels > 1)
         std::printf("; shadow caches every %d voxels\n", r.shadowCacheVoxels);
     else
         std::printf("; exact transmittance toward lights\n");
