@@ -6,7 +6,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <limits>
 
 namespace volmorph::render {
 namespace {
@@ -133,13 +132,8 @@ private:
     double ratioTracking(const Vec3d& ip, const Light& light)
     {
         const Vec3d p = mIn.density.indexToWorld(ip);
-        Vec3d toward = -light.direction.unit();
-        double distance = std::numeric_limits<double>::infinity(); // world units
-        if (light.type == Light::Type::Point) {
-            toward = light.position - p;
-            distance = toward.length();
-            toward /= distance;
-        }
+        double distance; // world units
+        const Vec3d toward = towardLight(light, p, distance);
         Vec3d dir = mIn.density.worldToIndex(p + toward) - ip; // index units per world unit
         const double scale = dir.length();
         dir /= scale;

@@ -24,6 +24,17 @@ ThreadReaders::ThreadReaders(const FrameInputs& frame)
             shadowCaches[l] = std::make_unique<CacheAccessor>(frame.shadows[l].cache->tree());
 }
 
+Vec3d towardLight(const Light& light, const Vec3d& p, double& distance)
+{
+    if (light.type != Light::Type::Point) {
+        distance = 1e30;
+        return -light.direction.unit();
+    }
+    const Vec3d toward = light.position - p;
+    distance = toward.length();
+    return toward / distance;
+}
+
 namespace {
 
 /// The exact transmittance from index point ip toward `light` (no shadow map or cache: the march
@@ -32,13 +43,8 @@ double exactTransmittance(ThreadReaders& readers, const Light& light, const Vec3
 {
     const FrameInputs& in = readers.in;
     const Vec3d p = in.density.indexToWorld(ip);
-    Vec3d toward = -light.direction.unit();
-    double distance = 1e30;
-    if (light.type == Light::Type::Point) {
-        toward = light.position - p;
-        distance = toward.length();
-        toward /= distance;
-    }
+    double distance;
+    const Vec3d toward = towardLight(light, p, distance);
     return std::exp(-opticalDepth(readers.shadowInter, in.levelSet, readers.shadowDensity, p,
                                   toward, distance, in.sigmaPerVoxel));
 }

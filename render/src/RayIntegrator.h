@@ -62,6 +62,10 @@ struct ThreadReaders {
     explicit ThreadReaders(const FrameInputs& frame);
 };
 
+/// The unit world direction from world point p toward `light` (directional or point); `distance`
+/// gets the world distance to it, 1e30 (beyond any grid) for a directional light.
+Vec3d towardLight(const Light& light, const Vec3d& p, double& distance);
+
 /// Light `l`'s (directional or point) colour times intensity, over the squared distance for a point
 /// light, times the phase function at index point ip from the light toward -direction (unit).
 Vec3d lightPhased(const FrameInputs& in, size_t l, const Vec3d& ip, const Vec3d& direction);
