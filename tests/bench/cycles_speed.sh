@@ -13,19 +13,16 @@
 #        defaults: build 160x90 64 64 16 (RES and BOUNCES must be those of REF); REF_CYCLES and
 #        REF_VOLMORPH: the references' samples
 set -eu
+: "${REF:?REF=DIR: the converged images (cycles_compare.sh with OUT=DIR at many samples)}"
 build=${1:-build}
-res=${2:-160x90}
 cycles_samples=${3:-64}
 volmorph_samples=${4:-64}
-bounces=${5:-16}
-src=$(cd "$(dirname "$0")/../.." && pwd)
-: "${REF:?REF=DIR: the converged images (cycles_compare.sh with OUT=DIR at many samples)}"
 compare=$build/tests/bench/volmorph_bench_image_compare
 out=$(mktemp -d)
 trap 'rm -rf "$out"' EXIT
 
-OUT=$out sh "$src/tests/bench/cycles_compare.sh" "$build" "$res" "$cycles_samples" \
-    "$volmorph_samples" "$bounces" >"$out/log" 2>&1 || { cat "$out/log"; exit 1; }
+OUT=$out sh "$(dirname "$0")/cycles_compare.sh" "$build" "${2:-160x90}" "$cycles_samples" \
+    "$volmorph_samples" "${5:-16}" >"$out/log" 2>&1 || { cat "$out/log"; exit 1; }
 tv=$(sed -n 's/^volmorph (\([0-9.]*\) s.*/\1/p' "$out/log")
 tc=$(sed -n 's/^cycles: rendered .* in \([0-9.]*\) s.*/\1/p' "$out/log")
 ev=$("$compare" "$out/volmorph.exr" "$REF/volmorph.exr" 1 | sed -n 's/.* rmse \([0-9.]*\) .*/\1/p')

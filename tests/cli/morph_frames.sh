@@ -3,16 +3,13 @@
 # chunk of frames is identical, bit for bit, to the same frames of a full run.
 # usage: morph_frames.sh VOLMORPH SOURCE_DIR
 set -eu
-volmorph=$1
-scene=$2/scenes/sphere-to-box.toml
-out=$(mktemp -d)
-trap 'rm -rf "$out"' EXIT
+. "$(dirname "$0")/lib.sh"
+scene=$src/scenes/sphere-to-box.toml
 
 "$volmorph" morph "$scene" -o "$out/full/m.####.vdb" -q
 "$volmorph" morph "$scene" --frames 1-3x2 -o "$out/chunk/m.####.vdb" -q
-ls "$out/full" | tr '\n' ' ' | grep -q "m.0000.vdb m.0001.vdb m.0002.vdb m.0003.vdb m.0004.vdb" \
-    || { echo "full run wrote: $(ls "$out/full")"; exit 1; }
-[ "$(ls "$out/chunk" | tr '\n' ' ')" = "m.0001.vdb m.0003.vdb " ] || { echo "chunk wrote: $(ls "$out/chunk")"; exit 1; }
+expect_files "$out/full" "m.0000.vdb m.0001.vdb m.0002.vdb m.0003.vdb m.0004.vdb"
+expect_files "$out/chunk" "m.0001.vdb m.0003.vdb"
 # Every file header holds a fresh UUID, so compare contents: every active value, bit for bit.
 if /usr/bin/python3 -c 'import pyopenvdb' 2>/dev/null; then
     for f in 0001 0003; do

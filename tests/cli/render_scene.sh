@@ -3,14 +3,11 @@
 # pixel; --skip-existing leaves finished frames alone and redoes a truncated one.
 # usage: render_scene.sh VOLMORPH SOURCE_DIR
 set -eu
-volmorph=$1
-scene=$2/scenes/sphere-to-box.toml
-out=$(mktemp -d)
-trap 'rm -rf "$out"' EXIT
+. "$(dirname "$0")/lib.sh"
+scene=$src/scenes/sphere-to-box.toml
 
 "$volmorph" render "$scene" -o "$out/full/f.####.exr" -q
-[ "$(ls "$out/full" | tr '\n' ' ')" = "f.0000.exr f.0001.exr f.0002.exr f.0003.exr f.0004.exr " ] \
-    || { echo "full run wrote: $(ls "$out/full")"; exit 1; }
+expect_files "$out/full" "f.0000.exr f.0001.exr f.0002.exr f.0003.exr f.0004.exr"
 # Three chunks, as three farm tasks would run them (one with one thread): the frames of the full run.
 "$volmorph" render "$scene" --frames 0-1 -o "$out/chunk/f.####.exr" -q
 "$volmorph" render "$scene" --frames 2-3 -o "$out/chunk/f.####.exr" -q --threads 1

@@ -127,17 +127,11 @@ void parseCamera(Reader& r, const toml::node& node, CameraSpec& camera)
 /// nothing for an environment. `key` is the name of a key that may place a light.
 std::string misplaced(LightType type, const std::string& key)
 {
-    const bool wanted =
-        key == "direction" ? type == LightType::Directional : type == LightType::Point;
-    if (wanted) return "";
-    switch (type) {
-    case LightType::Directional:
-        return "a directional light has a direction, not a position";
-    case LightType::Point:
+    if (type == LightType::Environment) return "an environment light lights from every direction";
+    if (type == LightType::Point && key == "direction")
         return "a point light has a position, not a direction";
-    case LightType::Environment:
-        return "an environment light lights from every direction";
-    }
+    if (type == LightType::Directional && key == "position")
+        return "a directional light has a direction, not a position";
     return "";
 }
 

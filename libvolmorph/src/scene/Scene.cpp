@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cassert>
 #include <cmath>
+#include <iterator>
 #include <sstream>
 
 namespace volmorph {
@@ -33,17 +34,9 @@ bool ObjectTransform::isIdentity() const
 
 const char* toString(FeatureType type)
 {
-    switch (type) {
-    case FeatureType::Point:
-        return "point";
-    case FeatureType::Segment:
-        return "segment";
-    case FeatureType::Rectangle:
-        return "rectangle";
-    case FeatureType::Box:
-        return "box";
-    }
-    return "?";
+    static constexpr const char* kNames[] = {"point", "segment", "rectangle", "box"};
+    static_assert(std::size(kNames) == size_t(FeatureType::Box) + 1, "a name for each type");
+    return kNames[size_t(type)];
 }
 
 double FramesSpec::t(int frame) const

@@ -12,34 +12,26 @@
 #include <optional>
 #include <sstream>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace volmorph::detail {
 
 inline const char* typeName(const toml::node& n)
 {
-    switch (n.type()) {
-    case toml::node_type::table:
-        return "a table";
-    case toml::node_type::array:
-        return "an array";
-    case toml::node_type::string:
-        return "a string";
-    case toml::node_type::integer:
-        return "an integer";
-    case toml::node_type::floating_point:
-        return "a number";
-    case toml::node_type::boolean:
-        return "a boolean";
-    case toml::node_type::date:
-        return "a date";
-    case toml::node_type::time:
-        return "a time";
-    case toml::node_type::date_time:
-        return "a date-time";
-    default:
-        return "nothing";
-    }
+    using T = toml::node_type;
+    static constexpr std::pair<T, const char*> kNames[] = {{T::table, "a table"},
+                                                           {T::array, "an array"},
+                                                           {T::string, "a string"},
+                                                           {T::integer, "an integer"},
+                                                           {T::floating_point, "a number"},
+                                                           {T::boolean, "a boolean"},
+                                                           {T::date, "a date"},
+                                                           {T::time, "a time"},
+                                                           {T::date_time, "a date-time"}};
+    for (const auto& [type, name] : kNames)
+        if (n.type() == type) return name;
+    return "nothing";
 }
 
 inline std::string formatNumber(double v)

@@ -52,6 +52,12 @@ void expectError(const std::string& text, int line, int column, const std::strin
     EXPECT_NE(d[0].message.find(fragment), std::string::npos) << d[0].str();
 }
 
+/// expectError on the minimal scene followed by `added` (whose first line is the scene's line 9).
+void expectAddedError(const std::string& added, int line, int column, const std::string& fragment)
+{
+    expectError(std::string(kMinimal) + added, line, column, fragment);
+}
+
 std::string withPair(const std::string& pair)
 {
     return std::string(kMinimal) + "[[pair]]\n" + pair;
@@ -201,23 +207,22 @@ TEST(SceneErrors, SyntaxError)
 
 TEST(SceneErrors, UnknownKeySuggestsNearMiss)
 {
-    expectError(std::string(kMinimal) + "[warp]\nepsilom = 0.1\n", 9, 1, "did you mean 'epsilon'?");
+    expectAddedError("[warp]\nepsilom = 0.1\n", 9, 1, "did you mean 'epsilon'?");
 }
 
 TEST(SceneErrors, UnknownKeyListsChoicesWhenNothingIsClose)
 {
-    expectError(std::string(kMinimal) + "[frames]\nzzz = 1\n", 9, 1,
-                "expected one of: range, output");
+    expectAddedError("[frames]\nzzz = 1\n", 9, 1, "expected one of: range, output");
 }
 
 TEST(SceneErrors, WrongType)
 {
-    expectError(std::string(kMinimal) + "[render]\nresolution = \"640x480\"\n", 9, 14,
-                "render.resolution: expected [width, height] in pixels");
-    expectError(std::string(kMinimal) + "[warp]\nepsilon = \"small\"\n", 9, 11,
-                "warp.epsilon: expected a number, got a string");
-    expectError(std::string(kMinimal) + "[render]\ncamera = 3\n", 9, 10,
-                "render.camera: expected a table, got an integer");
+    expectAddedError("[render]\nresolution = \"640x480\"\n", 9, 14,
+                     "render.resolution: expected [width, height] in pixels");
+    expectAddedError("[warp]\nepsilon = \"small\"\n", 9, 11,
+                     "warp.epsilon: expected a number, got a string");
+    expectAddedError("[render]\ncamera = 3\n", 9, 10,
+                     "render.camera: expected a table, got an integer");
 }
 
 TEST(SceneErrors, OutOfRange)
@@ -227,18 +232,16 @@ TEST(SceneErrors, OutOfRange)
     expectError(base + "[volume]\nvoxel_size = -0.5\n", 6, 14, "positive length in world units");
     expectError(base + "[volume]\nvoxel_size = 0.0\n", 6, 14, "positive length in world units");
     expectError(base + "[volume]\nresolution = 2\n", 6, 14, "from 8 to 16384");
-    expectError(std::string(kMinimal) + "[render]\nsamples = 0\n", 9, 11, "from 1 to 65536");
-    expectError(std::string(kMinimal) + "[render]\ncamera = { fov = 180 }\n", 9, 18,
-                "0 < fov <= 179");
-    expectError(std::string(kMinimal) + "[render]\nanisotropy = -1\n", 9, 14, "-1 < g < 1");
+    expectAddedError("[render]\nsamples = 0\n", 9, 11, "from 1 to 65536");
+    expectAddedError("[render]\ncamera = { fov = 180 }\n", 9, 18, "0 < fov <= 179");
+    expectAddedError("[render]\nanisotropy = -1\n", 9, 14, "-1 < g < 1");
 }
 
 TEST(SceneErrors, NanAndInf)
 {
-    expectError(std::string(kMinimal) + "[warp]\nepsilon = nan\n", 9, 11,
-                "expected a finite number, got nan");
-    expectError(std::string(kMinimal) + "[render]\ncamera = { eye = [0, -inf, 5] }\n", 9, 22,
-                "render.camera.eye[1]: expected a finite number, got -inf");
+    expectAddedError("[warp]\nepsilon = nan\n", 9, 11, "expected a finite number, got nan");
+    expectAddedError("[render]\ncamera = { eye = [0, -inf, 5] }\n", 9, 22,
+                     "render.camera.eye[1]: expected a finite number, got -inf");
 }
 
 TEST(SceneErrors, ZeroScale)
@@ -315,42 +318,42 @@ TEST(SceneErrors, VoxelSizeAndResolutionExcludeEachOther)
 TEST(SceneErrors, FrameRanges)
 {
     for (const char* bad : {"\"1-\"", "\"x\"", "\"10-1\"", "\"\"", "\"1-2-3\"", "\"1 - 5\""})
-        expectError(std::string(kMinimal) + "[frames]\nrange = " + bad + "\noutput = \"o.#.exr\"\n",
-                    9, 9, "frames.range: expected \"FIRST-LAST\"");
+        expectAddedError(std::string("[frames]\nrange = ") + bad + "\noutput = \"o.#.exr\"\n", 9, 9,
+                         "frames.range: expected \"FIRST-LAST\"");
 }
 
 TEST(SceneErrors, OutputPattern)
 {
-    expectError(std::string(kMinimal) + "[frames]\nrange = \"1-3\"\noutput = \"frame.exr\"\n", 10,
-                10, "no frame number placeholder");
-    expectError(std::string(kMinimal) + "[frames]\noutput = \"frame.png\"\n", 9, 10,
-                "ending in .exr");
+    expectAddedError("[frames]\nrange = \"1-3\"\noutput = \"frame.exr\"\n", 10, 10,
+                     "no frame number placeholder");
+    expectAddedError("[frames]\noutput = \"frame.png\"\n", 9, 10, "ending in .exr");
 }
 
 TEST(SceneErrors, Schedules)
 {
-    expectError(std::string(kMinimal) + "[blend]\ndensity = \"sigmoid(-2)\"\n", 9, 11,
-                "0 < k <= 1000");
-    expectError(std::string(kMinimal) + "[blend]\ndensity = \"easein\"\n", 9, 11,
-                "unknown schedule");
-    expectError(std::string(kMinimal) +
-                    "[blend]\ncolor = [[0, 0], [0.5, 0.7], [0.6, 0.4], [1, 1]]\n",
-                9, 30, "tau must not decrease");
-    expectError(std::string(kMinimal) + "[blend]\ncolor = [[0, 0], [0.5, 0.7]]\n", 9, 9,
-                "ending at [1, 1]");
+    struct Bad {
+        const char* value; // of blend.density or blend.color, on the scene's line 9
+        int column;
+        const char* fragment;
+    };
+    for (const Bad& bad :
+         {Bad{"density = \"sigmoid(-2)\"", 11, "0 < k <= 1000"},
+          Bad{"density = \"easein\"", 11, "unknown schedule"},
+          Bad{"color = [[0, 0], [0.5, 0.7], [0.6, 0.4], [1, 1]]", 30, "tau must not decrease"},
+          Bad{"color = [[0, 0], [0.5, 0.7]]", 9, "ending at [1, 1]"}}) {
+        SCOPED_TRACE(bad.value);
+        expectAddedError(std::string("[blend]\n") + bad.value + "\n", 9, bad.column, bad.fragment);
+    }
 }
 
 TEST(SceneErrors, CameraAndLights)
 {
-    expectError(std::string(kMinimal) +
-                    "[render]\ncamera = { eye = [1, 1, 1], lookat = [1, 1, 1] }\n",
-                9, 10, "eye and lookat are the same point");
-    expectError(std::string(kMinimal) +
-                    "[render]\ncamera = { eye = [0, 5, 0], lookat = [0, 0, 0] }\n",
-                9, 10, "up is parallel to the view direction");
-    expectError(std::string(kMinimal) +
-                    "[render]\nlights = [ { type = \"directional\", direction = [0, 0, 0] } ]\n",
-                9, 48, "render.lights[1].direction: expected a non-zero direction");
+    expectAddedError("[render]\ncamera = { eye = [1, 1, 1], lookat = [1, 1, 1] }\n", 9, 10,
+                     "eye and lookat are the same point");
+    expectAddedError("[render]\ncamera = { eye = [0, 5, 0], lookat = [0, 0, 0] }\n", 9, 10,
+                     "up is parallel to the view direction");
+    expectAddedError("[render]\nlights = [ { type = \"directional\", direction = [0, 0, 0] } ]\n",
+                     9, 48, "render.lights[1].direction: expected a non-zero direction");
     const std::vector<Diagnostic> d =
         errors(std::string(kMinimal) +
                "[render]\nlights = [ { type = \"point\", direction = [0, 0, 1] } ]\n");
@@ -364,8 +367,7 @@ TEST(SceneErrors, CameraAndLights)
 
 TEST(SceneErrors, BeierNeelyParametersNeedThatWeighting)
 {
-    expectError(std::string(kMinimal) + "[warp]\nb = 2\n", 9, 5,
-                "only used with weighting = \"beier-neely\"");
+    expectAddedError("[warp]\nb = 2\n", 9, 5, "only used with weighting = \"beier-neely\"");
     EXPECT_NO_THROW(parse(std::string(kMinimal) +
                           "[warp]\nweighting = \"beier-neely\"\na = 0.1\nb = 2\np = 0.5\n"));
 }
