@@ -2,7 +2,9 @@
 #include "Common.h"
 
 #include <volmorph/Scene.h>
+#include <volmorph/SceneVolumes.h>
 #include <volmorph/Schedule.h>
+#include <volmorph/VolumeInput.h>
 #include <volmorph/Voxelize.h>
 
 #include <algorithm>
@@ -30,8 +32,29 @@ void printMesh(const char* label, const ObjectSpec& spec, const Mesh& mesh)
         std::printf("        colour from the mesh's vertex colours\n");
 }
 
-/// Hand-placed features far from their mesh are usually a typo in a coordinate.
-void warnFarFeatures(const Scene& scene, const Mesh& source, const Mesh& target)
+/// A volume input: the grids that play each part, those carried, those left out.
+void printVolumeInput(const char* label, const ObjectSpec& spec, const SideExtent& extent)
+{
+    const VolumeFileInfo info = inspectVolume(spec);
+    auto name = [](const std::string& n, const char* otherwise) {
+        return n.empty() ? std::string(otherwise) : "'" + n + "'";
+    };
+    std::printf("%-7s %s\n", label, spec.volume.string().c_str());
+    std::printf("        density %s, sdf %s, colour %s\n",
+                name(info.density, "from the sdf").c_str(),
+                name(info.sdf, "none (derived from the density in sdf mode)").c_str(),
+                name(info.color, spec.color ? "the scene's" : "grey").c_str());
+    std::string carried, ignored;
+    for (const std::string& n : info.extras) carried += " " + n;
+    for (const std::string& n : info.ignored) ignored += " " + n;
+    if (!carried.empty()) std::printf("        carried:%s\n", carried.c_str());
+    if (!ignored.empty()) std::printf("        left out (not float or vec3):%s\n", ignored.c_str());
+    std::printf("        voxel size %s world units; bounds %s .. %s world units\n",
+                fmt(info.voxelSize).c_str(), fmt(extent.lo).c_str(), fmt(extent.hi).c_str());
+}
+
+/// Hand-placed features far from their side are usually a typo in a coordinate.
+void warnFarFeatures(const Scene& scene, const SideExtent& source, const SideExtent& target)
 {
     auto outside = [](const Vec3d& p, const std::pair<Vec3d, Vec3d>& b) {
         const Vec3d size = b.second - b.first;
@@ -40,16 +63,16 @@ void warnFarFeatures(const Scene& scene, const Mesh& source, const Mesh& target)
             if (p[i] < b.first[i] - margin || p[i] > b.second[i] + margin) return true;
         return false;
     };
-    const auto sb = source.bounds(), tb = target.bounds();
+    const std::pair<Vec3d, Vec3d> sb{source.lo, source.hi}, tb{target.lo, target.hi};
     for (size_t i = 0; i < scene.pairs.size(); ++i) {
         const FeaturePairSpec& pair = scene.pairs[i];
         if (outside(pair.source.origin, sb))
             std::fprintf(stderr,
-                         "%s: warning: pair %zu: source origin %s is far outside the source mesh\n",
+                         "%s: warning: pair %zu: source origin %s is far outside the source\n",
                          pair.where.str().c_str(), i + 1, fmt(pair.source.origin).c_str());
         if (outside(pair.target.origin, tb))
             std::fprintf(stderr,
-                         "%s: warning: pair %zu: target origin %s is far outside the target mesh\n",
+                         "%s: warning: pair %zu: target origin %s is far outside the target\n",
                          pair.where.str().c_str(), i + 1, fmt(pair.target.origin).c_str());
     }
 }
@@ -85,21 +108,22 @@ void warnCoincidentFeatures(const Scene& scene)
         }
 }
 
-/// The voxel grid both meshes share and the memory voxelizing them takes.
-void printVolume(const Scene& scene, const SceneMeshes& meshes)
+/// The voxel grid both sides share and the memory voxelizing the meshes takes.
+void printVolume(const Scene& scene, const SceneMeshes& meshes, const SideExtent& source,
+                 const SideExtent& target)
 {
-    auto [slo, shi] = meshes.source.bounds();
-    auto [tlo, thi] = meshes.target.bounds();
-    const Vec3d extent = maxComponent(shi, thi) - minComponent(slo, tlo);
-    const double voxel = sceneVoxelSize(scene.volume, meshes.source, meshes.target);
-    std::printf("volume  voxel size %s world units; both meshes span %.0f x %.0f x %.0f voxels\n",
+    const Vec3d extent = maxComponent(source.hi, target.hi) - minComponent(source.lo, target.lo);
+    const double voxel = sceneVoxelSize(scene.volume, source, target);
+    std::printf("volume  voxel size %s world units; both sides span %.0f x %.0f x %.0f voxels\n",
                 fmt(voxel).c_str(), std::ceil(extent.x() / voxel), std::ceil(extent.y() / voxel),
                 std::ceil(extent.z() / voxel));
     const double gib = double(1ull << 30);
+    auto bytes = [&](const ObjectSpec& spec, const Mesh& mesh) {
+        return spec.isVolume() ? 0.0 : double(estimateVoxelizeBytes(mesh, voxel, 3.0f)) / gib;
+    };
     std::printf(
         "        voxelizing needs about %.2f + %.2f GiB (limit %.1f GiB, half the memory)\n",
-        double(estimateVoxelizeBytes(meshes.source, voxel, 3.0f)) / gib,
-        double(estimateVoxelizeBytes(meshes.target, voxel, 3.0f)) / gib,
+        bytes(scene.source, meshes.source), bytes(scene.target, meshes.target),
         double(defaultMemoryLimitBytes()) / gib);
 }
 
@@ -203,16 +227,23 @@ int runCheck(const std::string& scenePath)
 {
     const Scene scene = loadScene(scenePath);
     const SceneMeshes meshes = importSceneMeshes(scene);
+    const auto [source, target] = sceneExtents(scene, meshes);
     std::printf("scene   %s\n", scenePath.c_str());
-    printMesh("source", scene.source, meshes.source);
-    printMesh("target", scene.target, meshes.target);
-    printVolume(scene, meshes);
+    for (auto [label, spec, mesh, extent] :
+         {std::tuple{"source", &scene.source, &meshes.source, &source},
+          std::tuple{"target", &scene.target, &meshes.target, &target}}) {
+        if (spec->isVolume())
+            printVolumeInput(label, *spec, *extent);
+        else
+            printMesh(label, *spec, *mesh);
+    }
+    printVolume(scene, meshes, source, target);
     printPairs(scene);
     printSettings(scene);
     printView(scene.render);
     printFrames(scene);
     std::fflush(stdout);
-    warnFarFeatures(scene, meshes.source, meshes.target);
+    warnFarFeatures(scene, source, target);
     warnCoincidentFeatures(scene);
     return 0;
 }

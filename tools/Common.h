@@ -3,6 +3,7 @@
 
 #include <volmorph/core/Interrupter.h>
 #include <volmorph/Mesh.h>
+#include <volmorph/SceneVolumes.h>
 #include <volmorph/VoxelCache.h>
 
 #include <CLI/CLI.hpp>

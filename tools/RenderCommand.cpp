@@ -7,6 +7,7 @@
 
 #include <volmorph/Frames.h>
 #include <volmorph/Morph.h>
+#include <volmorph/core/VdbRead.h>
 #include <volmorph/core/Version.h>
 #include <volmorph/Voxelize.h>
 #include <volmorph/render/Output.h>
@@ -67,30 +68,23 @@ InputGrids readInputGrids(const RenderVdbArgs& args)
 {
     openvdb::initialize();
     InputGrids grids;
+    openvdb::GridPtrVecPtr all;
     try {
-        openvdb::io::File file(args.input);
-        file.open();
-        std::string densityName, colorName;
-        for (auto it = file.beginName(); it != file.endName(); ++it) {
-            const openvdb::GridBase::Ptr g = file.readGridMetadata(it.gridName());
-            if (colorName.empty() && g->getName() == "Cd" && g->isType<openvdb::Vec3SGrid>())
-                colorName = it.gridName();
-            if (!densityName.empty()) continue;
-            if (!args.grid.empty() ? g->getName() == args.grid : g->isType<openvdb::FloatGrid>()) {
-                if (!g->isType<openvdb::FloatGrid>())
-                    throw UserError(SourceLocation{args.input},
-                                    "grid \"" + args.grid + "\" is not a float grid");
-                densityName = it.gridName();
-            }
-        }
-        if (!densityName.empty())
-            grids.density = openvdb::gridPtrCast<openvdb::FloatGrid>(file.readGrid(densityName));
-        if (!colorName.empty())
-            grids.color = openvdb::gridPtrCast<openvdb::Vec3SGrid>(file.readGrid(colorName));
-        file.close();
-    } catch (const openvdb::Exception& e) {
+        all = readVdbGrids(args.input);
+    } catch (const std::exception& e) {
         throw UserError(SourceLocation{args.input},
                         std::string("cannot read volume file (") + e.what() + ")");
+    }
+    for (const openvdb::GridBase::Ptr& g : *all) {
+        if (!grids.color && g->getName() == "Cd")
+            grids.color = openvdb::gridPtrCast<openvdb::Vec3SGrid>(g);
+        if (grids.density) continue;
+        if (!args.grid.empty() ? g->getName() == args.grid : g->isType<openvdb::FloatGrid>()) {
+            grids.density = openvdb::gridPtrCast<openvdb::FloatGrid>(g);
+            if (!grids.density)
+                throw UserError(SourceLocation{args.input},
+                                "grid \"" + args.grid + "\" is not a float grid");
+        }
     }
     if (!grids.density)
         throw UserError(SourceLocation{args.input}, args.grid.empty()

@@ -10,6 +10,7 @@
 // Run: build-bench/tests/bench/volmorph_bench_warp --benchmark_repetitions=5
 // --benchmark_report_aggregates_only=true
 #include <volmorph/Morph.h>
+#include <volmorph/SceneVolumes.h>
 #include <volmorph/Voxelize.h>
 #include <volmorph/Warp.h>
 

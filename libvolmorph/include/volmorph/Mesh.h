@@ -52,7 +52,7 @@ struct Mesh {
 Mesh importMesh(const std::filesystem::path& file, const ObjectTransform& transform = {},
                 const SourceLocation& where = {});
 
-/// A scene's two meshes, imported with their transforms.
+/// A scene's two meshes, imported with their transforms (empty for a side that is a volume).
 struct SceneMeshes {
     Mesh source, target;
 };

@@ -12,6 +12,7 @@
 #include <openvdb/math/Vec3.h>
 
 #include <filesystem>
+#include <map>
 #include <optional>
 #include <string>
 #include <string_view>
@@ -31,12 +32,25 @@ struct ObjectTransform {
     bool isIdentity() const;
 };
 
-/// One side of the morph: a mesh file and how it is placed.
+/// Which grids of a volume input play which part. An empty name: the first of the defaults
+/// (volmorph/VolumeInput.h) that the file holds.
+struct VolumeGridNames {
+    std::string density, sdf, color;
+    SourceLocation where; ///< the `grids` key, for a name the file lacks
+};
+
+/// One side of the morph: a mesh file or a volume file, and how it is placed.
 struct ObjectSpec {
-    std::filesystem::path mesh; ///< resolved against the scene file's folder
-    SourceLocation meshWhere;   ///< where `mesh` was written, for errors found on import
-    ObjectTransform transform;
-    std::optional<Vec3d> color; ///< linear RGB; when absent, the mesh's vertex colours or grey
+    std::filesystem::path mesh;   ///< resolved against the scene file's folder; empty for a volume
+    std::filesystem::path volume; ///< a .vdb (fog or level set), resolved; empty for a mesh
+    SourceLocation fileWhere;     ///< where `mesh` or `volume` was written, for errors on reading
+    VolumeGridNames grids;        ///< volume only
+    ObjectTransform transform;    ///< applied after the volume's own transform
+    std::optional<Vec3d> color;   ///< linear RGB; when absent, the mesh's vertex colours or grey
+                                  ///< (a volume's colour grid, or grey)
+
+    bool isVolume() const { return !volume.empty(); }
+    const std::filesystem::path& file() const { return isVolume() ? volume : mesh; }
 };
 
 /// Voxel grid settings: exactly one of voxelSize and resolution is set by the file.
@@ -97,6 +111,13 @@ struct BlendSpec {
     /// piece, are dropped (dust that a distance blend leaves where the blended field has an
     /// isolated minimum); 0 keeps everything.
     int minIslandVoxels = 27;
+    /// Schedules of the other grids volume inputs carry (temperature, flame, ...), by grid name;
+    /// a grid not named here follows the density schedule.
+    struct GridSchedule {
+        ScheduleSpec schedule;
+        SourceLocation where;
+    };
+    std::map<std::string, GridSchedule> grids;
 };
 
 enum class Projection { Perspective, Orthographic };

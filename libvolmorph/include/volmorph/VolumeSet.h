@@ -1,4 +1,4 @@
-// The voxel representation of one object (or one in-between): three grids on one transform.
+// The voxel representation of one object (or one in-between): its grids on one transform.
 #pragma once
 
 #include <openvdb/openvdb.h>
@@ -23,13 +23,20 @@ struct VolumeSet {
     openvdb::FloatGrid::Ptr density;
     /// Linear RGB colour, active on the sdf's narrow band; the background is the mean colour.
     openvdb::Vec3SGrid::Ptr color;
+    /// Every other grid a volume input carries (temperature, flame, ...): float or vec3 grids by
+    /// name, warped like Cd and blended with their own schedules (blend.grids).
+    std::map<std::string, openvdb::GridBase::Ptr> extras;
 
-    double voxelSize() const { return sdf ? sdf->voxelSize()[0] : 0.0; }
+    /// World units (the grids share one uniform linear transform).
+    double voxelSize() const
+    {
+        return density ? density->voxelSize()[0] : sdf ? sdf->voxelSize()[0] : 0.0;
+    }
 };
 
-/// Writes the grids that are set, with `metadata` added to each as string metadata.
-/// The file appears at `path` only when complete (written to a temporary name, then renamed).
-/// Throws UserError naming the path when it cannot be written.
+/// Writes the grids that are set, extras included, with `metadata` added to each as string
+/// metadata. The file appears at `path` only when complete (written to a temporary name, then
+/// renamed). Throws UserError naming the path when it cannot be written.
 void writeVolumeSet(const VolumeSet& volumes, const std::filesystem::path& path,
                     const std::map<std::string, std::string>& metadata = {});
 

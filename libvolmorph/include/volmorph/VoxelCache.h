@@ -14,7 +14,7 @@
 
 #include <volmorph/core/Interrupter.h>
 #include <volmorph/Scene.h>
-#include <volmorph/Voxelize.h>
+#include <volmorph/SceneVolumes.h>
 
 #include <cstdint>
 #include <filesystem>

@@ -84,23 +84,9 @@ double resolveVoxelSize(const Mesh& mesh, const VoxelizeOptions& options);
 /// An estimate of voxelize()'s peak memory in bytes, from the surface area and the band.
 uint64_t estimateVoxelizeBytes(const Mesh& mesh, double voxelSize, float halfWidthVoxels);
 
-/// A scene's voxel size in world units: volume.voxel_size, or volume.resolution voxels across the
-/// longest side of the source and target bounds together (both objects share one grid).
-double sceneVoxelSize(const VolumeSpec& volume, const Mesh& source, const Mesh& target);
-
 /// Voxelizes `mesh` (world units). Throws UserError when the mesh is empty or the estimate
 /// exceeds the memory limit, Interrupted when `interrupter` asks to stop.
 VolumeSet voxelize(const Mesh& mesh, const VoxelizeOptions& options,
                    Interrupter* interrupter = nullptr, VoxelizeStats* stats = nullptr);
-
-/// A scene's source and target voxelized on one shared transform, with the scene's colours.
-struct SceneVolumes {
-    SceneMeshes meshes;
-    VolumeSet source, target;
-};
-
-/// Imports and voxelizes both objects of `scene` (the same code as `volmorph voxelize`).
-SceneVolumes voxelizeScene(const Scene& scene, Interrupter* interrupter = nullptr,
-                           uint64_t memoryLimitBytes = 0);
 
 } // namespace volmorph

@@ -1,6 +1,7 @@
 #include "blend/DensityBlend.h"
 
 #include "blend/ColorBlend.h"
+#include "blend/ExtraGrids.h"
 #include "blend/Sample.h"
 #include "blend/WithSampler.h"
 
@@ -52,19 +53,25 @@ public:
         const float tauD = float(scheduleValue(mSpec.density, r.t));
         const float tauC = float(scheduleValue(mSpec.color, r.t));
         const Resampler<Sampler> resample{mSource, mTarget, tauD, tauC, leaves.background()};
+        const ExtraGrids extras(mSource, mTarget, mSpec, r.t);
         BlendedFrame out;
         r.adaptive->forEachLeaf(
             r.box, r.sourceBlocks, r.targetBlocks,
             [&](const WarpLeaf& w) {
                 auto [density, color] = leaves.make(w.origin, 0.0f);
-                if (resample(w, *density, *color))
-                    leaves.keep(std::move(density), std::move(color));
+                if (!resample(w, *density, *color)) return;
+                ExtraLeaves e = extras.make(w.origin);
+                extras.fill<Sampler>(density->getValueMask(), WarpedPoints{w}, e);
+                leaves.keep(std::move(density), std::move(color), std::move(e));
             },
             &out.warp, r.interrupter);
         out.grids.density = openvdb::FloatGrid::create(0.0f);
         out.grids.color = openvdb::Vec3SGrid::create(leaves.background());
         out.keptLeaves = leaves.size();
-        leaves.moveInto(out.grids.density->tree(), out.grids.color->tree(), 0.0f);
+        ExtraGrids::Outputs carried = extras.outputs();
+        leaves.moveInto(out.grids.density->tree(), out.grids.color->tree(), 0.0f, carried.floats,
+                        carried.vectors);
+        out.grids.extras = std::move(carried.grids);
         // Leaves of constant interior collapse into tiles.
         openvdb::tools::prune(out.grids.density->tree());
         return out;

@@ -13,13 +13,7 @@ OutputLeaves::OutputLeaves(double t, uint64_t limitBytes, uint64_t bytesPerLeaf,
 {
 }
 
-OutputLeaves::~OutputLeaves()
-{
-    for (auto& [value, color] : mLeaves) {
-        delete value;
-        delete color;
-    }
-}
+OutputLeaves::~OutputLeaves() = default;
 
 std::pair<std::unique_ptr<OutputLeaves::ValueLeaf>, std::unique_ptr<OutputLeaves::ColorLeaf>>
 OutputLeaves::make(const openvdb::Coord& origin, float value) const
@@ -28,7 +22,8 @@ OutputLeaves::make(const openvdb::Coord& origin, float value) const
             std::make_unique<ColorLeaf>(origin, mBackground, false)};
 }
 
-void OutputLeaves::keep(std::unique_ptr<ValueLeaf> value, std::unique_ptr<ColorLeaf> color)
+void OutputLeaves::keep(std::unique_ptr<ValueLeaf> value, std::unique_ptr<ColorLeaf> color,
+                        ExtraLeaves extras)
 {
     std::lock_guard<std::mutex> lock(mMutex);
     if (mLeaves.size() >= mMaxLeaves) {
@@ -41,7 +36,7 @@ void OutputLeaves::keep(std::unique_ptr<ValueLeaf> value, std::unique_ptr<ColorL
                       mT, double(mLimit) / double(1ull << 30), mMaxLeaves);
         throw UserError(SourceLocation{"morph"}, text);
     }
-    mLeaves.emplace_back(value.release(), color.release());
+    mLeaves.push_back(Kept{std::move(value), std::move(color), std::move(extras)});
 }
 
 void OutputLeaves::insideTile(const openvdb::Coord& origin)
@@ -51,11 +46,16 @@ void OutputLeaves::insideTile(const openvdb::Coord& origin)
 }
 
 void OutputLeaves::moveInto(openvdb::FloatTree& values, openvdb::Vec3STree& colors,
-                            float insideValue)
+                            float insideValue, const std::vector<openvdb::FloatTree*>& floatExtras,
+                            const std::vector<openvdb::Vec3STree*>& vectorExtras)
 {
-    for (auto& [value, color] : mLeaves) {
-        values.addLeaf(value);
-        colors.addLeaf(color);
+    for (Kept& k : mLeaves) {
+        values.addLeaf(k.value.release());
+        colors.addLeaf(k.color.release());
+        for (size_t i = 0; i < k.extras.floats.size(); ++i)
+            floatExtras[i]->addLeaf(k.extras.floats[i].release());
+        for (size_t i = 0; i < k.extras.vectors.size(); ++i)
+            vectorExtras[i]->addLeaf(k.extras.vectors[i].release());
     }
     mLeaves.clear();
     for (const openvdb::Coord& origin : mInside) values.addTile(1, origin, insideValue, false);

@@ -14,6 +14,12 @@
 
 namespace volmorph::detail {
 
+/// One output leaf of each extra grid (ExtraGrids.h), in its order.
+struct ExtraLeaves {
+    std::vector<std::unique_ptr<openvdb::FloatTree::LeafNodeType>> floats;
+    std::vector<std::unique_ptr<openvdb::Vec3STree::LeafNodeType>> vectors;
+};
+
 class OutputLeaves {
 public:
     using ValueLeaf = openvdb::FloatTree::LeafNodeType;
@@ -30,16 +36,20 @@ public:
     std::pair<std::unique_ptr<ValueLeaf>, std::unique_ptr<ColorLeaf>>
     make(const openvdb::Coord& origin, float value) const;
 
-    /// Keeps both; throws UserError past the memory limit.
-    void keep(std::unique_ptr<ValueLeaf> value, std::unique_ptr<ColorLeaf> color);
+    /// Keeps them all; throws UserError past the memory limit.
+    void keep(std::unique_ptr<ValueLeaf> value, std::unique_ptr<ColorLeaf> color,
+              ExtraLeaves extras = {});
     /// A leaf-sized tile inside the object (sdf mode).
     void insideTile(const openvdb::Coord& origin);
 
     size_t size() const { return mLeaves.size(); }
     const Vec3f& background() const { return mBackground; }
 
-    /// Moves the leaves into the two trees; inside tiles (leaf-sized) get `insideValue`.
-    void moveInto(openvdb::FloatTree& values, openvdb::Vec3STree& colors, float insideValue);
+    /// Moves the leaves into the trees (the extras' in ExtraLeaves' order); inside tiles
+    /// (leaf-sized) of the value tree get `insideValue`.
+    void moveInto(openvdb::FloatTree& values, openvdb::Vec3STree& colors, float insideValue,
+                  const std::vector<openvdb::FloatTree*>& floatExtras = {},
+                  const std::vector<openvdb::Vec3STree*>& vectorExtras = {});
 
 private:
     double mT;
@@ -47,7 +57,12 @@ private:
     size_t mMaxLeaves;
     Vec3f mBackground;
     std::mutex mMutex;
-    std::vector<std::pair<ValueLeaf*, ColorLeaf*>> mLeaves;
+    struct Kept {
+        std::unique_ptr<ValueLeaf> value;
+        std::unique_ptr<ColorLeaf> color;
+        ExtraLeaves extras;
+    };
+    std::vector<Kept> mLeaves;
     std::vector<openvdb::Coord> mInside;
 };
 

@@ -1,6 +1,7 @@
 #include "blend/SdfBlend.h"
 
 #include "blend/ExtendedDistance.h"
+#include "blend/ExtraGrids.h"
 #include "blend/IdentityDistances.h"
 #include "blend/Islands.h"
 #include "blend/Redistance.h"
@@ -69,14 +70,15 @@ public:
             r.prune && r.warp->pairCount() == 0 ? mIdentity.get() : nullptr;
         blend.classify(r.box, r.prune, kept);
         BlendedFrame out;
+        const ExtraGrids extras(mSource, mTarget, mSpec, r.t);
         const std::vector<Coord> evaluate = sortLeaves(blend.classes(), kept != nullptr, leaves);
         if (kept) {
-            fromKeptDistances(blend, *kept, evaluate, leaves, r.interrupter);
+            fromKeptDistances(blend, *kept, evaluate, extras, leaves, r.interrupter);
             out.warp.leaves = evaluate.size();
         } else {
-            throughWarp(blend, r, leaves, out.warp);
+            throughWarp(blend, r, extras, leaves, out.warp);
         }
-        assemble(blend, leaves, out);
+        assemble(blend, extras, leaves, out);
         return out;
     }
 
@@ -99,21 +101,27 @@ private:
         return evaluate;
     }
 
-    /// Keeps a filled leaf, or makes it an inside tile, or drops it (outside).
+    /// Keeps a filled leaf, with the extras on its kept band (where it has colour), or makes it
+    /// an inside tile, or drops it (outside).
+    template <typename Points>
     static void settle(int whole, const Coord& origin,
                        std::unique_ptr<OutputLeaves::ValueLeaf> value,
-                       std::unique_ptr<OutputLeaves::ColorLeaf> color, OutputLeaves& leaves)
+                       std::unique_ptr<OutputLeaves::ColorLeaf> color, const ExtraGrids& extras,
+                       const Points& points, OutputLeaves& leaves)
     {
-        if (whole == 0)
-            leaves.keep(std::move(value), std::move(color));
-        else if (whole < 0)
+        if (whole == 0) {
+            ExtraLeaves e = extras.make(origin);
+            extras.fill<Sampler>(color->getValueMask(), points, e);
+            leaves.keep(std::move(value), std::move(color), std::move(e));
+        } else if (whole < 0) {
             leaves.insideTile(origin);
+        }
     }
 
     /// The leaves `evaluate`, from the distances kept across frames (no pairs).
     void fromKeptDistances(const SdfFrame<Sampler>& blend, IdentityDistances& kept,
-                           const std::vector<Coord>& evaluate, OutputLeaves& leaves,
-                           Interrupter* interrupter) const
+                           const std::vector<Coord>& evaluate, const ExtraGrids& extras,
+                           OutputLeaves& leaves, Interrupter* interrupter) const
     {
         const float band = blend.computeBand();
         std::atomic<bool> stopped{false};
@@ -133,7 +141,14 @@ private:
                         kept.get<Sampler>(evaluate[i], a, b, *scratch, computed);
                     auto [value, color] = leaves.make(evaluate[i], band);
                     const int whole = blend(evaluate[i], distances, *value, *color);
-                    settle(whole, evaluate[i], std::move(value), std::move(color), leaves);
+                    // The identity warp: each voxel's points are the voxel itself.
+                    const auto atVoxel = [&origin = evaluate[i]](openvdb::Index n) {
+                        const openvdb::Vec3R p =
+                            (origin + OutputLeaves::ValueLeaf::offsetToLocalCoord(n)).asVec3d();
+                        return std::pair{p, p};
+                    };
+                    settle(whole, evaluate[i], std::move(value), std::move(color), extras, atVoxel,
+                           leaves);
                 }
                 blend.addSamples(computed);
             });
@@ -141,8 +156,8 @@ private:
     }
 
     /// The leaves the warp's traversal visits (those the classes want, when pruning).
-    void throughWarp(const SdfFrame<Sampler>& blend, const BlendRequest& r, OutputLeaves& leaves,
-                     AdaptiveWarpStats& stats) const
+    void throughWarp(const SdfFrame<Sampler>& blend, const BlendRequest& r,
+                     const ExtraGrids& extras, OutputLeaves& leaves, AdaptiveWarpStats& stats) const
     {
         const float band = blend.computeBand();
         const BlockClasses& classes = blend.classes();
@@ -154,21 +169,26 @@ private:
             [&](const WarpLeaf& w) {
                 auto [value, color] = leaves.make(w.origin, band);
                 const int whole = blend(w, *value, *color);
-                settle(whole, w.origin, std::move(value), std::move(color), leaves);
+                settle(whole, w.origin, std::move(value), std::move(color), extras, WarpedPoints{w},
+                       leaves);
             },
             &stats, r.interrupter, r.prune ? &wanted : nullptr);
     }
 
     /// The grids from the leaves: tiles and the background take the output band's values at once
     /// (+/- its width); the leaves' values beyond the compute band are rewritten by redistance().
-    void assemble(const SdfFrame<Sampler>& blend, OutputLeaves& leaves, BlendedFrame& out) const
+    void assemble(const SdfFrame<Sampler>& blend, const ExtraGrids& extras, OutputLeaves& leaves,
+                  BlendedFrame& out) const
     {
         openvdb::FloatGrid::Ptr values = openvdb::FloatGrid::create(blend.width());
         values->setTransform(mSource.density->transform().copy());
         values->setGridClass(openvdb::GRID_LEVEL_SET);
         out.grids.color = openvdb::Vec3SGrid::create(leaves.background());
         out.keptLeaves = leaves.size();
-        leaves.moveInto(values->tree(), out.grids.color->tree(), -blend.width());
+        ExtraGrids::Outputs carried = extras.outputs();
+        leaves.moveInto(values->tree(), out.grids.color->tree(), -blend.width(), carried.floats,
+                        carried.vectors);
+        out.grids.extras = std::move(carried.grids);
         dropIslands(*values, mSpec.minIslandVoxels, blend.computeBand(), blend.deepVoxels());
         const float voxel = float(mSource.voxelSize());
         RedistanceBands bands{voxel, blend.width(),

@@ -19,13 +19,13 @@ namespace volmorph {
 namespace {
 
 /// Bump when the entry's layout changes.
-constexpr int kCacheFormat = 1;
+constexpr int kCacheFormat = 2;
 constexpr const char* kKeyMeta = "volmorph_cache_key";
 
 std::string fileDigest(const std::filesystem::path& path, const SourceLocation& where)
 {
     std::ifstream in(path, std::ios::binary);
-    if (!in) throw UserError(where, "cannot read mesh file \"" + path.string() + "\"");
+    if (!in) throw UserError(where, "cannot read file \"" + path.string() + "\"");
     OIIO::SHA1 sha;
     char buffer[1 << 16];
     while (in) {
@@ -58,12 +58,34 @@ void describe(std::ostream& s, const char* side, const ObjectSpec& o)
     s << side << " translate " << x.translate << " rotate " << x.rotateRadians << " scale "
       << x.scale;
     if (o.color) s << " color " << *o.color;
+    if (o.isVolume())
+        s << " grids '" << o.grids.density << "' '" << o.grids.sdf << "' '" << o.grids.color << "'";
     s << '\n';
 }
 
-std::string gridName(const char* side, const char* grid)
+/// An entry's grid name: "<side>.<part>" for sdf, density and Cd, "<side>.extra.<name>" for the
+/// extras (whose names are the user's).
+const std::string kExtra = ".extra.";
+
+/// Files one grid of an entry into its side.
+std::string place(VolumeSet& v, const std::string& side, const openvdb::GridBase::Ptr& g)
 {
-    return std::string(side) + "." + grid;
+    const std::string name = g->getName().substr(side.size());
+    if (name.rfind(kExtra, 0) == 0) {
+        g->setName(name.substr(kExtra.size()));
+        v.extras[g->getName()] = g;
+        return {};
+    }
+    g->setName(name.substr(1));
+    if (g->getName() == kColorGridName)
+        v.color = openvdb::gridPtrCast<openvdb::Vec3SGrid>(g);
+    else if (g->getName() == kSdfGridName)
+        v.sdf = openvdb::gridPtrCast<openvdb::FloatGrid>(g);
+    else if (g->getName() == kDensityGridName)
+        v.density = openvdb::gridPtrCast<openvdb::FloatGrid>(g);
+    else
+        return "grid " + g->getName() + " is unknown";
+    return {};
 }
 
 std::filesystem::path checksumFile(const std::filesystem::path& entry)
@@ -91,27 +113,19 @@ std::string readEntry(const std::filesystem::path& path, const std::string& key,
         const openvdb::MetaMap::Ptr meta = file.getMetadata();
         const auto stored = meta ? meta->getMetadata<openvdb::StringMetadata>(kKeyMeta) : nullptr;
         if (!stored || stored->value() != key) return "it was written for other inputs";
-        for (const char* side : {"source", "target"}) {
-            VolumeSet& v = std::string(side) == "source" ? out.source : out.target;
-            for (const char* grid : {kSdfGridName, kDensityGridName, kColorGridName}) {
-                const std::string name = gridName(side, grid);
-                if (!file.hasGrid(name)) return "grid " + name + " is missing";
-                openvdb::GridBase::Ptr g = file.readGrid(name);
-                g->setName(grid);
-                if (grid == kColorGridName)
-                    v.color = openvdb::gridPtrCast<openvdb::Vec3SGrid>(g);
-                else if (grid == kSdfGridName)
-                    v.sdf = openvdb::gridPtrCast<openvdb::FloatGrid>(g);
-                else
-                    v.density = openvdb::gridPtrCast<openvdb::FloatGrid>(g);
-            }
-            if (!v.sdf || !v.density || !v.color)
-                return "a grid of the " + std::string(side) + " has the wrong type";
-            if (v.sdf->getGridClass() != openvdb::GRID_LEVEL_SET)
-                return "the " + std::string(side) + " sdf is not a level set";
+        for (const openvdb::GridBase::Ptr& g : *file.getGrids()) {
+            const bool source = g->getName().rfind("source.", 0) == 0;
+            std::string problem =
+                place(source ? out.source : out.target, source ? "source" : "target", g);
+            if (!problem.empty()) return problem;
         }
         file.close();
-        if (out.source.sdf->transform() != out.target.sdf->transform())
+        for (const VolumeSet* v : {&out.source, &out.target}) {
+            if (!v->density || !v->color) return "a side lacks its density or Cd grid";
+            if (v->sdf && v->sdf->getGridClass() != openvdb::GRID_LEVEL_SET)
+                return "an sdf is not a level set";
+        }
+        if (out.source.density->transform() != out.target.density->transform())
             return "source and target grids disagree";
     } catch (const std::exception& e) {
         return std::string("it does not read back (") + e.what() + ")";
@@ -129,9 +143,10 @@ void writeEntry(const std::filesystem::path& path, const std::string& key, const
     };
     for (const char* side : {"source", "target"}) {
         const VolumeSet& s = std::string(side) == "source" ? v.source : v.target;
-        add(s.sdf, gridName(side, kSdfGridName));
-        add(s.density, gridName(side, kDensityGridName));
-        add(s.color, gridName(side, kColorGridName));
+        if (s.sdf) add(s.sdf, std::string(side) + "." + kSdfGridName);
+        add(s.density, std::string(side) + "." + kDensityGridName);
+        add(s.color, std::string(side) + "." + kColorGridName);
+        for (const auto& [name, grid] : s.extras) add(grid, side + kExtra + name);
     }
     openvdb::MetaMap meta;
     meta.insertMeta(kKeyMeta, openvdb::StringMetadata(key));
@@ -168,12 +183,17 @@ std::string voxelCacheKey(const Scene& scene)
     s.precision(17);
     s << "volmorph voxel cache " << kCacheFormat << " version " << versionString() << " program "
       << programDigest() << '\n';
-    s << "source mesh " << fileDigest(scene.source.mesh, scene.source.meshWhere) << '\n';
-    s << "target mesh " << fileDigest(scene.target.mesh, scene.target.meshWhere) << '\n';
+    for (const auto& [side, o] :
+         {std::pair{"source", &scene.source}, std::pair{"target", &scene.target}})
+        s << side << (o->isVolume() ? " volume " : " mesh ") << fileDigest(o->file(), o->fileWhere)
+          << '\n';
     describe(s, "source", scene.source);
     describe(s, "target", scene.target);
     if (scene.volume.voxelSize) s << "voxel_size " << *scene.volume.voxelSize << '\n';
     if (scene.volume.resolution) s << "resolution " << *scene.volume.resolution << '\n';
+    // A fog volume gets a derived level set in sdf mode only.
+    if (scene.source.isVolume() || scene.target.isVolume())
+        s << "sdf mode " << (scene.blend.mode == BlendMode::Sdf) << '\n';
     return OIIO::SHA1::digest(s.str().data(), s.str().size());
 }
 

@@ -29,10 +29,10 @@ void writeVolumeSet(const VolumeSet& volumes, const std::filesystem::path& path,
                     const std::map<std::string, std::string>& metadata)
 {
     initializeOpenVdb();
+    openvdb::GridPtrVec all = {volumes.sdf, volumes.density, volumes.color};
+    for (const auto& [name, grid] : volumes.extras) all.push_back(grid);
     openvdb::GridPtrVec grids;
-    for (openvdb::GridBase::Ptr g :
-         {openvdb::GridBase::Ptr(volumes.sdf), openvdb::GridBase::Ptr(volumes.density),
-          openvdb::GridBase::Ptr(volumes.color)}) {
+    for (const openvdb::GridBase::Ptr& g : all) {
         if (!g) continue;
         for (const auto& [key, value] : metadata)
             g->insertMeta(key, openvdb::StringMetadata(value));

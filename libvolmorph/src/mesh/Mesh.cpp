@@ -424,8 +424,9 @@ SceneMeshes importSceneMeshes(const Scene& scene)
     const std::pair<const ObjectSpec*, Mesh*> sides[2] = {{&scene.source, &out.source},
                                                           {&scene.target, &out.target}};
     for (const auto& [spec, mesh] : sides) {
+        if (spec->isVolume()) continue;
         try {
-            *mesh = importMesh(spec->mesh, spec->transform, spec->meshWhere);
+            *mesh = importMesh(spec->mesh, spec->transform, spec->fileWhere);
         } catch (const UserError& e) {
             problems.insert(problems.end(), e.diagnostics().begin(), e.diagnostics().end());
         }

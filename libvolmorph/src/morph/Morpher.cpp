@@ -5,6 +5,7 @@
 #include <volmorph/Warp.h>
 
 #include "blend/BlendMethod.h"
+#include "blend/ExtraGrids.h"
 #include "warp/AdaptiveWarp.h"
 
 #include <volmorph/core/MemoryLimit.h>
@@ -58,6 +59,10 @@ void finish(VolumeSet& out, const openvdb::math::Transform& xform, MorphStats* s
     out.color->setName(kColorGridName);
     out.color->setVectorType(openvdb::VEC_INVARIANT);
     if (out.sdf) out.sdf->setName(kSdfGridName);
+    for (auto& [name, grid] : out.extras) {
+        grid->pruneGrid();
+        grid->setTransform(xform.copy());
+    }
     if (stats) {
         stats->maxWarpErrorVoxels = frame.warp.maxErrorVoxels;
         stats->exactEvaluations = frame.warp.exactEvaluations;
@@ -80,6 +85,7 @@ Morpher::Morpher(VolumeSet source, VolumeSet target, std::vector<FeaturePairSpec
     if (!(mSource.density->transform() == mTarget.density->transform()))
         throw std::invalid_argument("Morpher: source and target must share one transform");
     if (!mOptions.memoryLimitBytes) mOptions.memoryLimitBytes = defaultMemoryLimitBytes();
+    detail::ExtraGrids::check(mSource, mTarget, mBlend);
     mSourceBlocks = std::make_shared<const detail::Occupancy>(mSource.density->tree());
     mTargetBlocks = std::make_shared<const detail::Occupancy>(mTarget.density->tree());
     const detail::BlendSetup setup{mSource,
@@ -142,7 +148,9 @@ VolumeSet Morpher::run(double t, const CoordBBox& box, bool prune, double tolera
     request.targetBlocks = prune ? mTargetBlocks.get() : nullptr;
     request.interrupter = interrupter;
     const float tauColor = float(scheduleValue(mBlend.color, t));
-    detail::OutputLeaves leaves(t, mOptions.memoryLimitBytes, kMorphBytesPerLeaf,
+    detail::OutputLeaves leaves(t, mOptions.memoryLimitBytes,
+                                kMorphBytesPerLeaf +
+                                    detail::ExtraGrids::bytesPerLeaf(mSource, mTarget),
                                 detail::blendedColorBackground(mSource, mTarget, tauColor));
     detail::BlendedFrame frame = mMethod->frame(request, leaves);
     finish(frame.grids, mSource.density->transform(), stats, frame);

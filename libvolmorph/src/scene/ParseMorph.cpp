@@ -9,7 +9,8 @@ namespace volmorph::detail {
 namespace {
 
 const std::vector<std::string> kWarpKeys = {"epsilon", "tolerance", "weighting", "a", "b", "p"};
-const std::vector<std::string> kBlendKeys = {"mode", "density", "color", "sdf", "min_island"};
+const std::vector<std::string> kBlendKeys = {"mode", "density",    "color",
+                                             "sdf",  "min_island", "grids"};
 
 void parseSchedule(Reader& r, const toml::node& node, const std::string& path, ScheduleSpec& s)
 {
@@ -74,6 +75,26 @@ void parseSchedule(Reader& r, const toml::node& node, const std::string& path, S
     s.points = std::move(points);
 }
 
+/// blend.grids: a schedule per named grid.
+void parseGridSchedules(Reader& r, const toml::node& node, BlendSpec& b)
+{
+    const toml::table* t = r.table(node, "blend.grids");
+    if (!t) return;
+    for (auto&& [key, value] : *t) {
+        const std::string name(key.str());
+        if (name == "density" || name == "sdf" || name == "Cd") {
+            r.error(r.at(key.source()), "blend.grids." + name + ": the " + name +
+                                            " grid follows blend." +
+                                            (name == "Cd" ? "color" : name) +
+                                            "; blend.grids names the other grids a volume carries");
+            continue;
+        }
+        BlendSpec::GridSchedule& g = b.grids[name];
+        g.where = r.at(key.source());
+        parseSchedule(r, value, "blend.grids." + name, g.schedule);
+    }
+}
+
 } // namespace
 
 void parseWarp(Reader& r, const toml::node& node, WarpSpec& w)
@@ -123,6 +144,7 @@ void parseBlend(Reader& r, const toml::node& node, BlendSpec& b)
     if (const toml::node* n = t->get("min_island"))
         if (auto v = r.integerIn(*n, "blend.min_island", 0, 1000000000))
             b.minIslandVoxels = int(*v);
+    if (const toml::node* n = t->get("grids")) parseGridSchedules(r, *n, b);
 }
 
 } // namespace volmorph::detail

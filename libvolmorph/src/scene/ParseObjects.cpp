@@ -1,4 +1,4 @@
-// [source], [target] (mesh, transform, colour) and [volume].
+// [source], [target] (mesh or volume, grids, transform, colour) and [volume].
 #include "TableParsers.h"
 
 #include <limits>
@@ -6,7 +6,8 @@
 namespace volmorph::detail {
 namespace {
 
-const std::vector<std::string> kObjectKeys = {"mesh", "transform", "color"};
+const std::vector<std::string> kObjectKeys = {"mesh", "volume", "grids", "transform", "color"};
+const std::vector<std::string> kGridKeys = {"density", "sdf", "color"};
 const std::vector<std::string> kTransformKeys = {"translate", "rotate", "scale"};
 const std::vector<std::string> kVolumeKeys = {"voxel_size", "resolution"};
 
@@ -30,6 +31,41 @@ void parseTransform(Reader& r, const toml::node& node, const std::string& path, 
     }
 }
 
+/// A file name at `n`, resolved against `folder`, that must exist.
+void parseFile(Reader& r, const toml::node& n, const std::string& path,
+               const std::filesystem::path& folder, std::filesystem::path& file,
+               SourceLocation& where)
+{
+    const std::optional<std::string> s = r.string(n, path);
+    if (!s) return;
+    where = r.at(n);
+    const std::filesystem::path p(*s);
+    file = p.is_absolute() ? p : folder / p;
+    std::error_code ec;
+    if (s->empty())
+        r.error(r.at(n), path + ": expected a file name");
+    else if (!std::filesystem::is_regular_file(file, ec))
+        r.error(r.at(n),
+                path + ": file not found: '" + *s + "' (looked for " + file.string() + ")");
+}
+
+/// grids = { density = "...", sdf = "...", color = "..." }: grid names in the volume file.
+void parseGridNames(Reader& r, const toml::node& node, const std::string& path,
+                    VolumeGridNames& names)
+{
+    const toml::table* t = r.table(node, path);
+    if (!t) return;
+    r.checkKeys(*t, path, kGridKeys);
+    names.where = r.at(node);
+    for (auto [key, name] : {std::pair{"density", &names.density}, std::pair{"sdf", &names.sdf},
+                             std::pair{"color", &names.color}})
+        if (const toml::node* n = t->get(key))
+            if (auto s = r.string(*n, path + "." + key)) {
+                if (s->empty()) r.error(r.at(*n), path + "." + key + ": expected a grid name");
+                *name = *s;
+            }
+}
+
 } // namespace
 
 void parseObject(Reader& r, const toml::node& node, const std::string& path,
@@ -38,20 +74,22 @@ void parseObject(Reader& r, const toml::node& node, const std::string& path,
     const toml::table* t = r.table(node, path);
     if (!t) return;
     r.checkKeys(*t, path, kObjectKeys);
-    if (const toml::node* n = t->get("mesh")) {
-        if (auto s = r.string(*n, path + ".mesh")) {
-            object.meshWhere = r.at(*n);
-            std::filesystem::path p(*s);
-            object.mesh = p.is_absolute() ? p : folder / p;
-            std::error_code ec;
-            if (s->empty())
-                r.error(r.at(*n), path + ".mesh: expected a file name");
-            else if (!std::filesystem::is_regular_file(object.mesh, ec))
-                r.error(r.at(*n), path + ".mesh: file not found: '" + *s + "' (looked for " +
-                                      object.mesh.string() + ")");
-        }
-    } else {
-        r.missing(node, path + ".mesh", "a mesh file name, relative to the scene file");
+    const toml::node* mesh = t->get("mesh");
+    const toml::node* volume = t->get("volume");
+    if (mesh && volume)
+        r.error(r.at(*volume), path + ": give either mesh or volume, not both");
+    else if (mesh || volume)
+        parseFile(r, mesh ? *mesh : *volume, path + (mesh ? ".mesh" : ".volume"), folder,
+                  mesh ? object.mesh : object.volume, object.fileWhere);
+    else
+        r.missing(node, path + ".mesh",
+                  "a mesh file name, or volume = a .vdb file, relative to the scene file");
+    if (const toml::node* n = t->get("grids")) {
+        if (!volume)
+            r.error(r.at(*n),
+                    path + ".grids: only a volume has grids (give volume = \"FILE.vdb\")");
+        else
+            parseGridNames(r, *n, path + ".grids", object.grids);
     }
     if (const toml::node* n = t->get("transform"))
         parseTransform(r, *n, path + ".transform", object.transform);

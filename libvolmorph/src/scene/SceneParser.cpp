@@ -42,16 +42,17 @@ public:
         if (const toml::node* n = root.get("source"))
             detail::parseObject(r, *n, "source", mScene.folder, mScene.source);
         else
-            r.missingTable("source", "the mesh the morph starts from");
+            r.missingTable("source", "the mesh or volume the morph starts from");
         if (const toml::node* n = root.get("target"))
             detail::parseObject(r, *n, "target", mScene.folder, mScene.target);
         else
-            r.missingTable("target", "the mesh the morph ends at");
+            r.missingTable("target", "the mesh or volume the morph ends at");
 
         if (const toml::node* n = root.get("volume"))
             detail::parseVolume(r, *n, mScene.volume);
-        else
+        else if (!mScene.source.isVolume() && !mScene.target.isVolume())
             r.missingTable("volume", "voxel_size in world units, or resolution");
+        // With a volume input and no [volume], the finest input's voxel size is the scene's.
 
         if (const toml::node* n = root.get("pair")) detail::parsePairs(r, *n, mScene.pairs);
         if (const toml::node* n = root.get("warp")) detail::parseWarp(r, *n, mScene.warp);

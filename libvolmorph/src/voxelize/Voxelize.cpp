@@ -261,33 +261,6 @@ uint64_t estimateVoxelizeBytes(const Mesh& mesh, double voxelSize, float halfWid
     return bytes > 1.8e19 ? UINT64_MAX : uint64_t(bytes);
 }
 
-double sceneVoxelSize(const VolumeSpec& volume, const Mesh& source, const Mesh& target)
-{
-    if (volume.voxelSize) return *volume.voxelSize;
-    const auto [slo, shi] = source.bounds();
-    const auto [tlo, thi] = target.bounds();
-    const Vec3d extent = maxComponent(shi, thi) - minComponent(slo, tlo);
-    const double longest = std::max({extent.x(), extent.y(), extent.z()});
-    return longest / double(std::max(1, volume.resolution.value_or(128)));
-}
-
-SceneVolumes voxelizeScene(const Scene& scene, Interrupter* interrupter, uint64_t memoryLimitBytes)
-{
-    SceneVolumes out;
-    out.meshes = importSceneMeshes(scene);
-    VoxelizeOptions options;
-    options.voxelSize = sceneVoxelSize(scene.volume, out.meshes.source, out.meshes.target);
-    options.memoryLimitBytes = memoryLimitBytes;
-    auto withColor = [&options](const ObjectSpec& spec) {
-        VoxelizeOptions o = options;
-        if (spec.color) o.color = Vec3f(*spec.color);
-        return o;
-    };
-    out.source = voxelize(out.meshes.source, withColor(scene.source), interrupter);
-    out.target = voxelize(out.meshes.target, withColor(scene.target), interrupter);
-    return out;
-}
-
 VolumeSet voxelize(const Mesh& input, const VoxelizeOptions& options, Interrupter* interrupter,
                    VoxelizeStats* stats)
 {

@@ -2,6 +2,8 @@
 // volume change, dust removal.
 #include "support/WarpFixtures.h"
 
+#include <volmorph/SceneVolumes.h>
+
 using namespace volmorph;
 using namespace volmorph::test;
 

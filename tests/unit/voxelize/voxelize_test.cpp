@@ -1,3 +1,4 @@
+#include <volmorph/SceneVolumes.h>
 #include <volmorph/Voxelize.h>
 
 #include "mesh/Orientation.h"   // private to the library; tested directly
@@ -330,13 +331,19 @@ TEST(Voxelize, SceneObjectsShareOneGrid)
 
 TEST(Voxelize, SceneVoxelSizeFromResolutionSpansBothObjects)
 {
-    Mesh a, b;
-    a.points = {Vec3f(0, 0, 0), Vec3f(1, 0, 0), Vec3f(0, 1, 0)};
-    b.points = {Vec3f(3, 0, 0), Vec3f(4, 0, 0), Vec3f(3, 1, 0)};
+    const SideExtent a{Vec3d(0, 0, 0), Vec3d(1, 1, 0), std::nullopt},
+        b{Vec3d(3, 0, 0), Vec3d(4, 1, 0), std::nullopt};
     VolumeSpec spec;
     spec.resolution = 100;
     EXPECT_DOUBLE_EQ(sceneVoxelSize(spec, a, b), 0.04); // x spans 0..4
     spec.resolution.reset();
     spec.voxelSize = 0.5;
     EXPECT_DOUBLE_EQ(sceneVoxelSize(spec, a, b), 0.5);
+    // With a volume input and no [volume] settings: the finest input's voxel size.
+    spec.voxelSize.reset();
+    SideExtent fine = b;
+    fine.inputVoxelSize = 0.02;
+    EXPECT_DOUBLE_EQ(sceneVoxelSize(spec, a, fine), 0.02);
+    spec.resolution = 100; // a resolution given wins
+    EXPECT_DOUBLE_EQ(sceneVoxelSize(spec, a, fine), 0.04);
 }

@@ -1,0 +1,41 @@
+// A scene's two sides as voxels on one shared transform: each side's mesh voxelized (Voxelize.h)
+// or its volume file read and resampled (VolumeInput.h), at the scene's voxel size.
+#pragma once
+
+#include <volmorph/core/Interrupter.h>
+#include <volmorph/Mesh.h>
+#include <volmorph/Scene.h>
+#include <volmorph/VolumeSet.h>
+
+#include <cstdint>
+#include <optional>
+
+namespace volmorph {
+
+/// One side's world bounds, and for a volume its finest voxel size (world units), known before
+/// voxelizing.
+struct SideExtent {
+    Vec3d lo{0.0}, hi{0.0};
+    std::optional<double> inputVoxelSize;
+};
+
+/// The extents of both sides: a mesh's bounds from `meshes` (imported), a volume's from its file.
+std::pair<SideExtent, SideExtent> sceneExtents(const Scene& scene, const SceneMeshes& meshes);
+
+/// A scene's voxel size in world units: volume.voxel_size; or volume.resolution voxels across the
+/// longest side of both sides' bounds together (both share one grid); or, with neither (a scene
+/// with a volume input may leave out [volume]), the finest input volume's voxel size.
+double sceneVoxelSize(const VolumeSpec& volume, const SideExtent& source, const SideExtent& target);
+
+/// A scene's source and target on one shared transform, with the scene's colours.
+struct SceneVolumes {
+    SceneMeshes meshes; ///< the imported meshes (empty for a volume side)
+    VolumeSet source, target;
+};
+
+/// Imports and voxelizes (or reads) both sides of `scene` (the same code as `volmorph voxelize`).
+/// In sdf mode a fog volume gets a derived level set (VolumeInput.h).
+SceneVolumes voxelizeScene(const Scene& scene, Interrupter* interrupter = nullptr,
+                           uint64_t memoryLimitBytes = 0);
+
+} // namespace volmorph

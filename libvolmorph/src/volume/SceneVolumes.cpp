@@ -1,0 +1,78 @@
+// Both sides of a scene on one transform: meshes voxelized, volumes read and resampled.
+#include <volmorph/SceneVolumes.h>
+
+#include <volmorph/VolumeInput.h>
+#include <volmorph/Voxelize.h>
+
+#include <algorithm>
+
+namespace volmorph {
+
+namespace {
+
+SideExtent extentOf(const VolumeFileInfo& info)
+{
+    return SideExtent{info.worldMin, info.worldMax, info.voxelSize};
+}
+
+SideExtent extentOf(const Mesh& mesh)
+{
+    const auto [lo, hi] = mesh.bounds();
+    return SideExtent{lo, hi, std::nullopt};
+}
+
+} // namespace
+
+std::pair<SideExtent, SideExtent> sceneExtents(const Scene& scene, const SceneMeshes& meshes)
+{
+    auto extent = [](const ObjectSpec& spec, const Mesh& mesh) {
+        return spec.isVolume() ? extentOf(inspectVolume(spec)) : extentOf(mesh);
+    };
+    return {extent(scene.source, meshes.source), extent(scene.target, meshes.target)};
+}
+
+double sceneVoxelSize(const VolumeSpec& volume, const SideExtent& source, const SideExtent& target)
+{
+    if (volume.voxelSize) return *volume.voxelSize;
+    if (!volume.resolution && (source.inputVoxelSize || target.inputVoxelSize))
+        return std::min(source.inputVoxelSize.value_or(target.inputVoxelSize.value_or(0.0)),
+                        target.inputVoxelSize.value_or(source.inputVoxelSize.value_or(0.0)));
+    const Vec3d extent = maxComponent(source.hi, target.hi) - minComponent(source.lo, target.lo);
+    const double longest = std::max({extent.x(), extent.y(), extent.z()});
+    return longest / double(std::max(1, volume.resolution.value_or(128)));
+}
+
+SceneVolumes voxelizeScene(const Scene& scene, Interrupter* interrupter, uint64_t memoryLimitBytes)
+{
+    SceneVolumes out;
+    out.meshes = importSceneMeshes(scene);
+    // Each volume file is read once: its bounds and voxel size, then its grids.
+    std::optional<VolumeInput> inputs[2];
+    const ObjectSpec* specs[2] = {&scene.source, &scene.target};
+    const Mesh* meshes[2] = {&out.meshes.source, &out.meshes.target};
+    SideExtent extents[2];
+    for (int i = 0; i < 2; ++i) {
+        if (specs[i]->isVolume()) inputs[i].emplace(*specs[i]);
+        extents[i] = inputs[i] ? extentOf(inputs[i]->info()) : extentOf(*meshes[i]);
+    }
+    const double voxelSize = sceneVoxelSize(scene.volume, extents[0], extents[1]);
+    VolumeSet* sides[2] = {&out.source, &out.target};
+    for (int i = 0; i < 2; ++i) {
+        if (inputs[i]) {
+            VolumeInputOptions o;
+            o.voxelSize = voxelSize;
+            o.needSdf = scene.blend.mode == BlendMode::Sdf;
+            o.memoryLimitBytes = memoryLimitBytes;
+            *sides[i] = inputs[i]->resample(o, interrupter);
+            continue;
+        }
+        VoxelizeOptions o;
+        o.voxelSize = voxelSize;
+        o.memoryLimitBytes = memoryLimitBytes;
+        if (specs[i]->color) o.color = Vec3f(*specs[i]->color);
+        *sides[i] = voxelize(*meshes[i], o, interrupter);
+    }
+    return out;
+}
+
+} // namespace volmorph
