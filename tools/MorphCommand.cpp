@@ -19,22 +19,28 @@ namespace volmorph::cli {
 namespace {
 
 struct MorphArgs {
-    std::string scene, frames, output, mesh, sampling = "trilinear";
-    bool exact = false, quiet = false, verbose = false;
+    std::string scene, frames, output, mesh, sampling = "trilinear", preset = "volmorph";
+    bool exact = false, half = false, quiet = false, verbose = false;
     double memoryLimitGiB = 0.0;
     CacheArgs cache;
 };
 
 /// Writes one in-between as a .vdb at `file` (and its surface, with --mesh).
 void writeFrame(const VolumeSet& v, const std::filesystem::path& file, const MorphArgs& args,
-                const FrameStep& step)
+                const FrameStep& step, double fps)
 {
     if (file.has_parent_path()) std::filesystem::create_directories(file.parent_path());
-    writeVolumeSet(v, file,
-                   {{"volmorph_scene", std::filesystem::absolute(args.scene).string()},
-                    {"volmorph_frame", std::to_string(step.frame)},
-                    {"volmorph_t", fmt(step.t)},
-                    {"volmorph_version", versionString()}});
+    VdbWriteOptions write;
+    write.names = args.preset == "houdini"   ? GridNames::Houdini
+                  : args.preset == "blender" ? GridNames::Blender
+                                             : GridNames::Volmorph;
+    write.half = args.half;
+    write.metadata = {{"volmorph_scene", std::filesystem::absolute(args.scene).string()},
+                      {"volmorph_frame", std::to_string(step.frame)},
+                      {"volmorph_t", fmt(step.t)},
+                      {"volmorph_fps", fmt(fps)},
+                      {"volmorph_version", versionString()}};
+    writeVolumeSet(v, file, write);
     if (!args.mesh.empty()) {
         const std::filesystem::path meshFile = frameFileName(args.mesh, step.frame);
         if (meshFile.has_parent_path()) std::filesystem::create_directories(meshFile.parent_path());
@@ -79,7 +85,7 @@ int runMorph(const MorphArgs& args)
         MorphStats stats;
         const VolumeSet v = morph.frame(step.frame, &stats);
         const std::filesystem::path file = frameFileName(pattern, step.frame);
-        writeFrame(v, file, args, step);
+        writeFrame(v, file, args, step, scene.frames.fps);
         char detail[160];
         std::snprintf(detail, sizeof detail, "%llu active voxels, warp error <= %.3f voxels",
                       (unsigned long long)stats.activeVoxels, stats.maxWarpErrorVoxels);
@@ -111,6 +117,11 @@ Command addMorphCommand(CLI::App& app)
            "--memory-limit", args->memoryLimitGiB,
            "voxelization and in-between memory limit in GiB (default: half the machine's memory)")
         ->check(CLI::PositiveNumber);
+    sub->add_option("--preset", args->preset,
+                    "grid names: volmorph (sdf, density, Cd), houdini (surface, density, Cd, "
+                    "vel) or blender (sdf, density, color, velocity); carried grids keep theirs")
+        ->check(CLI::IsMember({"volmorph", "houdini", "blender"}));
+    sub->add_flag("--half", args->half, "store float and vec3 grids as 16-bit floats");
     addCacheOptions(sub, args->cache);
     sub->add_flag("-q,--quiet", args->quiet, "print nothing on success");
     sub->add_flag("-v,--verbose", args->verbose,

@@ -56,11 +56,12 @@ int runVoxelize(const VoxelizeArgs& args)
     if (interrupter.stopRequested()) throw Interrupted();
     std::ostringstream voxel;
     voxel << stats.voxelSize;
-    writeVolumeSet(volumes, output,
-                   {{"volmorph_source", std::filesystem::absolute(args.mesh).string()},
-                    {"volmorph_voxel_size", voxel.str()},
-                    {"volmorph_sign", stats.usedWindingNumber ? "winding number" : "flood fill"},
-                    {"volmorph_version", versionString()}});
+    VdbWriteOptions write;
+    write.metadata = {{"volmorph_source", std::filesystem::absolute(args.mesh).string()},
+                      {"volmorph_voxel_size", voxel.str()},
+                      {"volmorph_sign", stats.usedWindingNumber ? "winding number" : "flood fill"},
+                      {"volmorph_version", versionString()}};
+    writeVolumeSet(volumes, output, write);
     if (!args.quiet) {
         std::printf("%s: %zu triangles, %s\n", args.mesh.c_str(), mesh.triangles.size(),
                     describeTopology(mesh.report).c_str());

@@ -183,6 +183,8 @@ struct FramesSpec {
     int first = 1, last = 1;
     std::string output = "out/frame.####.exr"; ///< relative to the scene folder; #### or %04d pads
     SourceLocation outputWhere;
+    double fps = 24.0; ///< frames per second: what a frame is in time (velocity in world units per
+                       ///< second, motion blur's shutter)
 
     int count() const { return last - first + 1; }
     double t(int frame) const;

@@ -34,11 +34,26 @@ struct VolumeSet {
     }
 };
 
-/// Writes the grids that are set, extras included, with `metadata` added to each as string
-/// metadata. The file appears at `path` only when complete (written to a temporary name, then
-/// renamed). Throws UserError naming the path when it cannot be written.
+/// The grid names a .vdb is written with: volmorph's own (sdf, density, Cd, vel), Houdini's
+/// (surface, density, Cd, vel) or Blender's (sdf, density, color, velocity). Carried grids keep
+/// their names, but for vel / velocity, which each preset names its way.
+enum class GridNames { Volmorph, Houdini, Blender };
+
+struct VdbWriteOptions {
+    GridNames names = GridNames::Volmorph;
+    bool half = false; ///< float and vec3 grids stored as 16-bit floats
+    /// String metadata added to every grid (frame, t, fps, ...).
+    std::map<std::string, std::string> metadata;
+};
+
+/// The name `grid` (one of volmorph's names, or a carried grid's) is written with under `names`.
+std::string presetName(const std::string& grid, GridNames names);
+
+/// Writes the grids that are set, extras included, named and stored as `options` says. The file
+/// appears at `path` only when complete (written to a temporary name, then renamed). Throws
+/// UserError naming the path when it cannot be written.
 void writeVolumeSet(const VolumeSet& volumes, const std::filesystem::path& path,
-                    const std::map<std::string, std::string>& metadata = {});
+                    const VdbWriteOptions& options = {});
 
 /// Reads sdf, density and Cd from a .vdb file (any that are present). Throws UserError naming the
 /// file when it cannot be read.

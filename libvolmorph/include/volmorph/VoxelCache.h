@@ -1,12 +1,14 @@
 // An on-disk cache of a scene's voxelized source and target, so that the chunks of a sequence
 // rendered on a farm voxelize once, not once per chunk.
 //
-// An entry is one .vdb file, <folder>/<key>.vdb, holding the six grids of both sides, and the SHA-1
-// of its bytes in <folder>/<key>.sha1, checked before OpenVDB reads the entry. The key is
-// the SHA-1 of everything the voxels depend on: the cache format, the volmorph version and the
-// bytes of the running program (another build never reads this build's entries), the bytes of both
-// mesh files (not of files they reference, such as an OBJ's .mtl), both object transforms and
-// colours, and the scene's [volume] settings. A changed mesh or setting therefore misses; an entry
+// An entry is one .vdb file, <folder>/<key>.vdb, holding every grid of both sides ("source.sdf",
+// "target.density", "source.extra.temperature", ...), and the SHA-1 of its bytes in
+// <folder>/<key>.sha1, checked before OpenVDB reads the entry. The key is the SHA-1 of everything
+// the voxels depend on: the cache format, the volmorph version and the bytes of the running program
+// (another build never reads this build's entries), the bytes of both mesh or volume files (not of
+// files they reference, such as an OBJ's .mtl), both object transforms, colours and grid names,
+// the scene's [volume] settings, and with a volume input the blend mode (sdf mode derives a fog's
+// level set). A changed mesh or setting therefore misses; an entry
 // that does not read back whole, lacks a grid or carries another key is reported and rebuilt, never
 // trusted. Entries are written atomically (temporary name, then rename), so chunks racing to fill
 // the same entry are safe.
@@ -26,8 +28,8 @@ namespace volmorph {
 /// $HOME/.cache/volmorph; empty (no cache) when none of them is set.
 std::filesystem::path defaultCacheFolder();
 
-/// The cache key of `scene`'s voxels (40 hex digits). Reads both mesh files; throws UserError
-/// naming a mesh that cannot be read.
+/// The cache key of `scene`'s voxels (40 hex digits). Reads both input files; throws UserError
+/// naming one that cannot be read.
 std::string voxelCacheKey(const Scene& scene);
 
 struct CacheReport {

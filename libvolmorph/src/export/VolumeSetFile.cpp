@@ -13,6 +13,7 @@
 
 #include <cstdio>
 #include <mutex>
+#include <set>
 
 namespace volmorph {
 namespace {
@@ -25,18 +26,39 @@ void initializeOpenVdb()
 
 } // namespace
 
+std::string presetName(const std::string& grid, GridNames names)
+{
+    if (names == GridNames::Houdini) {
+        if (grid == kSdfGridName) return "surface";
+        if (grid == "velocity") return "vel";
+    } else if (names == GridNames::Blender) {
+        if (grid == kColorGridName) return "color";
+        if (grid == "vel") return "velocity";
+    }
+    return grid;
+}
+
 void writeVolumeSet(const VolumeSet& volumes, const std::filesystem::path& path,
-                    const std::map<std::string, std::string>& metadata)
+                    const VdbWriteOptions& options)
 {
     initializeOpenVdb();
     openvdb::GridPtrVec all = {volumes.sdf, volumes.density, volumes.color};
     for (const auto& [name, grid] : volumes.extras) all.push_back(grid);
     openvdb::GridPtrVec grids;
+    std::set<std::string> taken;
     for (const openvdb::GridBase::Ptr& g : all) {
         if (!g) continue;
-        for (const auto& [key, value] : metadata)
-            g->insertMeta(key, openvdb::StringMetadata(value));
-        grids.push_back(g);
+        // A shallow copy (the tree shared) carries the file's names and metadata.
+        openvdb::GridBase::Ptr out = g->copyGrid();
+        std::string name = presetName(g->getName(), options.names);
+        // A carried grid whose name a part takes under the preset (a "color" grid beside Cd, for
+        // Blender) keeps its data under a suffixed name.
+        while (!taken.insert(name).second) name += "_carried";
+        out->setName(name);
+        out->setSaveFloatAsHalf(options.half);
+        for (const auto& [key, value] : options.metadata)
+            out->insertMeta(key, openvdb::StringMetadata(value));
+        grids.push_back(out);
     }
     writeAtomically(path, "volume file", [&grids](const std::filesystem::path& temporary) {
         detail::writeVdbChecked(temporary, openvdb::GridCPtrVec(grids.begin(), grids.end()),

@@ -29,7 +29,7 @@ using detail::typeName;
 // reported with a "did you mean" for near misses.
 const std::vector<std::string> kRootKeys = {"source", "target", "volume", "pair",
                                             "warp",   "blend",  "render", "frames"};
-const std::vector<std::string> kFramesKeys = {"range", "output"};
+const std::vector<std::string> kFramesKeys = {"range", "output", "fps"};
 
 class SceneParser {
 public:
@@ -82,6 +82,10 @@ private:
                                       "(e.g. \"1-48\") or one frame \"N\", got \"" +
                                           *s + "\"");
         }
+        if (const toml::node* n = t->get("fps"))
+            if (auto v = r.numberIn(*n, "frames.fps", 0.0, false, 10000.0,
+                                    "frames per second, 0 < fps <= 10000"))
+                f.fps = *v;
         if (const toml::node* n = t->get("output")) {
             if (auto s = r.string(*n, "frames.output")) {
                 f.output = *s;

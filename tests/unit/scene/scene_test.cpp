@@ -212,7 +212,7 @@ TEST(SceneErrors, UnknownKeySuggestsNearMiss)
 
 TEST(SceneErrors, UnknownKeyListsChoicesWhenNothingIsClose)
 {
-    expectAddedError("[frames]\nzzz = 1\n", 9, 1, "expected one of: range, output");
+    expectAddedError("[frames]\nzzz = 1\n", 9, 1, "expected one of: range, output, fps");
 }
 
 TEST(SceneErrors, WrongType)

@@ -266,7 +266,9 @@ TEST(Voxelize, WritesAndReadsVdbAtomically)
         std::filesystem::temp_directory_path() / "volmorph_voxelize_test";
     std::filesystem::create_directories(dir);
     const std::filesystem::path file = dir / "sphere.vdb";
-    writeVolumeSet(v, file, {{"volmorph_source", "sphere.obj"}});
+    VdbWriteOptions options;
+    options.metadata = {{"volmorph_source", "sphere.obj"}};
+    writeVolumeSet(v, file, options);
     const VolumeSet back = readVolumeSet(file);
     ASSERT_TRUE(back.sdf && back.density && back.color);
     EXPECT_EQ(back.sdf->activeVoxelCount(), v.sdf->activeVoxelCount());
