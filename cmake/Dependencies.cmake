@@ -14,6 +14,16 @@ find_package(assimp CONFIG REQUIRED)
 find_package(tomlplusplus CONFIG REQUIRED)
 find_package(CLI11 CONFIG REQUIRED)
 
+# libnifti2 (NIfTI volumes). Debian 12's NIFTIConfig.cmake points at /usr/lib/libnifti2.so.2.1.0,
+# which the package installs under /usr/lib/<arch>/: find the library and headers directly.
+find_path(NIFTI_INCLUDE_DIR nifti2_io.h PATH_SUFFIXES nifti REQUIRED)
+find_library(NIFTI2_LIBRARY nifti2 REQUIRED)
+find_library(ZNZ_LIBRARY znz REQUIRED)
+find_package(ZLIB REQUIRED)
+add_library(volmorph_nifti INTERFACE)
+target_include_directories(volmorph_nifti SYSTEM INTERFACE ${NIFTI_INCLUDE_DIR})
+target_link_libraries(volmorph_nifti INTERFACE ${NIFTI2_LIBRARY} ${ZNZ_LIBRARY} ZLIB::ZLIB m)
+
 # OpenImageIO's exported target lists /usr/include/opencv4, which exists only when libopencv-dev
 # is installed; CMake refuses to generate with a missing include directory. volmorph does not use
 # OIIO's OpenCV interop, so drop that path.

@@ -1,6 +1,7 @@
 // volmorph check SCENE: validate a scene and summarise it.
 #include "Common.h"
 
+#include <volmorph/Frames.h>
 #include <volmorph/Scene.h>
 #include <volmorph/SceneVolumes.h>
 #include <volmorph/Schedule.h>
@@ -33,13 +34,22 @@ void printMesh(const char* label, const ObjectSpec& spec, const Mesh& mesh)
 }
 
 /// A volume input: the grids that play each part, those carried, those left out.
-void printVolumeInput(const char* label, const ObjectSpec& spec, const SideExtent& extent)
+void printVolumeInput(const char* label, const ObjectSpec& spec, const SideExtent& extent,
+                      int firstFrame)
 {
-    const VolumeFileInfo info = inspectVolume(spec);
+    ObjectSpec first = spec;
+    first.volume = spec.volumeAt(firstFrame);
+    first.volumeFrames.clear();
+    const VolumeFileInfo info = inspectVolume(first);
     auto name = [](const std::string& n, const char* otherwise) {
         return n.empty() ? std::string(otherwise) : "'" + n + "'";
     };
     std::printf("%-7s %s\n", label, spec.volume.string().c_str());
+    if (spec.isSequence())
+        std::printf("        a sequence: frames %s on disk, held outside them; the grid and the "
+                    "parts below are frame %d's (%s)\n",
+                    formatFrames(spec.volumeFrames).c_str(), firstFrame,
+                    first.volume.filename().string().c_str());
     std::printf("        density %s, sdf %s, colour %s\n",
                 name(info.density, "from the sdf").c_str(),
                 name(info.sdf, "none (derived from the density in sdf mode)").c_str(),
@@ -233,7 +243,7 @@ int runCheck(const std::string& scenePath)
          {std::tuple{"source", &scene.source, &meshes.source, &source},
           std::tuple{"target", &scene.target, &meshes.target, &target}}) {
         if (spec->isVolume())
-            printVolumeInput(label, *spec, *extent);
+            printVolumeInput(label, *spec, *extent, scene.frames.first);
         else
             printMesh(label, *spec, *mesh);
     }

@@ -78,7 +78,7 @@ int runMorph(const MorphArgs& args)
     MorphOptions options;
     if (args.sampling == "triquadratic") options.sampling = MorphOptions::Sampling::Triquadratic;
     options.memoryLimitBytes = memoryLimitBytes(args.memoryLimitGiB);
-    const SceneMorph morph(scene, args.cache, interrupter, options, args.quiet);
+    SceneMorph morph(scene, args.cache, interrupter, options, args.quiet);
 
     FrameLoop loop(scene, frames, 1, args.quiet, true, interrupter);
     loop.run([&](const FrameStep& step) {

@@ -233,7 +233,7 @@ int runRenderScene(const RenderSceneArgs& args)
     checkFilmMemory(scene.render.width, scene.render.height, args.memoryLimitGiB);
     MorphOptions morphOptions;
     morphOptions.memoryLimitBytes = memoryLimitBytes(args.memoryLimitGiB);
-    const SceneMorph morph(scene, args.cache, interrupter, morphOptions, args.quiet);
+    SceneMorph morph(scene, args.cache, interrupter, morphOptions, args.quiet);
     SceneRender renderer(scene, args.threads);
     renderer.settings.interrupter = &interrupter;
 

@@ -3,19 +3,45 @@
 #include <string>
 
 namespace volmorph::cli {
+namespace {
+
+bool hasSequence(const Scene& scene)
+{
+    return scene.source.isSequence() || scene.target.isSequence();
+}
+
+} // namespace
 
 SceneMorph::SceneMorph(const Scene& scene, const CacheArgs& cache, Interrupter& interrupter,
                        const MorphOptions& options, bool quiet)
-    : mScene(scene), mInterrupter(interrupter)
+    : mScene(scene), mFixed(scene), mCache(cache), mInterrupter(interrupter), mOptions(options),
+      mQuiet(quiet)
 {
-    SceneVolumes volumes =
-        loadSceneVolumes(scene, cache, interrupter, options.memoryLimitBytes, quiet);
-    mMorpher.emplace(std::move(volumes.source), std::move(volumes.target), scene.pairs, scene.warp,
-                     scene.blend, options);
+    if (hasSequence(scene)) {
+        const Scene first = sceneAtFrame(scene, scene.frames.first);
+        const auto [source, target] = sceneExtents(first, importSceneMeshes(first));
+        mFixed.volume.voxelSize = sceneVoxelSize(scene.volume, source, target);
+        return; // each frame loads its inputs
+    }
+    load(scene.frames.first);
 }
 
-VolumeSet SceneMorph::frame(int frame, MorphStats* stats) const
+void SceneMorph::load(int frame)
 {
+    const Scene scene = sceneAtFrame(mFixed, frame);
+    const std::pair inputs{scene.source.file(), scene.target.file()};
+    if (mMorpher && inputs == mLoaded) return;
+    mMorpher.reset();
+    SceneVolumes volumes =
+        loadSceneVolumes(scene, mCache, mInterrupter, mOptions.memoryLimitBytes, mQuiet);
+    mMorpher.emplace(std::move(volumes.source), std::move(volumes.target), scene.pairs, scene.warp,
+                     scene.blend, mOptions);
+    mLoaded = inputs;
+}
+
+VolumeSet SceneMorph::frame(int frame, MorphStats* stats)
+{
+    if (hasSequence(mScene)) load(frame);
     const std::string stage = "frame " + std::to_string(frame) + ": morph";
     mInterrupter.start(stage.c_str());
     VolumeSet v = mMorpher->frame(mScene.frames.t(frame), stats, &mInterrupter);

@@ -1,28 +1,40 @@
 // The scene's morph, ready to give frames: source and target through the voxel cache, then the
-// Morpher. Shared by `morph`, `render` and `preview`.
+// Morpher. Shared by `morph`, `render` and `preview`. A side that is a volume sequence changes with
+// the frame: its file for each frame is read (through the cache, keyed on that file) and the
+// Morpher rebuilt when a frame's inputs differ from the last frame's.
 #pragma once
 
 #include "Common.h"
 
 #include <volmorph/Morph.h>
 
+#include <filesystem>
 #include <optional>
+#include <utility>
 
 namespace volmorph::cli {
 
 class SceneMorph {
 public:
     /// Voxelizes (or reads from the cache) the scene's source and target, and builds the Morpher.
+    /// With a sequence, the voxel size is fixed from the scene's first frame (one grid for all).
     SceneMorph(const Scene& scene, const CacheArgs& cache, Interrupter& interrupter,
                const MorphOptions& options, bool quiet);
 
     /// The in-between of frame `frame` (at its t in the scene's range). Throws Interrupted when the
     /// interrupter asked to stop during it.
-    VolumeSet frame(int frame, MorphStats* stats = nullptr) const;
+    VolumeSet frame(int frame, MorphStats* stats = nullptr);
 
 private:
+    void load(int frame);
+
     const Scene& mScene;
+    Scene mFixed; ///< the scene with a sequence's voxel size fixed
+    CacheArgs mCache;
     Interrupter& mInterrupter;
+    MorphOptions mOptions;
+    bool mQuiet;
+    std::pair<std::filesystem::path, std::filesystem::path> mLoaded; ///< the Morpher's inputs
     std::optional<Morpher> mMorpher;
 };
 

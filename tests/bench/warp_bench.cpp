@@ -257,6 +257,35 @@ void lowerBound(benchmark::State& state, BlendMode mode)
     state.counters["active_voxels"] = double(out.density->activeVoxelCount());
 }
 
+/// A frame at t = 0.5 whose sides carry extra grids (issue 35: at most 1.3x per extra grid):
+/// range(1) float grids and range(2) vec3 grids, each a copy of the side's density (the shape a
+/// temperature or a velocity has: where the density is). range(3): 0 density mode, 1 sdf mode.
+void morphFrameExtras(benchmark::State& state)
+{
+    const Setup& s = setup(int(state.range(0)));
+    VolumeSet source = s.volumes.source, target = s.volumes.target;
+    for (VolumeSet* v : {&source, &target}) {
+        for (int i = 0; i < state.range(1); ++i)
+            v->extras["float" + std::to_string(i)] = v->density->deepCopy();
+        for (int i = 0; i < state.range(2); ++i) {
+            auto g = openvdb::Vec3SGrid::create(Vec3f(0.0f));
+            g->setTransform(v->density->transform().copy());
+            g->tree().topologyUnion(v->density->tree());
+            for (auto it = g->tree().beginValueOn(); it; ++it) it.setValue(Vec3f(0.0f, 1.0f, 0.5f));
+            v->extras["vec" + std::to_string(i)] = g;
+        }
+    }
+    BlendSpec blend = s.scene.blend;
+    blend.mode = state.range(3) ? BlendMode::Sdf : BlendMode::Density;
+    const Morpher morpher(source, target, s.scene.pairs, s.scene.warp, blend);
+    MorphStats stats;
+    for (auto _ : state) {
+        VolumeSet v = morpher.frame(0.5, &stats);
+        benchmark::DoNotOptimize(v);
+    }
+    state.counters["active_voxels"] = double(stats.activeVoxels);
+}
+
 void identityResample(benchmark::State& state)
 {
     lowerBound(state, BlendMode::Sdf);
@@ -284,3 +313,12 @@ BENCHMARK(morphFrame)->Apply(resolutions);
 BENCHMARK(morphFrameDensity)->Apply(resolutions);
 BENCHMARK(identityResample)->Apply(resolutions);
 BENCHMARK(identityResampleDensity)->Apply(resolutions);
+/// 256 across; no extra grid, one float, two floats, one vec3; density and sdf mode.
+void extraGrids(benchmark::internal::Benchmark* b)
+{
+    for (int sdf : {0, 1})
+        for (auto [floats, vectors] : {std::pair{0, 0}, {1, 0}, {2, 0}, {0, 1}})
+            b->Args({256, floats, vectors, sdf});
+    b->Unit(benchmark::kMillisecond)->UseRealTime();
+}
+BENCHMARK(morphFrameExtras)->Apply(extraGrids);

@@ -8,9 +8,12 @@ Deterministic; run with Debian's python3 (pyopenvdb, package python3-openvdb):
 - nan_density.vdb: the same ball with one NaN voxel;
 - frustum.vdb: a density grid on a frustum transform;
 - heat_only.vdb: the ball's temperature alone (neither a density nor a level set);
-- fog_ball_cut.vdb: fog_ball.vdb cut off after 150,000 bytes (a truncated file)."""
+- fog_ball_cut.vdb: fog_ball.vdb cut off after 150,000 bytes (a truncated file);
+- complex.nii: a NIfTI-1 volume of complex numbers (a datatype volmorph does not read), its header
+  written by hand (348 bytes, NIfTI-1's layout)."""
 import math
 import os
+import struct
 
 import pyopenvdb as vdb
 
@@ -61,6 +64,19 @@ def frustum():
     return [g]
 
 
+def complex_nifti(path, n=4):
+    header = bytearray(348)
+    struct.pack_into("<i", header, 0, 348)                        # sizeof_hdr
+    struct.pack_into("<8h", header, 40, 3, n, n, n, 1, 1, 1, 1)   # dim
+    struct.pack_into("<hh", header, 70, 32, 64)                   # datatype COMPLEX64, bitpix
+    struct.pack_into("<8f", header, 76, 1, 1, 1, 1, 1, 1, 1, 1)   # pixdim
+    struct.pack_into("<f", header, 108, 352.0)                    # vox_offset
+    struct.pack_into("<f", header, 112, 1.0)                      # scl_slope
+    header[344:348] = b"n+1\0"                                   # magic: one-file NIfTI-1
+    with open(path, "wb") as f:
+        f.write(bytes(header) + bytes(4) + bytes(8 * n * n * n))
+
+
 def main():
     os.makedirs(HERE, exist_ok=True)
     vdb.write(os.path.join(HERE, "fog_ball.vdb"), grids=ball())
@@ -71,6 +87,7 @@ def main():
         head = whole.read(150000)
     with open(os.path.join(HERE, "fog_ball_cut.vdb"), "wb") as cut:
         cut.write(head)
+    complex_nifti(os.path.join(HERE, "complex.nii"))
 
 
 if __name__ == "__main__":

@@ -28,6 +28,13 @@ int chunkCount(const std::vector<int>& frames, int chunkSize);
 /// #### -> 0042), or a printf %d / %0Nd. Returns an empty string when valid, else why not.
 std::string checkFramePattern(const std::string& pattern);
 
+/// Whether `pattern` has a frame placeholder (#### or %0Nd).
+bool hasFramePlaceholder(const std::string& pattern);
+
+/// The frame numbers of the files on disk that `pattern` names (OpenImageIO's directory scan),
+/// sorted; empty when there are none or the folder does not exist.
+std::vector<int> sequenceFrames(const std::string& pattern);
+
 /// The file name of `frame` under `pattern` (a pattern without placeholder names one file).
 std::string frameFileName(const std::string& pattern, int frame);
 

@@ -39,18 +39,31 @@ struct VolumeGridNames {
     SourceLocation where; ///< the `grids` key, for a name the file lacks
 };
 
+/// Whether `file` is a NIfTI volume (.nii or .nii.gz), by its name.
+bool isNiftiFile(const std::filesystem::path& file);
+
 /// One side of the morph: a mesh file or a volume file, and how it is placed.
 struct ObjectSpec {
-    std::filesystem::path mesh;   ///< resolved against the scene file's folder; empty for a volume
-    std::filesystem::path volume; ///< a .vdb (fog or level set), resolved; empty for a mesh
-    SourceLocation fileWhere;     ///< where `mesh` or `volume` was written, for errors on reading
-    VolumeGridNames grids;        ///< volume only
-    ObjectTransform transform;    ///< applied after the volume's own transform
-    std::optional<Vec3d> color;   ///< linear RGB; when absent, the mesh's vertex colours or grey
-                                  ///< (a volume's colour grid, or grey)
+    std::filesystem::path mesh;    ///< resolved against the scene file's folder; empty for a volume
+    std::filesystem::path volume;  ///< a .vdb (fog or level set), resolved; empty for a mesh. A
+                                   ///< sequence is a pattern (fx.####.vdb): see volumeAt()
+    std::vector<int> volumeFrames; ///< a sequence's frame numbers found on disk, sorted
+    SourceLocation fileWhere;      ///< where `mesh` or `volume` was written, for errors on reading
+    VolumeGridNames grids;         ///< volume only
+    /// NIfTI only: the intensities [lo, hi] mapped to density 0..1 (clamped); unset: the file's
+    /// cal_min..cal_max, else its data's range.
+    std::optional<std::pair<double, double>> window;
+    ObjectTransform transform;  ///< applied after the volume's own transform
+    std::optional<Vec3d> color; ///< linear RGB; when absent, the mesh's vertex colours or grey
+                                ///< (a volume's colour grid, or grey)
 
     bool isVolume() const { return !volume.empty(); }
+    bool isSequence() const { return !volumeFrames.empty(); }
     const std::filesystem::path& file() const { return isVolume() ? volume : mesh; }
+    /// A sequence's file for output frame `frame`: the input frame of the same number, or the
+    /// nearest before it on disk (held), the first before the sequence starts. Not a sequence:
+    /// `volume`.
+    std::filesystem::path volumeAt(int frame) const;
 };
 
 /// Voxel grid settings: exactly one of voxelSize and resolution is set by the file.
@@ -201,6 +214,10 @@ struct Scene {
     RenderSpec render;
     FramesSpec frames;
 };
+
+/// The scene with each volume sequence replaced by its file for output frame `frame`
+/// (ObjectSpec::volumeAt).
+Scene sceneAtFrame(const Scene& scene, int frame);
 
 /// Reads, parses and validates a scene file. Throws UserError listing every problem found, each
 /// with file:line:col; checks that mesh files exist (it does not import them).

@@ -19,7 +19,8 @@ struct SideExtent {
     std::optional<double> inputVoxelSize;
 };
 
-/// The extents of both sides: a mesh's bounds from `meshes` (imported), a volume's from its file.
+/// The extents of both sides: a mesh's bounds from `meshes` (imported), a volume's from its file (a
+/// sequence's at the scene's first frame).
 std::pair<SideExtent, SideExtent> sceneExtents(const Scene& scene, const SceneMeshes& meshes);
 
 /// A scene's voxel size in world units: volume.voxel_size; or volume.resolution voxels across the
@@ -33,8 +34,9 @@ struct SceneVolumes {
     VolumeSet source, target;
 };
 
-/// Imports and voxelizes (or reads) both sides of `scene` (the same code as `volmorph voxelize`).
-/// In sdf mode a fog volume gets a derived level set (VolumeInput.h).
+/// Imports and voxelizes (or reads) both sides of `scene` (the same code as `volmorph voxelize`);
+/// a sequence at the scene's first frame (sceneAtFrame() picks another). In sdf mode a fog volume
+/// gets a derived level set (VolumeInput.h).
 SceneVolumes voxelizeScene(const Scene& scene, Interrupter* interrupter = nullptr,
                            uint64_t memoryLimitBytes = 0);
 

@@ -177,8 +177,9 @@ std::filesystem::path defaultCacheFolder()
     return {};
 }
 
-std::string voxelCacheKey(const Scene& scene)
+std::string voxelCacheKey(const Scene& sequenced)
 {
+    const Scene scene = sceneAtFrame(sequenced, sequenced.frames.first);
     std::ostringstream s;
     s.precision(17);
     s << "volmorph voxel cache " << kCacheFormat << " version " << versionString() << " program "

@@ -3,6 +3,7 @@
 #include <OpenImageIO/filesystem.h>
 
 #include <algorithm>
+#include <filesystem>
 #include <set>
 
 namespace volmorph {
@@ -42,6 +43,28 @@ std::string checkFramePattern(const std::string& pattern)
     }
     if (directives > 1) return "the frame number may appear only once";
     return "";
+}
+
+bool hasFramePlaceholder(const std::string& pattern)
+{
+    return normalized(pattern).find('%') != std::string::npos;
+}
+
+std::vector<int> sequenceFrames(const std::string& pattern)
+{
+    std::vector<int> numbers;
+    std::vector<std::string> names;
+    if (!OIIO::Filesystem::scan_for_matching_filenames(normalized(pattern), numbers, names))
+        return {};
+    // Only names the pattern gives back exactly (its padding): "f.0001.vdb", not "f.1.vdb".
+    std::vector<int> frames;
+    for (size_t i = 0; i < numbers.size(); ++i)
+        if (std::filesystem::path(frameFileName(pattern, numbers[i])).filename() ==
+            std::filesystem::path(names[i]).filename())
+            frames.push_back(numbers[i]);
+    std::sort(frames.begin(), frames.end());
+    frames.erase(std::unique(frames.begin(), frames.end()), frames.end());
+    return frames;
 }
 
 std::string frameFileName(const std::string& pattern, int frame)

@@ -1,12 +1,15 @@
 // [source], [target] (mesh or volume, grids, transform, colour) and [volume].
 #include "TableParsers.h"
 
+#include <volmorph/Frames.h>
+
 #include <limits>
 
 namespace volmorph::detail {
 namespace {
 
-const std::vector<std::string> kObjectKeys = {"mesh", "volume", "grids", "transform", "color"};
+const std::vector<std::string> kObjectKeys = {"mesh",      "volume", "grids",
+                                              "transform", "color",  "window"};
 const std::vector<std::string> kGridKeys = {"density", "sdf", "color"};
 const std::vector<std::string> kTransformKeys = {"translate", "rotate", "scale"};
 const std::vector<std::string> kVolumeKeys = {"voxel_size", "resolution"};
@@ -49,6 +52,28 @@ void parseFile(Reader& r, const toml::node& n, const std::string& path,
                 path + ": file not found: '" + *s + "' (looked for " + file.string() + ")");
 }
 
+/// A volume file, or a sequence "fx.####.vdb" of which at least one frame is on disk.
+void parseVolumeFile(Reader& r, const toml::node& n, const std::string& path,
+                     const std::filesystem::path& folder, ObjectSpec& object)
+{
+    const std::optional<std::string> s = r.string(n, path);
+    if (!s || !hasFramePlaceholder(*s)) {
+        parseFile(r, n, path, folder, object.volume, object.fileWhere);
+        return;
+    }
+    object.fileWhere = r.at(n);
+    const std::filesystem::path p(*s);
+    object.volume = p.is_absolute() ? p : folder / p;
+    if (const std::string why = checkFramePattern(*s); !why.empty()) {
+        r.error(r.at(n), path + ": \"" + *s + "\": " + why);
+        return;
+    }
+    object.volumeFrames = sequenceFrames(object.volume.string());
+    if (object.volumeFrames.empty())
+        r.error(r.at(n), path + ": no file of the sequence '" + *s + "' exists (looked for " +
+                             object.volume.string() + ")");
+}
+
 /// grids = { density = "...", sdf = "...", color = "..." }: grid names in the volume file.
 void parseGridNames(Reader& r, const toml::node& node, const std::string& path,
                     VolumeGridNames& names)
@@ -66,6 +91,28 @@ void parseGridNames(Reader& r, const toml::node& node, const std::string& path,
             }
 }
 
+/// window = [lo, hi]: a NIfTI volume's intensities mapped to density 0..1.
+void parseWindow(Reader& r, const toml::node& n, const std::string& path, ObjectSpec& object)
+{
+    if (!isNiftiFile(object.volume)) {
+        r.error(r.at(n), path + ": only a NIfTI volume (.nii, .nii.gz) has a window");
+        return;
+    }
+    const toml::array* a = n.as_array();
+    if (!a || a->size() != 2) {
+        r.error(r.at(n), path + ": expected [lo, hi], the intensities mapped to density 0 and 1");
+        return;
+    }
+    const auto lo = r.number(*a->get(0), path + "[0]"), hi = r.number(*a->get(1), path + "[1]");
+    if (!lo || !hi) return;
+    if (!(*lo < *hi)) {
+        r.error(r.at(n), path + ": expected lo < hi, got [" + formatNumber(*lo) + ", " +
+                             formatNumber(*hi) + "]");
+        return;
+    }
+    object.window = std::pair{*lo, *hi};
+}
+
 } // namespace
 
 void parseObject(Reader& r, const toml::node& node, const std::string& path,
@@ -78,9 +125,10 @@ void parseObject(Reader& r, const toml::node& node, const std::string& path,
     const toml::node* volume = t->get("volume");
     if (mesh && volume)
         r.error(r.at(*volume), path + ": give either mesh or volume, not both");
-    else if (mesh || volume)
-        parseFile(r, mesh ? *mesh : *volume, path + (mesh ? ".mesh" : ".volume"), folder,
-                  mesh ? object.mesh : object.volume, object.fileWhere);
+    else if (mesh)
+        parseFile(r, *mesh, path + ".mesh", folder, object.mesh, object.fileWhere);
+    else if (volume)
+        parseVolumeFile(r, *volume, path + ".volume", folder, object);
     else
         r.missing(node, path + ".mesh",
                   "a mesh file name, or volume = a .vdb file, relative to the scene file");
@@ -91,6 +139,7 @@ void parseObject(Reader& r, const toml::node& node, const std::string& path,
         else
             parseGridNames(r, *n, path + ".grids", object.grids);
     }
+    if (const toml::node* n = t->get("window")) parseWindow(r, *n, path + ".window", object);
     if (const toml::node* n = t->get("transform"))
         parseTransform(r, *n, path + ".transform", object.transform);
     if (const toml::node* n = t->get("color"))

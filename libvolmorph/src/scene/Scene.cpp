@@ -1,6 +1,8 @@
 // Value functions of the scene's settings; parsing lives in SceneParser.cpp and its table units.
 #include <volmorph/Scene.h>
 
+#include <volmorph/Frames.h>
+
 #include <algorithm>
 #include <cassert>
 #include <cmath>
@@ -30,6 +32,35 @@ Vec3d ObjectTransform::apply(const Vec3d& p) const
 bool ObjectTransform::isIdentity() const
 {
     return translate == Vec3d(0.0) && rotateRadians == Vec3d(0.0) && scale == Vec3d(1.0);
+}
+
+bool isNiftiFile(const std::filesystem::path& file)
+{
+    const std::string name = file.filename().string();
+    auto endsWith = [&name](const std::string& end) {
+        return name.size() >= end.size() &&
+               name.compare(name.size() - end.size(), end.size(), end) == 0;
+    };
+    return endsWith(".nii") || endsWith(".nii.gz");
+}
+
+std::filesystem::path ObjectSpec::volumeAt(int frame) const
+{
+    if (!isSequence()) return volume;
+    auto held = std::upper_bound(volumeFrames.begin(), volumeFrames.end(), frame);
+    const int input = held == volumeFrames.begin() ? volumeFrames.front() : *std::prev(held);
+    return frameFileName(volume.string(), input);
+}
+
+Scene sceneAtFrame(const Scene& scene, int frame)
+{
+    Scene s = scene;
+    for (ObjectSpec* o : {&s.source, &s.target})
+        if (o->isSequence()) {
+            o->volume = o->volumeAt(frame);
+            o->volumeFrames.clear();
+        }
+    return s;
 }
 
 const char* toString(FeatureType type)

@@ -23,8 +23,9 @@ SideExtent extentOf(const Mesh& mesh)
 
 } // namespace
 
-std::pair<SideExtent, SideExtent> sceneExtents(const Scene& scene, const SceneMeshes& meshes)
+std::pair<SideExtent, SideExtent> sceneExtents(const Scene& sequenced, const SceneMeshes& meshes)
 {
+    const Scene scene = sceneAtFrame(sequenced, sequenced.frames.first);
     auto extent = [](const ObjectSpec& spec, const Mesh& mesh) {
         return spec.isVolume() ? extentOf(inspectVolume(spec)) : extentOf(mesh);
     };
@@ -42,8 +43,10 @@ double sceneVoxelSize(const VolumeSpec& volume, const SideExtent& source, const 
     return longest / double(std::max(1, volume.resolution.value_or(128)));
 }
 
-SceneVolumes voxelizeScene(const Scene& scene, Interrupter* interrupter, uint64_t memoryLimitBytes)
+SceneVolumes voxelizeScene(const Scene& sequenced, Interrupter* interrupter,
+                           uint64_t memoryLimitBytes)
 {
+    const Scene scene = sceneAtFrame(sequenced, sequenced.frames.first);
     SceneVolumes out;
     out.meshes = importSceneMeshes(scene);
     // Each volume file is read once: its bounds and voxel size, then its grids.

@@ -1,5 +1,7 @@
 #include "volume/VolumeFile.h"
 
+#include "volume/NiftiFile.h"
+
 #include <volmorph/core/VdbRead.h>
 
 #include <algorithm>
@@ -40,7 +42,8 @@ openvdb::math::Transform::Ptr placedTransform(const openvdb::math::Transform& gr
 VolumeFile::VolumeFile(const ObjectSpec& spec) : mSpec(spec)
 {
     try {
-        mGrids = readVdbGrids(spec.volume);
+        mGrids = isNiftiFile(spec.volume) ? readNiftiGrids(spec.volume, spec.window)
+                                          : readVdbGrids(spec.volume);
     } catch (const std::exception& e) {
         throw error(std::string("cannot read volume file (") + e.what() + ")");
     }

@@ -4,6 +4,8 @@
 // frames, and a fog morphs in sdf mode through its derived level set.
 #include "support/VolumeFixtures.h"
 
+#include <volmorph/core/VdbRead.h>
+#include <volmorph/Frames.h>
 #include <volmorph/SceneVolumes.h>
 #include <volmorph/Schedule.h>
 
@@ -112,6 +114,38 @@ TEST(VolumeMorph, ARotatedFinerCopyGivesTheSameFrames)
         EXPECT_LT(relativeL1(floatGrid(fa, "temperature"), floatGrid(fb, "temperature")),
                   1.2 * temperatures)
             << "t " << t;
+    }
+}
+
+TEST(VolumeMorph, EachFrameOfASequenceReadsItsOwnInputFrame)
+{
+    // The cloud drifting 0.1 world units along x per frame, frames 1-5 on disk; the scene runs
+    // 0-7: frame 0 holds input 1, frames 6 and 7 hold input 5.
+    const std::filesystem::path dir = clouds().dir / "drift";
+    std::filesystem::create_directories(dir);
+    const openvdb::GridPtrVecPtr grids = readVdbGrids(clouds().plain);
+    for (int f = 1; f <= 5; ++f) {
+        openvdb::GridPtrVec moved;
+        for (const auto& g : *grids) {
+            openvdb::GridBase::Ptr c = g->copyGrid();
+            openvdb::math::Transform::Ptr xf = g->transform().copy();
+            xf->postTranslate(openvdb::Vec3d(0.1 * f, 0.0, 0.0));
+            c->setTransform(xf);
+            moved.push_back(c);
+        }
+        openvdb::io::File(frameFileName((dir / "drift.####.vdb").string(), f)).write(moved);
+    }
+    Scene scene = cloudToSphere(dir / "drift.####.vdb");
+    ASSERT_EQ(scene.source.volumeFrames, (std::vector<int>{1, 2, 3, 4, 5}));
+    scene.frames.first = 0;
+    scene.frames.last = 7;
+    const double x0 = moments(*voxelizeScene(sceneAtFrame(scene, 1)).source.density).centroid.x();
+    for (int f = 0; f <= 7; ++f) {
+        const int input = std::clamp(f, 1, 5);
+        const Scene at = sceneAtFrame(scene, f);
+        EXPECT_EQ(at.source.volume.filename(), "drift.000" + std::to_string(input) + ".vdb");
+        const Moments m = moments(*voxelizeScene(at).source.density);
+        EXPECT_NEAR(m.centroid.x() - x0, 0.1 * (input - 1), 0.05 * kVoxel) << "frame " << f;
     }
 }
 
