@@ -5,19 +5,12 @@
 # usage: volume_morph.sh VOLMORPH SOURCE_DIR
 set -eu
 . "$(dirname "$0")/lib.sh"
-cat >"$out/scene.toml" <<TOML
-[source]
-volume = "$src/tests/data/volumes/fog_ball.vdb"
-[target]
-mesh = "$src/tests/data/meshes/cube.obj"
-transform = { translate = [1.5, 0, 0] }
-[blend]
+volume_scene "$src/tests/data/volumes/fog_ball.vdb" '[blend]
 grids = { temperature = "smoothstep" }
 [frames]
 range = "1-3"
 fps = 25
-output = "o.####.exr"
-TOML
+output = "o.####.exr"'
 "$volmorph" morph "$out/scene.toml" --frames 2 --preset blender --half -o "$out/b.####.vdb" -q
 expect_files "$out" "b.0002.vdb scene.toml"
 listing=$(vdb_print -l -m "$out/b.0002.vdb")

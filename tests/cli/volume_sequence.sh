@@ -21,16 +21,9 @@ for f in range(1, 6):
     g.transform.translate((0.1 * f, 0.0, 0.0))
     vdb.write("%s/drift.%04d.vdb" % (sys.argv[2], f), grids=[g])
 PY
-cat >"$out/scene.toml" <<TOML
-[source]
-volume = "drift.####.vdb"
-[target]
-mesh = "$src/tests/data/meshes/cube.obj"
-transform = { translate = [3, 0, 0] }
-[frames]
+volume_scene "drift.####.vdb" '[frames]
 range = "0-6"
-output = "o.####.exr"
-TOML
+output = "o.####.exr"'
 "$volmorph" morph "$out/scene.toml" -o "$out/m.####.vdb" -q --no-cache
 $py - "$src/tests/data/volumes/fog_ball.vdb" "$out" <<'PY'
 import sys

@@ -30,40 +30,19 @@ void convert(const void* data, std::vector<float>& out)
 /// integer or real scalar.
 bool intensities(const nifti_image& image, std::vector<float>& out)
 {
-    switch (image.datatype) {
-    case DT_UINT8:
-        convert<uint8_t>(image.data, out);
-        return true;
-    case DT_INT8:
-        convert<int8_t>(image.data, out);
-        return true;
-    case DT_INT16:
-        convert<int16_t>(image.data, out);
-        return true;
-    case DT_UINT16:
-        convert<uint16_t>(image.data, out);
-        return true;
-    case DT_INT32:
-        convert<int32_t>(image.data, out);
-        return true;
-    case DT_UINT32:
-        convert<uint32_t>(image.data, out);
-        return true;
-    case DT_INT64:
-        convert<int64_t>(image.data, out);
-        return true;
-    case DT_UINT64:
-        convert<uint64_t>(image.data, out);
-        return true;
-    case DT_FLOAT32:
-        convert<float>(image.data, out);
-        return true;
-    case DT_FLOAT64:
-        convert<double>(image.data, out);
-        return true;
-    default:
-        return false;
-    }
+    using Convert = void (*)(const void*, std::vector<float>&);
+    static const std::pair<int, Convert> kConverters[] = {
+        {DT_UINT8, convert<uint8_t>}, {DT_INT8, convert<int8_t>},
+        {DT_INT16, convert<int16_t>}, {DT_UINT16, convert<uint16_t>},
+        {DT_INT32, convert<int32_t>}, {DT_UINT32, convert<uint32_t>},
+        {DT_INT64, convert<int64_t>}, {DT_UINT64, convert<uint64_t>},
+        {DT_FLOAT32, convert<float>}, {DT_FLOAT64, convert<double>}};
+    for (const auto& [code, to] : kConverters)
+        if (image.datatype == code) {
+            to(image.data, out);
+            return true;
+        }
+    return false;
 }
 
 /// Index (i, j, k) to world: the sform, else the qform, else the voxel spacing.
