@@ -166,6 +166,8 @@ void printSettings(const Scene& scene)
     std::printf("blend   %s mode; density %s, colour %s, sdf %s\n",
                 b.mode == BlendMode::Sdf ? "sdf" : "density", describe(b.density).c_str(),
                 describe(b.color).c_str(), describe(b.sdf).c_str());
+    for (const auto& [name, grid] : b.grids)
+        std::printf("        carried grid %s: %s\n", name.c_str(), describe(grid.schedule).c_str());
     const RenderSpec& r = scene.render;
     std::printf(
         "render  %dx%d, %d samples, step %s voxels, extinction %s per world unit, albedo %s\n",

@@ -1,6 +1,6 @@
-// A procedural cumulus cloud as a fog .vdb (issue 33's second scene against Cycles), from the test
-// data generator (tests/unit/support/ProceduralCloud.h). Deterministic: the same arguments give the
-// same file.
+// A procedural cumulus cloud as a fog .vdb with a temperature grid (issue 33's second scene against
+// Cycles; scenes/volumes/cloud.vdb), from the test data generator
+// (tests/unit/support/ProceduralCloud.h). Deterministic: the same arguments give the same file.
 // usage: volmorph_bench_cloud OUT.vdb [VOXEL_SIZE (world units, default 0.01)]
 #include "support/ProceduralCloud.h"
 
@@ -19,9 +19,10 @@ int main(int argc, char** argv)
         return 2;
     }
     openvdb::initialize();
-    const openvdb::FloatGrid::Ptr grid =
-        volmorph::test::cloud::make(openvdb::math::Transform::createLinearTransform(voxel));
-    openvdb::io::File(argv[1]).write({grid});
+    openvdb::FloatGrid::Ptr temperature;
+    const openvdb::FloatGrid::Ptr grid = volmorph::test::cloud::make(
+        openvdb::math::Transform::createLinearTransform(voxel), &temperature);
+    openvdb::io::File(argv[1]).write({grid, temperature});
     std::printf("%s: %zu active voxels, voxel %g\n", argv[1], size_t(grid->activeVoxelCount()),
                 voxel);
     return 0;
