@@ -73,8 +73,8 @@ TEST(Scene, EveryExampleSceneLoads)
         ++count;
         EXPECT_NO_THROW({
             const Scene s = loadScene(entry.path());
-            EXPECT_TRUE(std::filesystem::exists(s.source.mesh));
-            EXPECT_TRUE(std::filesystem::exists(s.target.mesh));
+            EXPECT_TRUE(std::filesystem::exists(s.source.file()));
+            EXPECT_TRUE(std::filesystem::exists(s.target.file()));
             EXPECT_FALSE(s.pairs.empty());
         }) << entry.path();
     }
