@@ -3,6 +3,7 @@
 #include <OpenImageIO/filesystem.h>
 
 #include <algorithm>
+#include <cctype>
 #include <filesystem>
 #include <set>
 
@@ -47,7 +48,18 @@ std::string checkFramePattern(const std::string& pattern)
 
 bool hasFramePlaceholder(const std::string& pattern)
 {
-    return normalized(pattern).find('%') != std::string::npos;
+    const std::string p = normalized(pattern);
+    for (size_t i = 0; i < p.size(); ++i) {
+        if (p[i] != '%') continue;
+        if (i + 1 < p.size() && p[i + 1] == '%') {
+            ++i; // a literal '%'
+            continue;
+        }
+        size_t j = i + 1;
+        while (j < p.size() && std::isdigit(static_cast<unsigned char>(p[j]))) ++j;
+        if (j < p.size() && p[j] == 'd') return true;
+    }
+    return false;
 }
 
 std::vector<int> sequenceFrames(const std::string& pattern)

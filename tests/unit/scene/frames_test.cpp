@@ -2,6 +2,10 @@
 
 #include <gtest/gtest.h>
 
+#include <filesystem>
+#include <fstream>
+#include <unistd.h>
+
 using namespace volmorph;
 
 namespace {
@@ -95,4 +99,31 @@ TEST(Frames, ChunksCoverEveryFrameOnceInOrder)
             EXPECT_TRUE(chunkFrames(frames, size, chunks).empty());
         }
     }
+}
+
+TEST(Frames, PlaceholdersAndSequencesOnDisk)
+{
+    EXPECT_TRUE(hasFramePlaceholder("fx.####.vdb"));
+    EXPECT_TRUE(hasFramePlaceholder("fx.%04d.vdb"));
+    EXPECT_TRUE(hasFramePlaceholder("fx.%d.vdb"));
+    EXPECT_FALSE(hasFramePlaceholder("fx.vdb"));
+    EXPECT_FALSE(hasFramePlaceholder("100%%.vdb")); // a literal percent sign
+    const std::filesystem::path dir =
+        std::filesystem::temp_directory_path() / ("volmorph-seq-" + std::to_string(getpid()));
+    std::filesystem::create_directories(dir);
+    for (const char* name : {"s.0003.vdb", "s.0001.vdb", "s.7.vdb", "t.0002.vdb"})
+        std::ofstream(dir / name) << "x";
+    // Only the pattern's own padding counts: s.7.vdb is not frame 7 of s.####.vdb.
+    EXPECT_EQ(sequenceFrames((dir / "s.####.vdb").string()), (std::vector<int>{1, 3}));
+    EXPECT_TRUE(sequenceFrames((dir / "u.####.vdb").string()).empty());
+    EXPECT_TRUE(sequenceFrames((dir / "nowhere" / "s.####.vdb").string()).empty());
+    // A sequence's file for an output frame: its own, the one before a gap, the ends held.
+    ObjectSpec spec;
+    spec.volume = dir / "s.####.vdb";
+    spec.volumeFrames = {1, 3};
+    EXPECT_EQ(spec.volumeAt(0).filename(), "s.0001.vdb");
+    EXPECT_EQ(spec.volumeAt(2).filename(), "s.0001.vdb");
+    EXPECT_EQ(spec.volumeAt(3).filename(), "s.0003.vdb");
+    EXPECT_EQ(spec.volumeAt(9).filename(), "s.0003.vdb");
+    std::filesystem::remove_all(dir);
 }
