@@ -12,6 +12,7 @@
 #include <cmath>
 #include <cstdio>
 #include <memory>
+#include <tuple>
 
 namespace volmorph::cli {
 namespace {
@@ -34,8 +35,8 @@ void printMesh(const char* label, const ObjectSpec& spec, const Mesh& mesh)
 }
 
 /// A volume input: the grids that play each part, those carried, those left out.
-void printVolumeInput(const char* label, const ObjectSpec& spec, const SideExtent& extent,
-                      int firstFrame)
+/// Returns the side's extent (each volume file is read once).
+SideExtent printVolumeInput(const char* label, const ObjectSpec& spec, int firstFrame)
 {
     ObjectSpec first = spec;
     first.volume = spec.volumeAt(firstFrame);
@@ -60,7 +61,9 @@ void printVolumeInput(const char* label, const ObjectSpec& spec, const SideExten
     if (!carried.empty()) std::printf("        carried:%s\n", carried.c_str());
     if (!ignored.empty()) std::printf("        left out (not float or vec3):%s\n", ignored.c_str());
     std::printf("        voxel size %s world units; bounds %s .. %s world units\n",
-                fmt(info.voxelSize).c_str(), fmt(extent.lo).c_str(), fmt(extent.hi).c_str());
+                fmt(info.voxelSize).c_str(), fmt(info.worldMin).c_str(),
+                fmt(info.worldMax).c_str());
+    return SideExtent{info.worldMin, info.worldMax, info.voxelSize};
 }
 
 /// Hand-placed features far from their side are usually a typo in a coordinate.
@@ -239,15 +242,17 @@ int runCheck(const std::string& scenePath)
 {
     const Scene scene = loadScene(scenePath);
     const SceneMeshes meshes = importSceneMeshes(scene);
-    const auto [source, target] = sceneExtents(scene, meshes);
     std::printf("scene   %s\n", scenePath.c_str());
+    SideExtent source, target;
     for (auto [label, spec, mesh, extent] :
          {std::tuple{"source", &scene.source, &meshes.source, &source},
           std::tuple{"target", &scene.target, &meshes.target, &target}}) {
-        if (spec->isVolume())
-            printVolumeInput(label, *spec, *extent, scene.frames.first);
-        else
+        if (spec->isVolume()) {
+            *extent = printVolumeInput(label, *spec, scene.frames.first);
+        } else {
             printMesh(label, *spec, *mesh);
+            std::tie(extent->lo, extent->hi) = mesh->bounds();
+        }
     }
     printVolume(scene, meshes, source, target);
     printPairs(scene);

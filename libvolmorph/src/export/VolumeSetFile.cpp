@@ -2,6 +2,7 @@
 #include <volmorph/VolumeSet.h>
 
 #include <volmorph/core/AtomicFile.h>
+#include <volmorph/core/VdbRead.h>
 #include "export/VdbFile.h"
 
 #include <openvdb/io/File.h>
@@ -89,24 +90,21 @@ void writeVdbChecked(const std::filesystem::path& path, const openvdb::GridCPtrV
 
 VolumeSet readVolumeSet(const std::filesystem::path& path)
 {
-    initializeOpenVdb();
-    VolumeSet out;
+    openvdb::GridPtrVecPtr grids;
     try {
-        openvdb::io::File file(path.string());
-        file.open();
-        for (auto it = file.beginName(); it != file.endName(); ++it) {
-            const std::string name = it.gridName();
-            if (name == kSdfGridName)
-                out.sdf = openvdb::gridPtrCast<openvdb::FloatGrid>(file.readGrid(name));
-            else if (name == kDensityGridName)
-                out.density = openvdb::gridPtrCast<openvdb::FloatGrid>(file.readGrid(name));
-            else if (name == kColorGridName)
-                out.color = openvdb::gridPtrCast<openvdb::Vec3SGrid>(file.readGrid(name));
-        }
-        file.close();
+        grids = readVdbGrids(path);
     } catch (const std::exception& e) {
         throw UserError(SourceLocation{path.string()},
                         std::string("cannot read volume file (") + e.what() + ")");
+    }
+    VolumeSet out;
+    for (const openvdb::GridBase::Ptr& g : *grids) {
+        if (g->getName() == kSdfGridName)
+            out.sdf = openvdb::gridPtrCast<openvdb::FloatGrid>(g);
+        else if (g->getName() == kDensityGridName)
+            out.density = openvdb::gridPtrCast<openvdb::FloatGrid>(g);
+        else if (g->getName() == kColorGridName)
+            out.color = openvdb::gridPtrCast<openvdb::Vec3SGrid>(g);
     }
     return out;
 }
