@@ -42,9 +42,12 @@ struct Feature {
     /// The same, for q = frameCoordinates(p).
     double distanceInFrame(const Vec3d& q) const;
 
-    /// The gradient of the distance, in world (or index) axes, at p with frame coordinates q and
-    /// distance d > 0: the unit vector from the element's nearest point to p.
-    Vec3d gradientInFrame(const Vec3d& q, double d) const;
+    /// q minus its nearest point on the element, in the frame: its length is distanceInFrame(q)
+    /// and, divided by that, it is the distance's gradient in the frame.
+    Vec3d offsetFromElement(const Vec3d& q) const;
+    /// The frame axes the element extends along, from x: 0 for a point, 1 (x) for a segment, 2
+    /// for a rectangle, 3 for a box. Only their scales move the element's nearest points.
+    int extendedAxes() const { return int(type); }
 
     /// The element's characteristic length, for Beier-Neely weights: 1 for a point, the segment's
     /// length, the rectangle's and the box's diagonal.
@@ -60,6 +63,11 @@ struct Feature {
 /// The element at time t in [0, 1]: origin and scales linear, orientation by quaternion slerp
 /// along the shorter arc.
 Feature interpolate(const Feature& a, const Feature& b, double t);
+
+/// The angular velocity of interpolate(a, b, t)'s frame, in radians per unit of t about world (or
+/// index) axes: constant along the geodesic, so d(axis)/dt = omega x axis at every t. Between
+/// frames half a turn apart the geodesic is not unique and this gives one of them.
+Vec3d angularVelocity(const Feature& a, const Feature& b);
 
 /// The unit quaternion (as openvdb::math::Quat's constructor from a Mat3 gives it) of the
 /// rotation whose rows are the orthonormal frame x, y, z; also for frames a few ulps off, which

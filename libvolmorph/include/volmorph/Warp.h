@@ -9,6 +9,8 @@
 
 #include <volmorph/Feature.h>
 
+#include <openvdb/math/Mat3.h>
+
 #include <vector>
 
 namespace volmorph {
@@ -26,6 +28,19 @@ public:
 
     /// The exact warp: p' -> (source point, target point).
     void map(const Vec3d& p, Vec3d& source, Vec3d& target) const;
+
+    /// One side's warp W (output point -> that side's point) differentiated at an output point:
+    /// J = dW/dp' and dW/dt, t the morph time (lengths in the warp's units).
+    struct Derivatives {
+        openvdb::math::Mat3d jacobian = openvdb::math::Mat3d::identity();
+        Vec3d rate{0.0};
+    };
+    /// The exact warp's derivatives at p', analytic (through each pair's weight as well as its
+    /// map; where p' lies on elements, the mean of their maps').
+    void derivatives(const Vec3d& p, Derivatives& source, Derivatives& target) const;
+    /// The velocity of what one side shows at p': -J^-1 dW/dt, in the warp's units per unit of t.
+    /// False where J is singular (the warp folds there): then v is 0.
+    static bool velocity(const Derivatives& d, Vec3d& v);
 
     /// Every weight follows w_i(d) = scale_i (offset + d)^-exponent: inverse square is scale 1,
     /// offset epsilon, exponent 2; Beier-Neely is scale length_i^(p b), offset a, exponent b.
@@ -59,7 +74,10 @@ private:
         Vec3d toTarget[3];
         Vec3d sourceOrigin, targetOrigin;
         double lengthPow = 1; ///< length^p, Beier-Neely only
+        /// How the element moves per unit t: origin and scales (linear) and its frame's turn.
+        Vec3d originRate, scaleRate, omega;
     };
+    struct SideSums;
     double weight(const Pair& pair, double distance) const;
     /// Pair's affine images on both sides of the point with frame coordinates q.
     static void images(const Pair& pair, const Vec3d& q, Vec3d& source, Vec3d& target)
@@ -72,7 +90,7 @@ private:
 
     std::vector<Pair> mPairs;
     Weighting mWeighting;
-    double mEpsilon, mA, mB;
+    double mEpsilon, mA, mB, mP;
 };
 
 } // namespace volmorph

@@ -1,6 +1,6 @@
 #include <volmorph/Feature.h>
 
-#include <openvdb/math/Mat.h>
+#include <openvdb/math/Mat3.h>
 #include <openvdb/math/Quat.h>
 
 #include <algorithm>
@@ -39,27 +39,12 @@ double Feature::distanceInFrame(const Vec3d& q) const
     return q.length();
 }
 
-Vec3d Feature::gradientInFrame(const Vec3d& q, double d) const
+Vec3d Feature::offsetFromElement(const Vec3d& q) const
 {
-    // q minus its nearest point on the element, in the frame; then rotated to world axes.
-    auto beyond = [](double v, double half) { return v - std::clamp(v, -half, half); };
     Vec3d v = q;
-    switch (type) {
-    case FeatureType::Point:
-        break;
-    case FeatureType::Segment:
-        v = Vec3d(beyond(q.x(), 0.5 * scale.x()), q.y(), q.z());
-        break;
-    case FeatureType::Rectangle:
-        v = Vec3d(beyond(q.x(), 0.5 * scale.x()), beyond(q.y(), 0.5 * scale.y()), q.z());
-        break;
-    case FeatureType::Box:
-        v = Vec3d(beyond(q.x(), 0.5 * scale.x()), beyond(q.y(), 0.5 * scale.y()),
-                  beyond(q.z(), 0.5 * scale.z()));
-        break;
-    }
-    v /= d;
-    return x * v.x() + y * v.y() + z * v.z();
+    for (int k = 0; k < extendedAxes(); ++k)
+        v[k] = q[k] - std::clamp(q[k], -0.5 * scale[k], 0.5 * scale[k]);
+    return v;
 }
 
 double Feature::length() const
@@ -150,6 +135,36 @@ openvdb::math::Quatd rotationQuaternion(const Vec3d& x, const Vec3d& y, const Ve
     }
     const double norm = std::sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3]);
     return openvdb::math::Quatd(q[0] / norm, q[1] / norm, q[2] / norm, q[3] / norm);
+}
+
+Vec3d angularVelocity(const Feature& a, const Feature& b)
+{
+    // Q = sum_k b_k a_k^T turns a's axes onto b's; the geodesic is exp(t log Q) applied to a's.
+    // Its rotation vector: the axis from Q's skew part (sin), the angle with the trace (cos).
+    openvdb::math::Mat3d q = openvdb::math::Mat3d::zero();
+    const Vec3d* as[3] = {&a.x, &a.y, &a.z};
+    const Vec3d* bs[3] = {&b.x, &b.y, &b.z};
+    for (int k = 0; k < 3; ++k)
+        for (int i = 0; i < 3; ++i)
+            for (int j = 0; j < 3; ++j) q(i, j) += (*bs[k])[i] * (*as[k])[j];
+    const Vec3d skew(0.5 * (q(2, 1) - q(1, 2)), 0.5 * (q(0, 2) - q(2, 0)),
+                     0.5 * (q(1, 0) - q(0, 1))); // sin(theta) n
+    const double sinTheta = skew.length();
+    const double cosTheta = std::clamp(0.5 * (q(0, 0) + q(1, 1) + q(2, 2) - 1.0), -1.0, 1.0);
+    const double theta = std::atan2(sinTheta, cosTheta);
+    if (sinTheta > 1e-6) return skew * (theta / sinTheta);
+    if (cosTheta > 0.0) return skew; // theta ~ sin(theta): a small or no turn
+    // Near half a turn: n n^T = ((Q + Q^T) / 2 - cos I) / (1 - cos); its largest column, signed
+    // as the skew part leans.
+    int i = 0;
+    for (int k = 1; k < 3; ++k)
+        if (q(k, k) > q(i, i)) i = k;
+    Vec3d n;
+    for (int k = 0; k < 3; ++k)
+        n[k] = (0.5 * (q(k, i) + q(i, k)) - (k == i ? cosTheta : 0.0)) / (1.0 - cosTheta);
+    n.normalize();
+    if (n.dot(skew) < 0.0) n = -n;
+    return n * theta;
 }
 
 Feature interpolate(const Feature& a, const Feature& b, double t)

@@ -7,7 +7,8 @@ namespace volmorph {
 
 InverseWarp::InverseWarp(const std::vector<FeaturePairSpec>& pairs, const WarpSpec& spec, double t,
                          double unit)
-    : mWeighting(spec.weighting), mEpsilon(spec.epsilon * unit), mA(spec.a * unit), mB(spec.b)
+    : mWeighting(spec.weighting), mEpsilon(spec.epsilon * unit), mA(spec.a * unit), mB(spec.b),
+      mP(spec.p)
 {
     mPairs.reserve(pairs.size());
     for (const FeaturePairSpec& spec_ : pairs) {
@@ -25,6 +26,9 @@ InverseWarp::InverseWarp(const std::vector<FeaturePairSpec>& pairs, const WarpSp
         p.sourceOrigin = s.origin;
         p.targetOrigin = d.origin;
         p.lengthPow = std::pow(p.element.length(), spec.p);
+        p.originRate = d.origin - s.origin;
+        p.scaleRate = d.scale - s.scale;
+        p.omega = angularVelocity(s, d);
         mPairs.push_back(p);
     }
 }
