@@ -78,6 +78,7 @@ int runMorph(const MorphArgs& args)
     MorphOptions options;
     if (args.sampling == "triquadratic") options.sampling = MorphOptions::Sampling::Triquadratic;
     options.memoryLimitBytes = memoryLimitBytes(args.memoryLimitGiB);
+    options.secondsPerUnitT = scene.frames.secondsPerUnitT(); // the vel grid
     SceneMorph morph(scene, args.cache, interrupter, options, args.quiet);
 
     FrameLoop loop(scene, frames, 1, args.quiet, true, interrupter);
@@ -100,7 +101,7 @@ Command addMorphCommand(CLI::App& app)
 {
     auto args = std::make_shared<MorphArgs>();
     CLI::App* sub = app.add_subcommand(
-        "morph", "Write the morphed volume of each frame as a .vdb (grids density, Cd)");
+        "morph", "Write the morphed volume of each frame as a .vdb (grids density, Cd, vel)");
     sub->add_option("SCENE", args->scene, "scene file (TOML)")->required();
     sub->add_option("--frames", args->frames,
                     "frames to write, e.g. 1-10, 1-100x2, 1,5,10-20 (default: all)");

@@ -187,13 +187,16 @@ void approximatedWarp(benchmark::State& state)
     warpOnly(state, 0.25);
 }
 
-/// One whole frame at t = 0.5 with the scene's pairs, in the given blend mode.
-void frame(benchmark::State& state, BlendMode mode)
+/// One whole frame at t = 0.5 with the scene's pairs (or `pairs` of pairsFor), in the given blend
+/// mode, at range(0) voxels across (or 256 when `pairs` is given).
+void frame(benchmark::State& state, BlendMode mode, int pairs = 0, MorphOptions options = {})
 {
-    const Setup& s = setup(int(state.range(0)));
+    const Setup& s = setup(pairs ? 256 : int(state.range(0)));
     BlendSpec blend = s.scene.blend;
     blend.mode = mode;
-    const Morpher morpher(s.volumes.source, s.volumes.target, s.scene.pairs, s.scene.warp, blend);
+    const Morpher morpher(s.volumes.source, s.volumes.target,
+                          pairs ? pairsFor(s.scene, pairs) : s.scene.pairs, s.scene.warp, blend,
+                          options);
     MorphStats stats;
     for (auto _ : state) {
         VolumeSet v = morpher.frame(0.5, &stats);
@@ -206,6 +209,10 @@ void frame(benchmark::State& state, BlendMode mode)
     state.counters["ns_per_active_voxel"] = benchmark::Counter(
         double(stats.activeVoxels) * 1e-9,
         benchmark::Counter::kIsIterationInvariantRate | benchmark::Counter::kInvert);
+    if (options.secondsPerUnitT > 0.0) {
+        state.counters["vel_interpolated_cubes"] = double(stats.velocityInterpolated);
+        state.counters["vel_exact_cubes"] = double(stats.velocityExact);
+    }
 }
 
 /// The default scene's frame (sdf mode: the blend of extended distances, its islands dropped,
@@ -286,6 +293,15 @@ void morphFrameExtras(benchmark::State& state)
     state.counters["active_voxels"] = double(stats.activeVoxels);
 }
 
+/// A density-mode frame at t = 0.5 with range(0) pairs (the scene's, then random ones), without
+/// (range(1) = 0) and with the `vel` grid (issue 36: at most 1.3x).
+void morphFrameVelocity(benchmark::State& state)
+{
+    MorphOptions options;
+    options.secondsPerUnitT = state.range(1) ? 1.0 : 0.0;
+    frame(state, BlendMode::Density, int(state.range(0)), options);
+}
+
 void identityResample(benchmark::State& state)
 {
     lowerBound(state, BlendMode::Sdf);
@@ -322,3 +338,8 @@ void extraGrids(benchmark::internal::Benchmark* b)
     b->Unit(benchmark::kMillisecond)->UseRealTime();
 }
 BENCHMARK(morphFrameExtras)->Apply(extraGrids);
+/// The scene's 3 pairs and 16 pairs, without and with velocity.
+BENCHMARK(morphFrameVelocity)
+    ->ArgsProduct({{3, 16}, {0, 1}})
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();

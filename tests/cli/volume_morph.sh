@@ -1,7 +1,8 @@
 #!/bin/sh
 # volmorph morph of a volume input (a fog ball with temperature, vel and a bool grid) into a mesh:
-# --preset blender --half writes Blender's names (color, velocity) with the carried temperature,
-# 16-bit floats and the frame, t and fps; --preset houdini in sdf mode writes a `surface` level set.
+# --preset blender --half writes Blender's names (color, velocity: the morph's own) with the carried
+# temperature and the input's vel (as velocity_carried), 16-bit floats and the frame, t and fps;
+# --preset houdini in sdf mode writes a `surface` level set.
 # usage: volume_morph.sh VOLMORPH SOURCE_DIR
 set -eu
 . "$(dirname "$0")/lib.sh"
@@ -14,7 +15,7 @@ output = "o.####.exr"'
 "$volmorph" morph "$out/scene.toml" --frames 2 --preset blender --half -o "$out/b.####.vdb" -q
 expect_files "$out" "b.0002.vdb scene.toml"
 listing=$(vdb_print -l -m "$out/b.0002.vdb")
-for name in density color temperature velocity; do
+for name in density color temperature velocity velocity_carried; do
     echo "$listing" | grep -q "^Name: $name\$" || { echo "no grid $name:"; echo "$listing"; exit 1; }
 done
 echo "$listing" | grep -q "^Name: ids" && { echo "the bool grid was carried"; exit 1; }
@@ -27,7 +28,7 @@ import sys
 import pyopenvdb as vdb
 grids, _ = vdb.readAll(sys.argv[1])
 names = sorted(g.name for g in grids)
-assert names == ["color", "density", "temperature", "velocity"], names
+assert names == ["color", "density", "temperature", "velocity", "velocity_carried"], names
 for g in grids:
     assert g.metadata.get("is_saved_as_half_float"), (g.name, "not half")
 heat = [g for g in grids if g.name == "temperature"][0]

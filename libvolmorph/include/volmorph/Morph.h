@@ -30,11 +30,17 @@ struct MorphOptions {
     /// A frame stops with a UserError once its output would need more than this many bytes
     /// (kMorphBytesPerLeaf per kept 8^3 leaf); 0 = half the machine's memory.
     uint64_t memoryLimitBytes = 0;
+    /// The `vel` grid's time unit: the seconds one unit of t lasts ((last - first) / fps for a
+    /// frame range). 0: no velocity grid.
+    double secondsPerUnitT = 0.0;
 };
 
 /// What one kept output leaf costs while a frame is made: density, colour and, in sdf mode, the
 /// distance field and its fog, with the tools' temporaries (an upper estimate).
 inline constexpr uint64_t kMorphBytesPerLeaf = 24 * 1024;
+/// What the velocity adds per kept leaf: its values and mask, and both sides' velocities while
+/// the leaf is filled.
+inline constexpr uint64_t kVelocityBytesPerLeaf = 7 * 1024;
 
 struct MorphStats {
     double maxWarpErrorVoxels =
@@ -44,6 +50,8 @@ struct MorphStats {
     uint64_t outputLeaves = 0;     ///< output leaves kept (non-empty)
     uint64_t activeVoxels = 0;     ///< of the density grid, tiles included
     uint64_t blendSamples = 0;     ///< sdf mode: points where the blend was evaluated
+    /// Velocity: 4^3 sub-cubes interpolated from their leaf's lattice, and evaluated exactly.
+    uint64_t velocityInterpolated = 0, velocityExact = 0;
 };
 
 class Morpher {

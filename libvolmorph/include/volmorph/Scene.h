@@ -201,6 +201,9 @@ struct FramesSpec {
 
     int count() const { return last - first + 1; }
     double t(int frame) const;
+    /// The seconds one unit of t lasts: (last - first) / fps; 0 for a single frame (t stands
+    /// still).
+    double secondsPerUnitT() const { return last > first ? double(last - first) / fps : 0.0; }
 };
 
 struct Scene {

@@ -13,6 +13,7 @@ namespace volmorph {
 inline constexpr const char* kSdfGridName = "sdf";
 inline constexpr const char* kDensityGridName = "density";
 inline constexpr const char* kColorGridName = "Cd";
+inline constexpr const char* kVelocityGridName = "vel";
 
 struct VolumeSet {
     /// Signed distance in world units, negative inside; GRID_LEVEL_SET with a narrow band of
@@ -26,6 +27,9 @@ struct VolumeSet {
     /// Every other grid a volume input carries (temperature, flame, ...): float or vec3 grids by
     /// name, warped like Cd and blended with their own schedules (blend.grids).
     std::map<std::string, openvdb::GridBase::Ptr> extras;
+    /// An in-between's velocity, world units per second: the motion of the material it shows (the
+    /// time derivative of the warp, as the blend weights the sides). Active where the density is.
+    openvdb::Vec3SGrid::Ptr velocity;
 
     /// World units (the grids share one uniform linear transform).
     double voxelSize() const
@@ -55,8 +59,8 @@ std::string presetName(const std::string& grid, GridNames names);
 void writeVolumeSet(const VolumeSet& volumes, const std::filesystem::path& path,
                     const VdbWriteOptions& options = {});
 
-/// Reads sdf, density and Cd from a .vdb file (any that are present). Throws UserError naming the
-/// file when it cannot be read.
+/// Reads sdf, density, Cd and vel (or Blender's velocity) from a .vdb file (any that are present).
+/// Throws UserError naming the file when it cannot be read.
 VolumeSet readVolumeSet(const std::filesystem::path& path);
 
 } // namespace volmorph

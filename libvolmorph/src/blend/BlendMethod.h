@@ -46,6 +46,9 @@ struct BlendRequest {
     const Occupancy* sourceBlocks = nullptr;
     const Occupancy* targetBlocks = nullptr;
     Interrupter* interrupter = nullptr;
+    /// The velocity's units: world units per second of one index unit per unit t (voxel size over
+    /// the seconds a unit of t lasts); 0: no velocity grid.
+    double velocityScale = 0.0;
 };
 
 /// A method's frame: the grids (density and Cd; sdf in sdf mode), without names or transforms
@@ -55,6 +58,8 @@ struct BlendedFrame {
     size_t keptLeaves = 0;
     AdaptiveWarpStats warp;
     uint64_t blendSamples = 0; ///< points where the blend was evaluated (sdf mode)
+    /// The velocity's 4^3 sub-cubes: interpolated from the leaf's lattice, and evaluated exactly.
+    uint64_t velocityInterpolated = 0, velocityExact = 0;
 };
 
 class BlendMethod {

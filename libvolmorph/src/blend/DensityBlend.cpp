@@ -3,6 +3,7 @@
 #include "blend/ColorBlend.h"
 #include "blend/ExtraGrids.h"
 #include "blend/Sample.h"
+#include "blend/VelocityBlend.h"
 #include "blend/WithSampler.h"
 
 #include <volmorph/Schedule.h>
@@ -21,9 +22,10 @@ struct Resampler {
     float tauDensity, tauColor;
     Vec3f background;
 
-    /// Returns false when the leaf holds nothing.
+    /// Returns false when the leaf holds nothing. a, b: each side's density at the voxels'
+    /// warped points, where the output is kept.
     bool operator()(const WarpLeaf& w, OutputLeaves::ValueLeaf& value,
-                    OutputLeaves::ColorLeaf& color) const
+                    OutputLeaves::ColorLeaf& color, float a[512], float b[512]) const
     {
         auto ds = source.density->getConstAccessor();
         auto dt = target.density->getConstAccessor();
@@ -31,13 +33,13 @@ struct Resampler {
         bool any = false;
         for (openvdb::Index n = 0; n < 512; ++n) {
             const openvdb::Vec3R ps(w.source(n)), pt(w.target(n));
-            const float a = sample<Sampler>(ds, ps);
-            const float b = sample<Sampler>(dt, pt);
-            const float d = (1.0f - tauDensity) * a + tauDensity * b;
+            a[n] = sample<Sampler>(ds, ps);
+            b[n] = sample<Sampler>(dt, pt);
+            const float d = (1.0f - tauDensity) * a[n] + tauDensity * b[n];
             if (!(d > kEmpty)) continue;
             value.setValueOn(n, d);
             any = true;
-            color.setValueOn(n, blend(ps, pt, a, b));
+            color.setValueOn(n, blend(ps, pt, a[n], b[n]));
         }
         return any;
     }
@@ -54,23 +56,31 @@ public:
         const float tauC = float(scheduleValue(mSpec.color, r.t));
         const Resampler<Sampler> resample{mSource, mTarget, tauD, tauC, leaves.background()};
         const ExtraGrids extras(mSource, mTarget, mSpec, r.t);
+        const VelocityBlend velocity(*r.warp, r.velocityScale, tauD);
         BlendedFrame out;
         r.adaptive->forEachLeaf(
             r.box, r.sourceBlocks, r.targetBlocks,
             [&](const WarpLeaf& w) {
                 auto [density, color] = leaves.make(w.origin, 0.0f);
-                if (!resample(w, *density, *color)) return;
+                float a[512], b[512];
+                if (!resample(w, *density, *color, a, b)) return;
                 ExtraLeaves e = extras.make(w.origin);
                 extras.fill<Sampler>(density->getValueMask(), WarpedPoints{w}, e);
+                if (velocity.enabled())
+                    e.velocity = velocity.leaf(w.origin, density->getValueMask(), a, b);
                 leaves.keep(std::move(density), std::move(color), std::move(e));
             },
             &out.warp, r.interrupter);
         out.grids.density = openvdb::FloatGrid::create(0.0f);
         out.grids.color = openvdb::Vec3SGrid::create(leaves.background());
         out.keptLeaves = leaves.size();
+        out.velocityInterpolated = velocity.interpolatedCubes();
+        out.velocityExact = velocity.exactCubes();
         ExtraGrids::Outputs carried = extras.outputs();
+        if (velocity.enabled()) out.grids.velocity = openvdb::Vec3SGrid::create(Vec3f(0.0f));
         leaves.moveInto(out.grids.density->tree(), out.grids.color->tree(), 0.0f, carried.floats,
-                        carried.vectors);
+                        carried.vectors,
+                        out.grids.velocity ? &out.grids.velocity->tree() : nullptr);
         out.grids.extras = std::move(carried.grids);
         // Leaves of constant interior collapse into tiles.
         openvdb::tools::prune(out.grids.density->tree());

@@ -47,7 +47,8 @@ void OutputLeaves::insideTile(const openvdb::Coord& origin)
 
 void OutputLeaves::moveInto(openvdb::FloatTree& values, openvdb::Vec3STree& colors,
                             float insideValue, const std::vector<openvdb::FloatTree*>& floatExtras,
-                            const std::vector<openvdb::Vec3STree*>& vectorExtras)
+                            const std::vector<openvdb::Vec3STree*>& vectorExtras,
+                            openvdb::Vec3STree* velocity)
 {
     for (Kept& k : mLeaves) {
         values.addLeaf(k.value.release());
@@ -56,6 +57,7 @@ void OutputLeaves::moveInto(openvdb::FloatTree& values, openvdb::Vec3STree& colo
             floatExtras[i]->addLeaf(k.extras.floats[i].release());
         for (size_t i = 0; i < k.extras.vectors.size(); ++i)
             vectorExtras[i]->addLeaf(k.extras.vectors[i].release());
+        if (velocity && k.extras.velocity) velocity->addLeaf(k.extras.velocity.release());
     }
     mLeaves.clear();
     for (const openvdb::Coord& origin : mInside) values.addTile(1, origin, insideValue, false);

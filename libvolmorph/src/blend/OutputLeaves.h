@@ -18,6 +18,8 @@ namespace volmorph::detail {
 struct ExtraLeaves {
     std::vector<std::unique_ptr<openvdb::FloatTree::LeafNodeType>> floats;
     std::vector<std::unique_ptr<openvdb::Vec3STree::LeafNodeType>> vectors;
+    /// The velocity's leaf (VelocityBlend.h), when the frame has one.
+    std::unique_ptr<openvdb::Vec3STree::LeafNodeType> velocity;
 };
 
 class OutputLeaves {
@@ -45,11 +47,12 @@ public:
     size_t size() const { return mLeaves.size(); }
     const Vec3f& background() const { return mBackground; }
 
-    /// Moves the leaves into the trees (the extras' in ExtraLeaves' order); inside tiles
-    /// (leaf-sized) of the value tree get `insideValue`.
+    /// Moves the leaves into the trees (the extras' in ExtraLeaves' order, the velocity's into
+    /// `velocity` when given); inside tiles (leaf-sized) of the value tree get `insideValue`.
     void moveInto(openvdb::FloatTree& values, openvdb::Vec3STree& colors, float insideValue,
                   const std::vector<openvdb::FloatTree*>& floatExtras = {},
-                  const std::vector<openvdb::Vec3STree*>& vectorExtras = {});
+                  const std::vector<openvdb::Vec3STree*>& vectorExtras = {},
+                  openvdb::Vec3STree* velocity = nullptr);
 
 private:
     double mT;

@@ -43,7 +43,7 @@ void writeVolumeSet(const VolumeSet& volumes, const std::filesystem::path& path,
                     const VdbWriteOptions& options)
 {
     initializeOpenVdb();
-    openvdb::GridPtrVec all = {volumes.sdf, volumes.density, volumes.color};
+    openvdb::GridPtrVec all = {volumes.sdf, volumes.density, volumes.color, volumes.velocity};
     for (const auto& [name, grid] : volumes.extras) all.push_back(grid);
     openvdb::GridPtrVec grids;
     std::set<std::string> taken;
@@ -105,6 +105,8 @@ VolumeSet readVolumeSet(const std::filesystem::path& path)
             out.density = openvdb::gridPtrCast<openvdb::FloatGrid>(g);
         else if (g->getName() == kColorGridName)
             out.color = openvdb::gridPtrCast<openvdb::Vec3SGrid>(g);
+        else if (g->getName() == kVelocityGridName || g->getName() == "velocity")
+            out.velocity = openvdb::gridPtrCast<openvdb::Vec3SGrid>(g);
     }
     return out;
 }

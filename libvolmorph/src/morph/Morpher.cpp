@@ -59,6 +59,11 @@ void finish(VolumeSet& out, const openvdb::math::Transform& xform, MorphStats* s
     out.color->setName(kColorGridName);
     out.color->setVectorType(openvdb::VEC_INVARIANT);
     if (out.sdf) out.sdf->setName(kSdfGridName);
+    if (out.velocity) {
+        out.velocity->setTransform(xform.copy());
+        out.velocity->setName(kVelocityGridName);
+        out.velocity->setVectorType(openvdb::VEC_CONTRAVARIANT_RELATIVE);
+    }
     for (auto& [name, grid] : out.extras) {
         grid->pruneGrid();
         grid->setTransform(xform.copy());
@@ -70,6 +75,8 @@ void finish(VolumeSet& out, const openvdb::math::Transform& xform, MorphStats* s
         stats->outputLeaves = frame.keptLeaves;
         stats->activeVoxels = out.density->activeVoxelCount();
         stats->blendSamples = frame.blendSamples;
+        stats->velocityInterpolated = frame.velocityInterpolated;
+        stats->velocityExact = frame.velocityExact;
     }
 }
 
@@ -147,10 +154,13 @@ VolumeSet Morpher::run(double t, const CoordBBox& box, bool prune, double tolera
     request.sourceBlocks = prune ? mSourceBlocks.get() : nullptr;
     request.targetBlocks = prune ? mTargetBlocks.get() : nullptr;
     request.interrupter = interrupter;
+    if (mOptions.secondsPerUnitT > 0.0)
+        request.velocityScale = mSource.voxelSize() / mOptions.secondsPerUnitT;
     const float tauColor = float(scheduleValue(mBlend.color, t));
     detail::OutputLeaves leaves(t, mOptions.memoryLimitBytes,
                                 kMorphBytesPerLeaf +
-                                    detail::ExtraGrids::bytesPerLeaf(mSource, mTarget),
+                                    detail::ExtraGrids::bytesPerLeaf(mSource, mTarget) +
+                                    (request.velocityScale > 0.0 ? kVelocityBytesPerLeaf : 0),
                                 detail::blendedColorBackground(mSource, mTarget, tauColor));
     detail::BlendedFrame frame = mMethod->frame(request, leaves);
     finish(frame.grids, mSource.density->transform(), stats, frame);

@@ -25,15 +25,8 @@ TEST(Morph, BoxPairRotatesThePrincipalAxis)
 {
     // A bar along x becomes the same bar along y; halfway, it lies at 45 degrees.
     const double voxel = 0.02;
-    ObjectTransform bar, turned;
-    bar.scale = Vec3d(1.0, 0.3, 0.3);
-    turned.scale = Vec3d(1.0, 0.3, 0.3);
-    turned.rotateRadians = Vec3d(0, 0, M_PI / 2);
-    const VolumeSet s = voxelized("cube.obj", voxel, bar), d = voxelized("cube.obj", voxel, turned);
-    const auto p = pair(FeatureType::Box,
-                        element(Vec3d(0.0), Vec3d(1, 0, 0), Vec3d(0, 1, 0), Vec3d(1, 0.3, 0.3)),
-                        element(Vec3d(0.0), Vec3d(0, 1, 0), Vec3d(-1, 0, 0), Vec3d(1, 0.3, 0.3)));
-    const Morpher morpher(s, d, {p}, WarpSpec{}, BlendSpec{});
+    const OnePairMorph bar = turningBar(voxel);
+    const Morpher morpher(bar.source, bar.target, {bar.pair}, WarpSpec{}, BlendSpec{});
     const Moments m = moments(*morpher.frame(0.5).density);
     const double angle = 0.5 * std::atan2(2.0 * m.ixy, m.ixx - m.iyy);
     EXPECT_NEAR(angle * 180.0 / M_PI, 45.0, 0.5);
@@ -44,16 +37,12 @@ TEST(Morph, BoxPairRotatesThePrincipalAxis)
 TEST(Morph, ScalingPairScalesTheVolumeCubically)
 {
     // Both sides warped to the same sphere scaled by 1 + t, in either blend mode.
-    const double voxel = 0.02;
-    const VolumeSet s = voxelized("sphere.obj", voxel),
-                    d = voxelized("sphere.obj", voxel, placed(Vec3d(0.0), 2.0));
-    const auto p = pair(FeatureType::Box, element(Vec3d(0.0)),
-                        element(Vec3d(0.0), Vec3d(1, 0, 0), Vec3d(0, 1, 0), Vec3d(2.0)));
-    const double v0 = moments(*s.density).mass;
+    const OnePairMorph sphere = doublingSphere(0.02);
+    const double v0 = moments(*sphere.source.density).mass;
     for (BlendMode mode : {BlendMode::Density, BlendMode::Sdf}) {
         BlendSpec blend;
         blend.mode = mode;
-        const Morpher morpher(s, d, {p}, WarpSpec{}, blend);
+        const Morpher morpher(sphere.source, sphere.target, {sphere.pair}, WarpSpec{}, blend);
         for (double t : {0.25, 0.5, 0.75}) {
             const double scale = 1.0 + t;
             EXPECT_NEAR(moments(*morpher.frame(t).density).mass / v0, scale * scale * scale,

@@ -73,6 +73,33 @@ inline VolumeSet voxelized(const std::string& mesh, double voxelSize,
     return voxelize(importMesh(kMeshes / mesh, xf), o);
 }
 
+/// Two objects and the one pair that turns one into the other.
+struct OnePairMorph {
+    VolumeSet source, target;
+    FeaturePairSpec pair;
+};
+/// A bar along x (1 x 0.3 x 0.3 world units) and the same bar turned a quarter turn about z.
+inline OnePairMorph turningBar(double voxelSize)
+{
+    ObjectTransform bar, turned;
+    bar.scale = Vec3d(1.0, 0.3, 0.3);
+    turned.scale = Vec3d(1.0, 0.3, 0.3);
+    turned.rotateRadians = Vec3d(0, 0, M_PI / 2);
+    return {voxelized("cube.obj", voxelSize, bar), voxelized("cube.obj", voxelSize, turned),
+            pair(FeatureType::Box,
+                 element(Vec3d(0.0), Vec3d(1, 0, 0), Vec3d(0, 1, 0), Vec3d(1, 0.3, 0.3)),
+                 element(Vec3d(0.0), Vec3d(0, 1, 0), Vec3d(-1, 0, 0), Vec3d(1, 0.3, 0.3)))};
+}
+
+/// The unit sphere (radius 0.5) and the same sphere scaled by 2 about the origin.
+inline OnePairMorph doublingSphere(double voxelSize)
+{
+    return {voxelized("sphere.obj", voxelSize),
+            voxelized("sphere.obj", voxelSize, placed(Vec3d(0.0), 2.0)),
+            pair(FeatureType::Box, element(Vec3d(0.0)),
+                 element(Vec3d(0.0), Vec3d(1, 0, 0), Vec3d(0, 1, 0), Vec3d(2.0)))};
+}
+
 /// The default scene's two objects (scenes/bunny-to-knot.toml), voxelized.
 struct VolumePair {
     VolumeSet source, target;

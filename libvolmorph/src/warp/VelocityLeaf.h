@@ -1,0 +1,49 @@
+// The velocity of the material each side shows at the voxels of one output leaf: v = -J^-1 dW/dt
+// of the exact warp (InverseWarp::derivatives), in index units per unit of t.
+//
+// Evaluating it at every voxel costs O(pairs) per voxel. Velocity is smooth wherever the warp is
+// (it has the warp's own scale of variation, the distance to the nearest element), so a leaf takes
+// it exactly at a lattice 4 voxels apart (27 points, corners shared with nothing: each leaf is
+// independent, so the result does not depend on threads) and interpolates trilinearly between
+// them. The interpolant is checked at each of the eight 4^3 sub-cubes' centres, where its error is
+// largest for a smooth field, against the exact velocity there; a sub-cube whose check is off by
+// more than the tolerance (relative to the largest speed on the leaf's lattice) is evaluated
+// exactly at its active voxels instead, and so is a whole leaf whose lattice touches a fold of the
+// warp (J singular) or that has no more active voxels than the lattice and check together. The
+// check is a posteriori: between its points the error is estimated, not bounded.
+#pragma once
+
+#include <volmorph/core/Math.h>
+#include <volmorph/Warp.h>
+
+#include <openvdb/openvdb.h>
+
+#include <cstdint>
+
+namespace volmorph::detail {
+
+class VelocityLeaf {
+public:
+    /// `warp` maps output index space at the frame's t (built with unit 1 / voxel size).
+    /// tolerance: the check's allowed error, relative to the leaf's largest lattice speed.
+    explicit VelocityLeaf(const InverseWarp& warp, double tolerance = 2e-3)
+        : mWarp(warp), mTolerance(tolerance)
+    {
+    }
+
+    /// Both sides' velocities at the voxels `on` of the leaf at `origin` (index units per unit t,
+    /// voxel n = (i * 8 + j) * 8 + k); returns how many of the 8 sub-cubes were interpolated.
+    int fill(const openvdb::Coord& origin, const openvdb::util::NodeMask<3>& on, Vec3f source[512],
+             Vec3f target[512]) const;
+
+private:
+    /// Exact velocities of both sides at p (index space); false at a fold.
+    bool exact(const Vec3d& p, Vec3d& source, Vec3d& target) const;
+    void fillExact(const openvdb::Coord& origin, const openvdb::util::NodeMask<3>& on,
+                   Vec3f source[512], Vec3f target[512]) const;
+
+    const InverseWarp& mWarp;
+    double mTolerance;
+};
+
+} // namespace volmorph::detail

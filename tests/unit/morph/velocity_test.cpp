@@ -1,0 +1,147 @@
+// The in-between's `vel` grid (density mode): closed forms where the density is above 0.5 (a
+// translating sphere, a box turning a quarter turn, a sphere scaling), the centroid's motion
+// between frames, and the per-leaf interpolation of the warp's velocity against the exact
+// derivative at random voxels of a 16-pair warp.
+#include "support/WarpFixtures.h"
+
+#include "warp/VelocityLeaf.h" // private to the library; tested directly
+
+using namespace volmorph;
+using namespace volmorph::test;
+
+namespace {
+
+/// Frames 1-25 at 24 fps: one unit of t lasts one second.
+constexpr double kSecondsPerT = 24.0 / 24.0;
+
+MorphOptions withVelocity()
+{
+    MorphOptions o;
+    o.secondsPerUnitT = kSecondsPerT;
+    return o;
+}
+
+/// The largest |vel - expected(world point)| over voxels with density above 0.5, relative to
+/// the largest expected speed there; also counts those voxels.
+template <typename Expected>
+double worstError(const VolumeSet& frame, const Expected& expected, int& count)
+{
+    EXPECT_TRUE(frame.velocity);
+    if (!frame.velocity) return 1e9;
+    auto vel = frame.velocity->getConstAccessor();
+    double worst = 0.0, fastest = 0.0;
+    count = 0;
+    for (auto it = frame.density->cbeginValueOn(); it; ++it) {
+        if (*it <= 0.5f || !it.isVoxelValue()) continue;
+        const Vec3d p = frame.density->indexToWorld(it.getCoord());
+        const Vec3d e = expected(p);
+        worst = std::max(worst, (Vec3d(vel.getValue(it.getCoord())) - e).length());
+        fastest = std::max(fastest, e.length());
+        ++count;
+    }
+    return worst / fastest;
+}
+
+} // namespace
+
+TEST(Velocity, ATranslatingSphereMovesAtD)
+{
+    // A point pair moving by d over one second: vel = d everywhere, and the centroid moves at the
+    // density-weighted mean velocity (the frames differenced: an independent check).
+    const double voxel = 0.04;
+    const Vec3d d(1.0, 0.25, 0.0);
+    const VolumeSet s = voxelized("sphere.obj", voxel),
+                    e = voxelized("sphere.obj", voxel, placed(d));
+    const Morpher morpher(s, e, {pair(FeatureType::Point, element(Vec3d(0.0)), element(d))},
+                          WarpSpec{}, BlendSpec{}, withVelocity());
+    for (double t : {0.25, 0.5}) {
+        const VolumeSet frame = morpher.frame(t);
+        int count = 0;
+        EXPECT_LT(worstError(
+                      frame, [&](const Vec3d&) { return d; }, count),
+                  0.01)
+            << t;
+        EXPECT_GT(count, 5000);
+        const double h = 0.01;
+        const Vec3d rate = (moments(*morpher.frame(t + h).density).centroid -
+                            moments(*morpher.frame(t - h).density).centroid) /
+                           (2 * h * kSecondsPerT);
+        EXPECT_NEAR((rate - d).length(), 0.0, 0.01 * d.length()) << t;
+    }
+}
+
+TEST(Velocity, ABoxTurningAQuarterTurnMovesAsOmegaCrossR)
+{
+    const OnePairMorph bar = turningBar(0.02);
+    const Morpher morpher(bar.source, bar.target, {bar.pair}, WarpSpec{}, BlendSpec{},
+                          withVelocity());
+    const Vec3d omega(0, 0, M_PI / 2 / kSecondsPerT);
+    int count = 0;
+    EXPECT_LT(worstError(
+                  morpher.frame(0.5), [&](const Vec3d& x) { return omega.cross(x); }, count),
+              0.01);
+    EXPECT_GT(count, 5000);
+}
+
+TEST(Velocity, AScalingSphereMovesAsRTimesTheScaleRate)
+{
+    const OnePairMorph sphere = doublingSphere(0.02);
+    const Morpher morpher(sphere.source, sphere.target, {sphere.pair}, WarpSpec{}, BlendSpec{},
+                          withVelocity());
+    for (double t : {0.25, 0.75}) {
+        int count = 0;
+        const double rate = 1.0 / (1.0 + t) / kSecondsPerT; // s(t) = 1 + t
+        EXPECT_LT(worstError(
+                      morpher.frame(t), [&](const Vec3d& x) { return x * rate; }, count),
+                  0.01)
+            << t;
+        EXPECT_GT(count, 5000);
+    }
+}
+
+TEST(Velocity, NoVelocityGridUnlessAsked)
+{
+    const VolumeSet s = voxelized("sphere.obj", 0.05);
+    const Morpher morpher(s, s, {}, WarpSpec{}, BlendSpec{});
+    EXPECT_FALSE(morpher.frame(0.5).velocity);
+}
+
+TEST(Velocity, InterpolatedLeavesMatchTheExactDerivative)
+{
+    // 16 random pairs over 96 voxels (the warp bench's kind of scene): at 10,000 random voxels of
+    // the pairs' region (50 in each of 200 random leaves), each side's velocity from VelocityLeaf
+    // is the exact one within 1% of its speed (plus 1e-3 of the region's largest speed, where the
+    // speed passes through 0).
+    std::mt19937 random(5);
+    const auto pairs = randomPairs(random, 16, 96.0);
+    const InverseWarp warp(pairs, WarpSpec{}, 0.4);
+    const detail::VelocityLeaf leaves(warp);
+    std::uniform_int_distribution<int> coordinate(-16, 112), voxel(0, 511);
+    std::vector<std::pair<Vec3d, Vec3d>> samples; // (from the leaf, exact)
+    double fastest = 0.0;
+    int interpolated = 0;
+    for (int leaf = 0; leaf < 200; ++leaf) {
+        const openvdb::Coord origin =
+            openvdb::Coord(coordinate(random), coordinate(random), coordinate(random)) & ~7;
+        const openvdb::util::NodeMask<3> on(true);
+        Vec3f vs[512], vt[512];
+        interpolated += leaves.fill(origin, on, vs, vt);
+        for (int n = 0; n < 50; ++n) {
+            const openvdb::Index k = openvdb::Index(voxel(random));
+            const openvdb::Coord ijk = openvdb::FloatTree::LeafNodeType::offsetToLocalCoord(k);
+            InverseWarp::Derivatives ds, dt;
+            warp.derivatives((origin + ijk).asVec3d(), ds, dt);
+            Vec3d es, et;
+            InverseWarp::velocity(ds, es);
+            InverseWarp::velocity(dt, et);
+            samples.emplace_back(Vec3d(vs[k]), es);
+            samples.emplace_back(Vec3d(vt[k]), et);
+            fastest = std::max({fastest, es.length(), et.length()});
+        }
+    }
+    EXPECT_GT(interpolated, 100); // of 1600: 16 pairs within 96 voxels bend the field sharply
+    int bad = 0;
+    for (const auto& [got, exact] : samples)
+        if ((got - exact).length() > 0.01 * exact.length() + 1e-3 * fastest) ++bad;
+    EXPECT_EQ(bad, 0) << "of " << samples.size() << "; sub-cubes interpolated: " << interpolated;
+}
