@@ -79,6 +79,8 @@ int runMorph(const MorphArgs& args)
     if (args.sampling == "triquadratic") options.sampling = MorphOptions::Sampling::Triquadratic;
     options.memoryLimitBytes = memoryLimitBytes(args.memoryLimitGiB);
     options.secondsPerUnitT = scene.frames.secondsPerUnitT(); // the vel grid
+    // covering half a frame either way: Blender's and Houdini's default shutters, centred
+    options.velocityReachSeconds = 0.5 / scene.frames.fps;
     SceneMorph morph(scene, args.cache, interrupter, options, args.quiet);
 
     FrameLoop loop(scene, frames, 1, args.quiet, true, interrupter);

@@ -33,6 +33,10 @@ struct MorphOptions {
     /// The `vel` grid's time unit: the seconds one unit of t lasts ((last - first) / fps for a
     /// frame range). 0: no velocity grid.
     double secondsPerUnitT = 0.0;
+    /// The `vel` grid also covers every voxel its motion reaches within this many seconds of the
+    /// frame (the shutter's reach), with the warp's own velocity there: Eulerian motion blur reads
+    /// the velocity where the density is about to arrive.
+    double velocityReachSeconds = 0.0;
 };
 
 /// What one kept output leaf costs while a frame is made: density, colour and, in sdf mode, the

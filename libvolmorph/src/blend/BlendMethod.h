@@ -49,6 +49,8 @@ struct BlendRequest {
     /// The velocity's units: world units per second of one index unit per unit t (voxel size over
     /// the seconds a unit of t lasts); 0: no velocity grid.
     double velocityScale = 0.0;
+    /// The velocity also covers the voxels its motion reaches within this many seconds.
+    double velocityReachSeconds = 0.0;
 };
 
 /// A method's frame: the grids (density and Cd; sdf in sdf mode), without names or transforms

@@ -82,6 +82,8 @@ public:
                         carried.vectors,
                         out.grids.velocity ? &out.grids.velocity->tree() : nullptr);
         out.grids.extras = std::move(carried.grids);
+        if (out.grids.velocity)
+            velocity.extend(*out.grids.velocity, r.velocityReachSeconds, mSource.voxelSize());
         // Leaves of constant interior collapse into tiles.
         openvdb::tools::prune(out.grids.density->tree());
         return out;

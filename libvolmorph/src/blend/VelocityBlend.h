@@ -9,8 +9,11 @@
 #include "warp/VelocityLeaf.h"
 
 #include <openvdb/openvdb.h>
+#include <openvdb/tools/Morphology.h>
+#include <openvdb/tree/LeafManager.h>
 
 #include <algorithm>
+#include <cmath>
 #include <atomic>
 #include <memory>
 
@@ -48,6 +51,12 @@ public:
         return out;
     }
 
+    /// Extends `velocity` (this blend's, in world units per second) by the voxels the motion
+    /// reaches in `seconds` either way: dilated by the fastest speed times that, each new voxel
+    /// holding the warp's own velocity there ((1 - tau) v_S + tau v_T: both sides are empty).
+    /// Eulerian motion blur reads the velocity where the density is about to arrive.
+    void extend(openvdb::Vec3SGrid& velocity, double seconds, double voxelSize) const;
+
     /// Sub-cubes (4^3 voxels) whose warp velocity was interpolated, and evaluated exactly, so far.
     uint64_t interpolatedCubes() const { return mInterpolated; }
     uint64_t exactCubes() const { return mExact; }
@@ -57,5 +66,30 @@ private:
     float mScale, mTau;
     mutable std::atomic<uint64_t> mInterpolated{0}, mExact{0};
 };
+
+inline void VelocityBlend::extend(openvdb::Vec3SGrid& velocity, double seconds,
+                                  double voxelSize) const
+{
+    float fastest = 0.0f;
+    for (auto it = velocity.cbeginValueOn(); it; ++it) fastest = std::max(fastest, it->length());
+    const int reach = int(std::ceil(double(fastest) * seconds / voxelSize));
+    if (reach <= 0) return;
+    openvdb::Vec3STree original(velocity.tree(), Vec3f(0.0f), openvdb::TopologyCopy());
+    openvdb::tools::dilateActiveValues(velocity.tree(), reach, openvdb::tools::NN_FACE_EDGE_VERTEX,
+                                       openvdb::tools::IGNORE_TILES);
+    auto fill = [&](Leaf& leaf, size_t) {
+        openvdb::util::NodeMask<3> added = leaf.getValueMask();
+        if (const auto* before = original.probeConstLeaf(leaf.origin()))
+            added -= before->getValueMask();
+        if (added.isOff()) return;
+        Vec3f vs[512], vt[512];
+        mLeaf.fill(leaf.origin(), added, vs, vt);
+        for (auto it = added.beginOn(); it; ++it)
+            leaf.setValueOnly(it.pos(),
+                              ((1.0f - mTau) * vs[it.pos()] + mTau * vt[it.pos()]) * mScale);
+    };
+    openvdb::tree::LeafManager<openvdb::Vec3STree> leaves(velocity.tree());
+    leaves.foreach (fill);
+}
 
 } // namespace volmorph::detail

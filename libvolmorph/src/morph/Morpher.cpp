@@ -156,6 +156,7 @@ VolumeSet Morpher::run(double t, const CoordBBox& box, bool prune, double tolera
     request.interrupter = interrupter;
     if (mOptions.secondsPerUnitT > 0.0)
         request.velocityScale = mSource.voxelSize() / mOptions.secondsPerUnitT;
+    request.velocityReachSeconds = mOptions.velocityReachSeconds;
     const float tauColor = float(scheduleValue(mBlend.color, t));
     detail::OutputLeaves leaves(t, mOptions.memoryLimitBytes,
                                 kMorphBytesPerLeaf +

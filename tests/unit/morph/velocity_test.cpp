@@ -70,6 +70,34 @@ TEST(Velocity, ATranslatingSphereMovesAtD)
     }
 }
 
+TEST(Velocity, TheVelocityCoversTheShuttersReach)
+{
+    // Moving at |d| = 1.03 world units per second with a reach of 0.25 s: 6.4 voxels of 0.04 ahead
+    // of the sphere hold the velocity d too (the warp's own, both sides empty there).
+    const double voxel = 0.04;
+    const Vec3d d(1.0, 0.25, 0.0);
+    const VolumeSet s = voxelized("sphere.obj", voxel),
+                    e = voxelized("sphere.obj", voxel, placed(d));
+    MorphOptions options = withVelocity();
+    options.velocityReachSeconds = 0.25;
+    const Morpher morpher(s, e, {pair(FeatureType::Point, element(Vec3d(0.0)), element(d))},
+                          WarpSpec{}, BlendSpec{}, options);
+    const VolumeSet frame = morpher.frame(0.5);
+    auto vel = frame.velocity->getConstAccessor();
+    auto density = frame.density->getConstAccessor();
+    for (double ahead : {2.0, 5.0, -5.0}) { // voxels past the surface, in front and behind
+        const Vec3d p =
+            0.5 * d + d.unit() * (ahead > 0 ? 1.0 : -1.0) * (0.5 + std::abs(ahead) * voxel);
+        const openvdb::Coord ijk = frame.density->transform().worldToIndexCellCentered(p);
+        EXPECT_EQ(density.getValue(ijk), 0.0f) << ahead;
+        EXPECT_TRUE(vel.isValueOn(ijk)) << ahead;
+        EXPECT_NEAR((Vec3d(vel.getValue(ijk)) - d).length(), 0.0, 0.01 * d.length()) << ahead;
+    }
+    // Beyond the reach, nothing.
+    const Vec3d far = 0.5 * d + d.unit() * (0.5 + 12 * voxel);
+    EXPECT_FALSE(vel.isValueOn(frame.density->transform().worldToIndexCellCentered(far)));
+}
+
 TEST(Velocity, ABoxTurningAQuarterTurnMovesAsOmegaCrossR)
 {
     const OnePairMorph bar = turningBar(0.02);
