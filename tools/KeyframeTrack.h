@@ -1,7 +1,8 @@
 // Animation of the scene's camera and lights: one keyframe track type for both. A track is the
 // keys of one camera or light (Scene.h's CameraKey or LightKey: a frame and every value), held
 // before the first key and after the last, and interpolated linearly between the two keys around
-// a frame (directions renormalized). Header-only: the CLI's SceneRender and the tests use it.
+// a frame (directions renormalized). Frames may be fractional: a shutter's times between frames.
+// Header-only: the CLI's SceneRender and the tests use it.
 #pragma once
 
 #include <volmorph/Scene.h>
@@ -35,7 +36,7 @@ public:
             return lerpDirection(a->*member, b->*member, u);
         }
     };
-    Span at(int frame) const
+    Span at(double frame) const
     {
         Span s{&mKeys.front(), &mKeys.front(), 0.0};
         if (frame <= mKeys.front().frame) return s;
@@ -69,7 +70,7 @@ private:
 /// `spec` (a camera or a light) at `frame`: a copy without keys whose values `interpolate(copy,
 /// span)` sets from the two keys around the frame; `spec` itself, less its keys, when it has none.
 template <typename Spec, typename Interpolate>
-Spec atFrame(const Spec& spec, int frame, const Interpolate& interpolate)
+Spec atFrame(const Spec& spec, double frame, const Interpolate& interpolate)
 {
     using Key = typename decltype(spec.keys)::value_type;
     Spec out = spec;
@@ -79,7 +80,7 @@ Spec atFrame(const Spec& spec, int frame, const Interpolate& interpolate)
 }
 
 /// The camera at `frame`: its keys interpolated, up renormalized.
-inline CameraSpec cameraAt(const CameraSpec& camera, int frame)
+inline CameraSpec cameraAt(const CameraSpec& camera, double frame)
 {
     return atFrame(camera, frame, [](CameraSpec& c, const KeyframeTrack<CameraKey>::Span& at) {
         c.eye = at(&CameraKey::eye);
@@ -91,7 +92,7 @@ inline CameraSpec cameraAt(const CameraSpec& camera, int frame)
 }
 
 /// The light at `frame`: its keys interpolated, direction renormalized.
-inline LightSpec lightAt(const LightSpec& light, int frame)
+inline LightSpec lightAt(const LightSpec& light, double frame)
 {
     return atFrame(light, frame, [](LightSpec& l, const KeyframeTrack<LightKey>::Span& at) {
         l.direction = at.direction(&LightKey::direction);

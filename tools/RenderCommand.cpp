@@ -44,6 +44,8 @@ struct RenderVdbArgs {
     int shadowCache = 1;
     int samples = 1, threads = 0, bounces = 0;
     double memoryLimitGiB = 0.0;
+    std::vector<double> shutter; ///< open, close in frames: motion blur along the vel grid
+    double fps = 24.0;
     bool floatExr = false, verbose = false;
 };
 
@@ -60,6 +62,7 @@ void parseResolution(const std::string& text, int& width, int& height)
 struct InputGrids {
     openvdb::FloatGrid::Ptr density;
     openvdb::Vec3SGrid::Ptr color;
+    openvdb::Vec3SGrid::Ptr velocity; ///< `vel` or Blender's `velocity`, world units per second
 };
 
 /// The float grid to render (--grid, or the first) and the `Cd` colour grid if there is one; only
@@ -78,6 +81,8 @@ InputGrids readInputGrids(const RenderVdbArgs& args)
     for (const openvdb::GridBase::Ptr& g : *all) {
         if (!grids.color && g->getName() == "Cd")
             grids.color = openvdb::gridPtrCast<openvdb::Vec3SGrid>(g);
+        if (!grids.velocity && (g->getName() == "vel" || g->getName() == "velocity"))
+            grids.velocity = openvdb::gridPtrCast<openvdb::Vec3SGrid>(g);
         if (grids.density) continue;
         if (!args.grid.empty() ? g->getName() == args.grid : g->isType<openvdb::FloatGrid>()) {
             grids.density = openvdb::gridPtrCast<openvdb::FloatGrid>(g);
@@ -134,10 +139,35 @@ std::vector<render::Light> vdbLights(const RenderVdbArgs& args)
     return lights;
 }
 
+/// The still image, or with --shutter the image blurred along the file's velocity grid.
+render::Image renderVdbImage(const RenderVdbArgs& args, const InputGrids& grids,
+                             const render::Camera& camera, const std::vector<render::Light>& lights,
+                             const render::Medium& medium, render::RenderSettings settings)
+{
+    if (args.shutter.empty() || !(args.shutter[1] > args.shutter[0]))
+        return render::renderVolume(*grids.density, grids.color.get(), camera, lights, medium,
+                                    settings);
+    if (!grids.velocity)
+        throw UserError(SourceLocation{args.input},
+                        "--shutter needs a vec3 velocity grid named vel (or velocity); the file "
+                        "has none");
+    std::vector<render::ShutterTime> times;
+    for (double offset : render::shutterOffsets(args.shutter[0], args.shutter[1], args.samples))
+        times.push_back({offset / args.fps, camera, lights});
+    settings.centreSingleSample = false;
+    return render::renderMotionBlurred(*grids.density, grids.color.get(), *grids.velocity, times,
+                                       medium, settings);
+}
+
 int runRenderVdb(const RenderVdbArgs& args)
 {
     int width = 0, height = 0;
     parseResolution(args.resolution, width, height); // flags first: no work before a usage error
+    if (!args.shutter.empty() && !(args.shutter[0] <= args.shutter[1]))
+        throw UserError(SourceLocation{"--shutter"},
+                        "expected OPEN,CLOSE in frames with OPEN <= CLOSE, got " +
+                            std::to_string(args.shutter[0]) + "," +
+                            std::to_string(args.shutter[1]));
     checkFilmMemory(width, height, args.memoryLimitGiB);
     Interrupter interrupter(false, args.verbose);
     StopSignals signals(interrupter);
@@ -156,8 +186,7 @@ int runRenderVdb(const RenderVdbArgs& args)
     settings.threads = args.threads;
     settings.interrupter = &interrupter;
     const auto start = std::chrono::steady_clock::now();
-    const render::Image image =
-        render::renderVolume(*grids.density, grids.color.get(), camera, lights, medium, settings);
+    const render::Image image = renderVdbImage(args, grids, camera, lights, medium, settings);
     const double seconds = secondsSince(start);
     render::ExrOptions exr;
     exr.halfFloat = !args.floatExr;
@@ -231,10 +260,14 @@ int runRenderScene(const RenderSceneArgs& args)
     Interrupter interrupter(false, args.verbose);
     StopSignals signals(interrupter);
     checkFilmMemory(scene.render.width, scene.render.height, args.memoryLimitGiB);
+    SceneRender renderer(scene, args.threads);
     MorphOptions morphOptions;
     morphOptions.memoryLimitBytes = memoryLimitBytes(args.memoryLimitGiB);
+    if (scene.render.motionBlur()) { // the vel grid, over the shutter's reach
+        morphOptions.secondsPerUnitT = scene.frames.secondsPerUnitT();
+        morphOptions.velocityReachSeconds = renderer.shutterReachSeconds();
+    }
     SceneMorph morph(scene, args.cache, interrupter, morphOptions, args.quiet);
-    SceneRender renderer(scene, args.threads);
     renderer.settings.interrupter = &interrupter;
 
     // Two steps per frame (morph, render), so the progress moves within long frames too.
@@ -310,6 +343,13 @@ Command addRenderVdbCommand(CLI::App& app)
                     "path tracing)")
         ->check(CLI::Range(0, 100000));
     sub->add_option("--samples", a->samples, "samples per pixel")->check(CLI::Range(1, 65536));
+    sub->add_option("--shutter", a->shutter,
+                    "motion blur along the vel grid: the shutter's OPEN,CLOSE in frames around "
+                    "the frame (e.g. -0.25,0.25); one shutter time per sample, up to 64")
+        ->delimiter(',')
+        ->expected(2);
+    sub->add_option("--fps", a->fps, "frames per second, for --shutter (default 24)")
+        ->check(CLI::PositiveNumber);
     sub->add_option("--step", a->step,
                     "longest step of the scattering integral, in voxels (optical depth is exact)")
         ->check(CLI::Range(0.01, 8.0));

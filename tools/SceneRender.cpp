@@ -23,7 +23,7 @@ render::Camera sceneCamera(const CameraSpec& c, const RenderSpec& r, int width)
 } // namespace
 
 SceneRender::SceneRender(const Scene& scene, int threads, int width)
-    : mSpec(scene.render), mWidth(width)
+    : mSpec(scene.render), mFps(scene.frames.fps), mWidth(width)
 {
     const RenderSpec& r = scene.render;
     medium.extinction = r.extinction;
@@ -38,12 +38,12 @@ SceneRender::SceneRender(const Scene& scene, int threads, int width)
     settings.threads = threads;
 }
 
-render::Camera SceneRender::camera(int frame) const
+render::Camera SceneRender::camera(double frame) const
 {
     return sceneCamera(cameraAt(mSpec.camera, frame), mSpec, mWidth);
 }
 
-std::vector<render::Light> SceneRender::lights(int frame) const
+std::vector<render::Light> SceneRender::lights(double frame) const
 {
     std::vector<render::Light> lights;
     for (const LightSpec& spec : mSpec.lights) {
@@ -65,8 +65,22 @@ render::Image SceneRender::renderFrame(const VolumeSet& volumes, int frame) cons
 {
     render::RenderSettings s = settings;
     s.frame = frame;
-    return render::renderVolume(*volumes.density, volumes.color.get(), camera(frame), lights(frame),
-                                medium, s);
+    if (!mSpec.motionBlur() || !volumes.velocity)
+        return render::renderVolume(*volumes.density, volumes.color.get(), camera(frame),
+                                    lights(frame), medium, s);
+    std::vector<render::ShutterTime> times;
+    for (double offset :
+         render::shutterOffsets(mSpec.shutter.first, mSpec.shutter.second, s.samples))
+        times.push_back({offset / mFps, camera(frame + offset), lights(frame + offset)});
+    s.centreSingleSample = false; // each time's sample anywhere in the pixel: antialiased
+    return render::renderMotionBlurred(*volumes.density, volumes.color.get(), *volumes.velocity,
+                                       times, medium, s);
+}
+
+double SceneRender::shutterReachSeconds() const
+{
+    if (!mSpec.motionBlur()) return 0.0;
+    return std::max(std::abs(mSpec.shutter.first), std::abs(mSpec.shutter.second)) / mFps;
 }
 
 } // namespace volmorph::cli

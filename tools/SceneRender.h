@@ -17,15 +17,20 @@ struct SceneRender {
     /// `width` overrides the scene's image width in pixels (the height follows the aspect ratio).
     SceneRender(const Scene& scene, int threads, int width = 0);
 
-    /// The camera and lights at `frame` (their keys interpolated).
-    render::Camera camera(int frame) const;
-    std::vector<render::Light> lights(int frame) const;
+    /// The camera and lights at `frame` (their keys interpolated; fractional within a shutter).
+    render::Camera camera(double frame) const;
+    std::vector<render::Light> lights(double frame) const;
 
-    /// Renders frame `frame` of the morph, `volumes` being that frame's in-between.
+    /// Renders frame `frame` of the morph, `volumes` being that frame's in-between; blurred along
+    /// its velocity over render.shutter when the scene has a shutter and the volume a vel grid.
     render::Image renderFrame(const VolumeSet& volumes, int frame) const;
+
+    /// The seconds either side of a frame that the shutter reaches (0: no motion blur).
+    double shutterReachSeconds() const;
 
 private:
     RenderSpec mSpec;
+    double mFps;
     int mWidth;
 };
 

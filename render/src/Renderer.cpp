@@ -47,8 +47,9 @@ void renderPixel(ThreadReaders& readers, const Camera& camera, const RenderSetti
         // One sample goes through the pixel centre (no antialiasing, as vdb_render); more are
         // stratified and jittered over the pixel.
         const double jx = random.next(), jy = random.next();
-        const double sx = samples == 1 ? 0.5 : ((s % strata) + jx) / strata;
-        const double sy = samples == 1 ? 0.5 : ((s / strata) % strata + jy) / strata;
+        const bool centre = samples == 1 && settings.centreSingleSample;
+        const double sx = centre ? 0.5 : ((s % strata) + jx) / strata;
+        const double sy = centre ? 0.5 : ((s / strata) % strata + jy) / strata;
         const Ray ray = camera.ray(x + sx, y + sy);
         const RaySample sample =
             readers.in.majorants ? tracePath(readers, ray, random) : integrateRay(readers, ray);

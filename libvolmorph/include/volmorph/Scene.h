@@ -16,6 +16,7 @@
 #include <optional>
 #include <string>
 #include <string_view>
+#include <utility>
 #include <vector>
 
 namespace volmorph {
@@ -186,6 +187,10 @@ struct RenderSpec {
     /// Spacing of the transmittance caches toward lights, in voxels; 0: exact per sample.
     int shadowCacheVoxels = 1;
     unsigned seed = 0;
+    /// Motion blur: the shutter's open and close, in frames around the frame ([-0.25, 0.25]: half a
+    /// frame centred on it); open == close (the default) renders the instant.
+    std::pair<double, double> shutter{0.0, 0.0};
+    bool motionBlur() const { return shutter.second > shutter.first; }
     CameraSpec camera;
     std::vector<LightSpec> lights; ///< default: one directional light from above-front
 };

@@ -98,19 +98,8 @@ void parseWindow(Reader& r, const toml::node& n, const std::string& path, Object
         r.error(r.at(n), path + ": only a NIfTI volume (.nii, .nii.gz) has a window");
         return;
     }
-    const toml::array* a = n.as_array();
-    if (!a || a->size() != 2) {
-        r.error(r.at(n), path + ": expected [lo, hi], the intensities mapped to density 0 and 1");
-        return;
-    }
-    const auto lo = r.number(*a->get(0), path + "[0]"), hi = r.number(*a->get(1), path + "[1]");
-    if (!lo || !hi) return;
-    if (!(*lo < *hi)) {
-        r.error(r.at(n), path + ": expected lo < hi, got [" + formatNumber(*lo) + ", " +
-                             formatNumber(*hi) + "]");
-        return;
-    }
-    object.window = std::pair{*lo, *hi};
+    if (auto w = r.interval(n, path, "the intensities mapped to density 0 and 1", true))
+        object.window = *w;
 }
 
 } // namespace

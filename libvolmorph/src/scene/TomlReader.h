@@ -175,6 +175,26 @@ public:
         return v;
     }
 
+    /// [lo, hi]: two finite numbers with lo < hi (or lo <= hi when `strict` is false); `what` says
+    /// what they are, for the message.
+    std::optional<std::pair<double, double>> interval(const toml::node& n, const std::string& path,
+                                                      const std::string& what, bool strict)
+    {
+        const toml::array* a = n.as_array();
+        if (!a || a->size() != 2) {
+            error(at(n), path + ": expected [lo, hi], " + what);
+            return std::nullopt;
+        }
+        const auto lo = number(*a->get(0), path + "[0]"), hi = number(*a->get(1), path + "[1]");
+        if (!lo || !hi) return std::nullopt;
+        if (strict ? !(*lo < *hi) : !(*lo <= *hi)) {
+            error(at(n), path + ": expected lo " + (strict ? "<" : "<=") + " hi, got [" +
+                             formatNumber(*lo) + ", " + formatNumber(*hi) + "]");
+            return std::nullopt;
+        }
+        return std::pair{*lo, *hi};
+    }
+
     /// A vec3 whose components are all >= 0 (colours).
     std::optional<Vec3d> nonNegativeVec3(const toml::node& n, const std::string& path)
     {

@@ -82,7 +82,10 @@ struct RenderSettings {
     int bounces = 0;
     bool tracePaths = false; ///< trace paths also for bounces 0 without environment (comparisons)
     unsigned seed = 0;
-    int frame = 0;   ///< part of the sampling seed
+    int frame = 0; ///< part of the sampling seed
+    /// samples = 1 goes through the pixel centre unless this is false (then jittered over the
+    /// pixel, as each shutter time's one sample is).
+    bool centreSingleSample = true;
     int threads = 0; ///< 0 = all cores
     /// Asked between pixels and between the shadow maps' columns (OpenVDB's interrupter interface);
     /// when it answers true, renderVolume throws volmorph::Interrupted. May be null.
@@ -108,5 +111,28 @@ struct Image {
 Image renderVolume(const openvdb::FloatGrid& density, const openvdb::Vec3SGrid* color,
                    const Camera& camera, const std::vector<Light>& lights, const Medium& medium,
                    const RenderSettings& settings);
+
+/// One time in the shutter: seconds from the frame (negative before it), and the camera and lights
+/// at that time (keyed ones move, and blur).
+struct ShutterTime {
+    double seconds = 0.0;
+    Camera camera;
+    std::vector<Light> lights;
+};
+
+/// The shutter's times for `samples` samples per pixel, in frames from the frame: one per sample,
+/// up to 64, evenly spread over [open, close] (each at the middle of its share).
+std::vector<double> shutterOffsets(double open, double close, int samples);
+
+/// Eulerian motion blur: the mean of one image per time in `times`, each of the density (and
+/// colour) advected along `velocity` (world units per second) by its seconds, rho(p - v(p) s), by
+/// OpenVDB's semi-Lagrangian VolumeAdvection, seen by its camera under its lights, with
+/// samples / times.size() samples per pixel (at least 1; set centreSingleSample false to jitter a
+/// lone one), seeded apart. Exact for a
+/// velocity constant along the motion (a translation); `velocity` must cover where the density
+/// arrives within the times (volmorph's vel does: MorphOptions::velocityReachSeconds).
+Image renderMotionBlurred(const openvdb::FloatGrid& density, const openvdb::Vec3SGrid* color,
+                          const openvdb::Vec3SGrid& velocity, const std::vector<ShutterTime>& times,
+                          const Medium& medium, const RenderSettings& settings);
 
 } // namespace volmorph::render
