@@ -22,7 +22,8 @@ struct SceneRender {
     std::vector<render::Light> lights(double frame) const;
 
     /// Renders frame `frame` of the morph, `volumes` being that frame's in-between; blurred along
-    /// its velocity over render.shutter when the scene has a shutter and the volume a vel grid.
+    /// its velocity (if it has a vel grid) and the camera's and lights' motion over render.shutter
+    /// when the scene has a shutter.
     render::Image renderFrame(const VolumeSet& volumes, int frame) const;
 
     /// The seconds either side of a frame that the shutter reaches (0: no motion blur).

@@ -51,9 +51,12 @@ public:
         return out;
     }
 
+    static constexpr int kMaxReach = 64; ///< voxels
+
     /// Extends `velocity` (this blend's, in world units per second) by the voxels the motion
     /// reaches in `seconds` either way: dilated by the fastest speed times that, each new voxel
-    /// holding the warp's own velocity there ((1 - tau) v_S + tau v_T: both sides are empty).
+    /// holding the warp's own velocity there ((1 - tau) v_S + tau v_T: both sides are empty); by
+    /// at most kMaxReach voxels.
     /// Eulerian motion blur reads the velocity where the density is about to arrive.
     void extend(openvdb::Vec3SGrid& velocity, double seconds, double voxelSize) const;
 
@@ -72,7 +75,10 @@ inline void VelocityBlend::extend(openvdb::Vec3SGrid& velocity, double seconds,
 {
     float fastest = 0.0f;
     for (auto it = velocity.cbeginValueOn(); it; ++it) fastest = std::max(fastest, it->length());
-    const int reach = int(std::ceil(double(fastest) * seconds / voxelSize));
+    // At most kMaxReach voxels: near a fold of the warp the speed spikes, and a dilation by it
+    // would fill the machine.
+    const double voxels = std::ceil(double(fastest) * seconds / voxelSize);
+    const int reach = voxels > 0.0 ? int(std::min(voxels, double(kMaxReach))) : 0;
     if (reach <= 0) return;
     openvdb::Vec3STree original(velocity.tree(), Vec3f(0.0f), openvdb::TopologyCopy());
     openvdb::tools::dilateActiveValues(velocity.tree(), reach, openvdb::tools::NN_FACE_EDGE_VERTEX,
