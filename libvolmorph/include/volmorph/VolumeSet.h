@@ -38,6 +38,24 @@ struct VolumeSet {
     }
 };
 
+/// Puts `grid` in the part of `volumes` its name gives (sdf, density, Cd, vel or Blender's
+/// velocity; a part of another type is left empty); false for any other name.
+inline bool setPartByName(VolumeSet& volumes, const openvdb::GridBase::Ptr& grid)
+{
+    const std::string& name = grid->getName();
+    if (name == kSdfGridName)
+        volumes.sdf = openvdb::gridPtrCast<openvdb::FloatGrid>(grid);
+    else if (name == kDensityGridName)
+        volumes.density = openvdb::gridPtrCast<openvdb::FloatGrid>(grid);
+    else if (name == kColorGridName)
+        volumes.color = openvdb::gridPtrCast<openvdb::Vec3SGrid>(grid);
+    else if (name == kVelocityGridName || name == "velocity")
+        volumes.velocity = openvdb::gridPtrCast<openvdb::Vec3SGrid>(grid);
+    else
+        return false;
+    return true;
+}
+
 /// The grid names a .vdb is written with: volmorph's own (sdf, density, Cd, vel), Houdini's
 /// (surface, density, Cd, vel) or Blender's (sdf, density, color, velocity). Carried grids keep
 /// their names, but for vel / velocity, which each preset names its way.

@@ -77,14 +77,7 @@ std::string place(VolumeSet& v, const std::string& side, const openvdb::GridBase
         return {};
     }
     g->setName(name.substr(1));
-    if (g->getName() == kColorGridName)
-        v.color = openvdb::gridPtrCast<openvdb::Vec3SGrid>(g);
-    else if (g->getName() == kSdfGridName)
-        v.sdf = openvdb::gridPtrCast<openvdb::FloatGrid>(g);
-    else if (g->getName() == kDensityGridName)
-        v.density = openvdb::gridPtrCast<openvdb::FloatGrid>(g);
-    else
-        return "grid " + g->getName() + " is unknown";
+    if (!setPartByName(v, g)) return "grid " + g->getName() + " is unknown";
     return {};
 }
 

@@ -98,16 +98,7 @@ VolumeSet readVolumeSet(const std::filesystem::path& path)
                         std::string("cannot read volume file (") + e.what() + ")");
     }
     VolumeSet out;
-    for (const openvdb::GridBase::Ptr& g : *grids) {
-        if (g->getName() == kSdfGridName)
-            out.sdf = openvdb::gridPtrCast<openvdb::FloatGrid>(g);
-        else if (g->getName() == kDensityGridName)
-            out.density = openvdb::gridPtrCast<openvdb::FloatGrid>(g);
-        else if (g->getName() == kColorGridName)
-            out.color = openvdb::gridPtrCast<openvdb::Vec3SGrid>(g);
-        else if (g->getName() == kVelocityGridName || g->getName() == "velocity")
-            out.velocity = openvdb::gridPtrCast<openvdb::Vec3SGrid>(g);
-    }
+    for (const openvdb::GridBase::Ptr& g : *grids) setPartByName(out, g);
     return out;
 }
 
