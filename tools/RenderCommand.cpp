@@ -155,8 +155,8 @@ render::Image renderVdbImage(const RenderVdbArgs& args, const InputGrids& grids,
     for (double offset : render::shutterOffsets(args.shutter[0], args.shutter[1], args.samples))
         times.push_back({offset / args.fps, camera, lights});
     settings.centreSingleSample = false;
-    return render::renderMotionBlurred(*grids.density, grids.color.get(), *grids.velocity, times,
-                                       medium, settings);
+    return render::renderMotionBlurred(*grids.density, grids.color.get(), grids.velocity.get(),
+                                       times, medium, settings);
 }
 
 int runRenderVdb(const RenderVdbArgs& args)

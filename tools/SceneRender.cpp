@@ -68,20 +68,15 @@ render::Image SceneRender::renderFrame(const VolumeSet& volumes, int frame) cons
     if (!mSpec.motionBlur())
         return render::renderVolume(*volumes.density, volumes.color.get(), camera(frame),
                                     lights(frame), medium, s);
-    // Without a vel grid (sdf mode, a single frame) the volume stands still: the camera and
-    // lights still blur.
-    openvdb::Vec3SGrid::Ptr velocity = volumes.velocity;
-    if (!velocity) {
-        velocity = openvdb::Vec3SGrid::create(Vec3f(0.0f));
-        velocity->setTransform(volumes.density->transform().copy());
-    }
     std::vector<render::ShutterTime> times;
     for (double offset :
          render::shutterOffsets(mSpec.shutter.first, mSpec.shutter.second, s.samples))
         times.push_back({offset / mFps, camera(frame + offset), lights(frame + offset)});
     s.centreSingleSample = false; // each time's sample anywhere in the pixel: antialiased
-    return render::renderMotionBlurred(*volumes.density, volumes.color.get(), *velocity, times,
-                                       medium, s);
+    // Without a vel grid (sdf mode, a single frame) the volume stands still: the camera and
+    // lights still blur.
+    return render::renderMotionBlurred(*volumes.density, volumes.color.get(),
+                                       volumes.velocity.get(), times, medium, s);
 }
 
 double SceneRender::shutterReachSeconds() const

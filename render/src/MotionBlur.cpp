@@ -7,6 +7,7 @@
 #include <openvdb/tools/VolumeAdvect.h>
 
 #include <algorithm>
+#include <optional>
 
 namespace volmorph::render {
 namespace {
@@ -14,12 +15,14 @@ namespace {
 using Advection =
     openvdb::tools::VolumeAdvection<openvdb::Vec3SGrid, false, openvdb::util::NullInterrupter>;
 
-/// The grid moved along the velocity by `seconds`: g(p - v(p) seconds), trilinear.
+/// One shutter time's grid: the input itself where nothing moves, else the input advected along
+/// the velocity by `seconds`, g(p - v(p) seconds), trilinear (kept in `moved`).
 template <typename GridT>
-typename GridT::Ptr advected(Advection& advection, const GridT& grid, double seconds)
+const GridT* at(Advection* advection, const GridT* grid, double seconds, typename GridT::Ptr& moved)
 {
-    if (seconds == 0.0) return grid.deepCopy();
-    return advection.template advect<GridT, openvdb::tools::BoxSampler>(grid, seconds);
+    if (!advection || !grid || seconds == 0.0) return grid;
+    moved = advection->template advect<GridT, openvdb::tools::BoxSampler>(*grid, seconds);
+    return moved.get();
 }
 
 } // namespace
@@ -33,23 +36,29 @@ std::vector<double> shutterOffsets(double open, double close, int samples)
 }
 
 Image renderMotionBlurred(const openvdb::FloatGrid& density, const openvdb::Vec3SGrid* color,
-                          const openvdb::Vec3SGrid& velocity, const std::vector<ShutterTime>& times,
+                          const openvdb::Vec3SGrid* velocity, const std::vector<ShutterTime>& times,
                           const Medium& medium, const RenderSettings& settings)
 {
     if (times.empty()) throw std::invalid_argument("renderMotionBlurred: no shutter time");
-    Advection advection(velocity, settings.interrupter);
-    advection.setIntegrator(openvdb::tools::Scheme::SEMI); // rho(p - v(p) s): Eulerian blur
+    std::optional<Advection> advection;
+    if (velocity) {
+        advection.emplace(*velocity, settings.interrupter);
+        advection->setIntegrator(openvdb::tools::Scheme::SEMI);      // rho(p - v(p) s): Eulerian
+        if (!(advection->getMaxVelocity() > 0.0)) advection.reset(); // the volume stands still
+    }
+    Advection* const a = advection ? &*advection : nullptr;
     RenderSettings each = settings;
     each.samples = std::max(1, settings.samples / int(times.size()));
     Image sum;
     for (size_t k = 0; k < times.size(); ++k) {
         const ShutterTime& time = times[k];
-        const openvdb::FloatGrid::Ptr d = advected(advection, density, time.seconds);
-        const openvdb::Vec3SGrid::Ptr c =
-            color ? advected(advection, *color, time.seconds) : nullptr;
+        openvdb::FloatGrid::Ptr movedDensity;
+        openvdb::Vec3SGrid::Ptr movedColor;
+        const openvdb::FloatGrid* d = at(a, &density, time.seconds, movedDensity);
+        const openvdb::Vec3SGrid* c = at(a, color, time.seconds, movedColor);
         if (settings.interrupter && settings.interrupter->wasInterrupted()) throw Interrupted();
         each.seed = settings.seed ^ unsigned(0x9E3779B9u * (k + 1)); // the times' samples apart
-        const Image image = renderVolume(*d, c.get(), time.camera, time.lights, medium, each);
+        const Image image = renderVolume(*d, c, time.camera, time.lights, medium, each);
         if (k == 0) {
             sum = image;
         } else {

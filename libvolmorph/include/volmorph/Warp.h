@@ -76,8 +76,9 @@ private:
         double lengthPow = 1; ///< length^p, Beier-Neely only
         /// How the element moves per unit t: origin and scales (linear) and its frame's turn.
         Vec3d originRate, scaleRate, omega;
+        /// d p_side / d p' at t: the linear parts of the affine maps (sourceAffine, targetAffine).
+        openvdb::math::Mat3d sourceJacobian, targetJacobian;
     };
-    struct SideSums;
     double weight(const Pair& pair, double distance) const;
     /// Pair's affine images on both sides of the point with frame coordinates q.
     static void images(const Pair& pair, const Vec3d& q, Vec3d& source, Vec3d& target)

@@ -10,6 +10,7 @@
 
 #include <openvdb/openvdb.h>
 #include <openvdb/tools/Morphology.h>
+#include <openvdb/tools/Statistics.h>
 #include <openvdb/tree/LeafManager.h>
 
 #include <algorithm>
@@ -73,11 +74,10 @@ private:
 inline void VelocityBlend::extend(openvdb::Vec3SGrid& velocity, double seconds,
                                   double voxelSize) const
 {
-    float fastest = 0.0f;
-    for (auto it = velocity.cbeginValueOn(); it; ++it) fastest = std::max(fastest, it->length());
+    const double fastest = openvdb::tools::extrema(velocity.cbeginValueOn(), true).max();
     // At most kMaxReach voxels: near a fold of the warp the speed spikes, and a dilation by it
     // would fill the machine.
-    const double voxels = std::ceil(double(fastest) * seconds / voxelSize);
+    const double voxels = std::ceil(fastest * seconds / voxelSize);
     const int reach = voxels > 0.0 ? int(std::min(voxels, double(kMaxReach))) : 0;
     if (reach <= 0) return;
     openvdb::Vec3STree original(velocity.tree(), Vec3f(0.0f), openvdb::TopologyCopy());

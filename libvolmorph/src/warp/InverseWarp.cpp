@@ -5,6 +5,32 @@
 
 namespace volmorph {
 
+namespace {
+
+/// p_side = c_side + T (R'^T (p - c')) as p -> M p + b: M = T R'^T, b = c_side - M c'.
+InverseWarp::Affine affineOf(const Feature& e, const Vec3d toSide[3], const Vec3d& sideOrigin)
+{
+    InverseWarp::Affine a;
+    for (int c = 0; c < 3; ++c) {
+        const Vec3d q(e.x[c], e.y[c], e.z[c]); // R'^T times the unit vector along axis c
+        a.col[c] = toSide[0] * q.x() + toSide[1] * q.y() + toSide[2] * q.z();
+    }
+    a.offset = Vec3d(0.0);
+    a.offset = sideOrigin - a.apply(e.origin);
+    return a;
+}
+
+/// The linear part of an affine map, as a matrix (columns col).
+openvdb::math::Mat3d linearPart(const InverseWarp::Affine& a)
+{
+    openvdb::math::Mat3d m;
+    for (int c = 0; c < 3; ++c)
+        for (int i = 0; i < 3; ++i) m(i, c) = a.col[c][i];
+    return m;
+}
+
+} // namespace
+
 InverseWarp::InverseWarp(const std::vector<FeaturePairSpec>& pairs, const WarpSpec& spec, double t,
                          double unit)
     : mWeighting(spec.weighting), mEpsilon(spec.epsilon * unit), mA(spec.a * unit), mB(spec.b),
@@ -29,6 +55,8 @@ InverseWarp::InverseWarp(const std::vector<FeaturePairSpec>& pairs, const WarpSp
         p.originRate = d.origin - s.origin;
         p.scaleRate = d.scale - s.scale;
         p.omega = angularVelocity(s, d);
+        p.sourceJacobian = linearPart(affineOf(p.element, p.toSource, p.sourceOrigin));
+        p.targetJacobian = linearPart(affineOf(p.element, p.toTarget, p.targetOrigin));
         mPairs.push_back(p);
     }
 }
@@ -81,23 +109,6 @@ void InverseWarp::map(const Vec3d& p, Vec3d& source, Vec3d& target) const
         target = sumT / sumW;
     }
 }
-
-namespace {
-
-/// p_side = c_side + T (R'^T (p - c')) as p -> M p + b: M = T R'^T, b = c_side - M c'.
-InverseWarp::Affine affineOf(const Feature& e, const Vec3d toSide[3], const Vec3d& sideOrigin)
-{
-    InverseWarp::Affine a;
-    for (int c = 0; c < 3; ++c) {
-        const Vec3d q(e.x[c], e.y[c], e.z[c]); // R'^T times the unit vector along axis c
-        a.col[c] = toSide[0] * q.x() + toSide[1] * q.y() + toSide[2] * q.z();
-    }
-    a.offset = Vec3d(0.0);
-    a.offset = sideOrigin - a.apply(e.origin);
-    return a;
-}
-
-} // namespace
 
 InverseWarp::Affine InverseWarp::sourceAffine(size_t i) const
 {

@@ -26,19 +26,18 @@ Mat3d outer(const Vec3d& a, const Vec3d& b)
 }
 
 /// Pair i's map on one side at frame coordinates q, and its derivatives: the map is
-/// origin + sum_k to[k] q_k, and to[k] = axis_k s_k / s'_k(t) shrinks as the element's scale grows.
+/// origin + sum_k to[k] q_k, and to[k] = axis_k s_k / s'_k(t) shrinks as the element's scale grows;
+/// its Jacobian (the affine map's linear part) is the pair's, made once per warp.
 struct Image {
     Vec3d p, rate;
-    Mat3d jacobian;
-    Image(const Vec3d to[3], const Vec3d& origin, const Feature& e, const Vec3d& q,
-          const Vec3d& qRate, const Vec3d& scaleRate)
-        : p(origin), rate(0.0), jacobian(Mat3d::zero())
+    const Mat3d& jacobian;
+    Image(const Vec3d to[3], const Vec3d& origin, const Mat3d& linear, const Feature& e,
+          const Vec3d& q, const Vec3d& qRate, const Vec3d& scaleRate)
+        : p(origin), rate(0.0), jacobian(linear)
     {
-        const Vec3d* axes[3] = {&e.x, &e.y, &e.z};
         for (int k = 0; k < 3; ++k) {
             p += to[k] * q[k];
             rate += to[k] * (qRate[k] - q[k] * scaleRate[k] / e.scale[k]);
-            jacobian += outer(to[k], *axes[k]);
         }
     }
 };
@@ -95,8 +94,10 @@ void InverseWarp::derivatives(const Vec3d& p, Derivatives& source, Derivatives& 
         const Vec3d q = e.frameCoordinates(p);
         const Vec3d u = (p - e.origin).cross(pair.omega) - pair.originRate;
         const Vec3d qRate(e.x.dot(u), e.y.dot(u), e.z.dot(u));
-        const Image is(pair.toSource, pair.sourceOrigin, e, q, qRate, pair.scaleRate);
-        const Image it(pair.toTarget, pair.targetOrigin, e, q, qRate, pair.scaleRate);
+        const Image is(pair.toSource, pair.sourceOrigin, pair.sourceJacobian, e, q, qRate,
+                       pair.scaleRate);
+        const Image it(pair.toTarget, pair.targetOrigin, pair.targetJacobian, e, q, qRate,
+                       pair.scaleRate);
         const double d = e.distanceInFrame(q);
         if (mWeighting == Weighting::InverseSquare && d + mEpsilon < kOnElement) {
             s.hit(is);

@@ -116,7 +116,7 @@ TEST(MotionBlur, ATranslatingSphereBlursAsTheMeanOfItsPositions)
                                              medium(), settings(1)));
     }
     const render::Image blurred = render::renderMotionBlurred(
-        *fog, nullptr, *uniformVelocity(*fog, v), times, medium(), settings(kTimes));
+        *fog, nullptr, uniformVelocity(*fog, v).get(), times, medium(), settings(kTimes));
     EXPECT_LT(meanRelativeDifference(blurred, mean(still)), 0.01);
     // And it is blurred: the instant differs from it by far more.
     const render::Image instant =
@@ -136,6 +136,6 @@ TEST(MotionBlur, APanningCameraBlursAStillSphere)
         still.push_back(render::renderVolume(*fog, nullptr, camera, sun(), medium(), settings(1)));
     }
     const render::Image blurred = render::renderMotionBlurred(
-        *fog, nullptr, *uniformVelocity(*fog, Vec3d(0.0)), times, medium(), settings(kTimes));
+        *fog, nullptr, uniformVelocity(*fog, Vec3d(0.0)).get(), times, medium(), settings(kTimes));
     EXPECT_LT(meanRelativeDifference(blurred, mean(still)), 0.01);
 }
