@@ -266,13 +266,6 @@ int runRenderScene(const RenderSceneArgs& args)
     if (scene.render.motionBlur()) { // the vel grid, over the shutter's reach
         morphOptions.secondsPerUnitT = scene.frames.secondsPerUnitT();
         morphOptions.velocityReachSeconds = renderer.shutterReachSeconds();
-        if (scene.blend.mode != BlendMode::Density)
-            std::fprintf(
-                stderr,
-                "%s: warning: render.shutter: only density mode's in-betweens "
-                "carry velocity yet; these frames blur with the camera's and lights' motion "
-                "only\n",
-                scene.file.string().c_str());
     }
     SceneMorph morph(scene, args.cache, interrupter, morphOptions, args.quiet);
     renderer.settings.interrupter = &interrupter;

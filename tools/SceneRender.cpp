@@ -73,7 +73,7 @@ render::Image SceneRender::renderFrame(const VolumeSet& volumes, int frame) cons
          render::shutterOffsets(mSpec.shutter.first, mSpec.shutter.second, s.samples))
         times.push_back({offset / mFps, camera(frame + offset), lights(frame + offset)});
     s.centreSingleSample = false; // each time's sample anywhere in the pixel: antialiased
-    // Without a vel grid (sdf mode, a single frame) the volume stands still: the camera and
+    // Without a vel grid (a single frame: no frame rate) the volume stands still: the camera and
     // lights still blur.
     return render::renderMotionBlurred(*volumes.density, volumes.color.get(),
                                        volumes.velocity.get(), times, medium, s);

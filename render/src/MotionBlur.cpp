@@ -4,6 +4,7 @@
 
 #include <volmorph/core/Interrupter.h>
 
+#include <openvdb/tools/ValueTransformer.h>
 #include <openvdb/tools/VolumeAdvect.h>
 
 #include <algorithm>
@@ -15,13 +16,26 @@ namespace {
 using Advection =
     openvdb::tools::VolumeAdvection<openvdb::Vec3SGrid, false, openvdb::util::NullInterrupter>;
 
+/// A density read at p - v(p) s is interpolated twice, by the advection and by the renderer's
+/// trilinear read; trilinear twice smooths a translated sphere's blur by 1.4% against sub-frames of
+/// the sphere moved exactly (64 times), triquadratic then trilinear by under 1%.
+void clampNegative(openvdb::FloatGrid& density)
+{
+    openvdb::tools::foreach (density.beginValueOn(), [](const openvdb::FloatGrid::ValueOnIter& v) {
+        if (*v < 0.0f) v.setValue(0.0f);
+    });
+}
+void clampNegative(openvdb::Vec3SGrid&) {}
+
 /// One shutter time's grid: the input itself where nothing moves, else the input advected along
-/// the velocity by `seconds`, g(p - v(p) seconds), trilinear (kept in `moved`).
+/// the velocity by `seconds`, g(p - v(p) seconds), triquadratic (its undershoot at a density's
+/// edge clamped to 0; kept in `moved`).
 template <typename GridT>
 const GridT* at(Advection* advection, const GridT* grid, double seconds, typename GridT::Ptr& moved)
 {
     if (!advection || !grid || seconds == 0.0) return grid;
-    moved = advection->template advect<GridT, openvdb::tools::BoxSampler>(*grid, seconds);
+    moved = advection->template advect<GridT, openvdb::tools::QuadraticSampler>(*grid, seconds);
+    clampNegative(*moved);
     return moved.get();
 }
 
@@ -57,7 +71,7 @@ Image renderMotionBlurred(const openvdb::FloatGrid& density, const openvdb::Vec3
         const openvdb::FloatGrid* d = at(a, &density, time.seconds, movedDensity);
         const openvdb::Vec3SGrid* c = at(a, color, time.seconds, movedColor);
         if (settings.interrupter && settings.interrupter->wasInterrupted()) throw Interrupted();
-        each.seed = settings.seed ^ unsigned(0x9E3779B9u * (k + 1)); // the times' samples apart
+        each.seed = shutterSeed(settings.seed, k);
         const Image image = renderVolume(*d, c, time.camera, time.lights, medium, each);
         if (k == 0) {
             sum = image;

@@ -293,13 +293,14 @@ void morphFrameExtras(benchmark::State& state)
     state.counters["active_voxels"] = double(stats.activeVoxels);
 }
 
-/// A density-mode frame at t = 0.5 with range(0) pairs (the scene's, then random ones), without
-/// (range(1) = 0) and with the `vel` grid (issue 36: at most 1.3x).
+/// A frame at t = 0.5 with range(0) pairs (the scene's, then random ones), without (range(1) = 0)
+/// and with the `vel` grid (issue 36: at most 1.3x), in density (range(2) = 0) or sdf mode.
 void morphFrameVelocity(benchmark::State& state)
 {
     MorphOptions options;
     options.secondsPerUnitT = state.range(1) ? 1.0 : 0.0;
-    frame(state, BlendMode::Density, int(state.range(0)), options);
+    frame(state, state.range(2) ? BlendMode::Sdf : BlendMode::Density, int(state.range(0)),
+          options);
 }
 
 void identityResample(benchmark::State& state)
@@ -338,8 +339,8 @@ void extraGrids(benchmark::internal::Benchmark* b)
     b->Unit(benchmark::kMillisecond)->UseRealTime();
 }
 BENCHMARK(morphFrameExtras)->Apply(extraGrids);
-/// The scene's 3 pairs and 16 pairs, without and with velocity.
+/// The scene's 3 pairs and 16 pairs, without and with velocity, density and sdf mode.
 BENCHMARK(morphFrameVelocity)
-    ->ArgsProduct({{3, 16}, {0, 1}})
+    ->ArgsProduct({{3, 16}, {0, 1}, {0, 1}})
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime();

@@ -43,8 +43,9 @@ struct MorphOptions {
 /// distance field and its fog, with the tools' temporaries (an upper estimate).
 inline constexpr uint64_t kMorphBytesPerLeaf = 24 * 1024;
 /// What the velocity adds per kept leaf: its values and mask, and both sides' velocities while
-/// the leaf is filled.
-inline constexpr uint64_t kVelocityBytesPerLeaf = 7 * 1024;
+/// the leaf is filled; in sdf mode also each side's distance and the normal correction (an upper
+/// estimate for both modes).
+inline constexpr uint64_t kVelocityBytesPerLeaf = 17 * 1024;
 
 struct MorphStats {
     double maxWarpErrorVoxels =

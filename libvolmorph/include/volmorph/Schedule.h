@@ -12,6 +12,10 @@ namespace volmorph {
 /// (0, 0) and (1, 1), or the curve's points interpolated linearly (held beyond its ends).
 double scheduleValue(const ScheduleSpec& schedule, double t);
 
+/// d tau / dt at t: 0 outside (0, 1) and where the schedule holds; a curve's slope is its
+/// segment's (the segment scheduleValue interpolates on, so the right-hand one at a point).
+double scheduleSlope(const ScheduleSpec& schedule, double t);
+
 /// "linear", "smoothstep", "sigmoid(K)" or "curve of N points", for `volmorph check`.
 std::string describe(const ScheduleSpec& schedule);
 

@@ -77,10 +77,11 @@ public:
         out.velocityInterpolated = velocity.interpolatedCubes();
         out.velocityExact = velocity.exactCubes();
         ExtraGrids::Outputs carried = extras.outputs();
-        if (velocity.enabled()) out.grids.velocity = openvdb::Vec3SGrid::create(Vec3f(0.0f));
-        leaves.moveInto(out.grids.density->tree(), out.grids.color->tree(), 0.0f, carried.floats,
-                        carried.vectors,
-                        out.grids.velocity ? &out.grids.velocity->tree() : nullptr);
+        if (velocity.enabled()) {
+            out.grids.velocity = openvdb::Vec3SGrid::create(Vec3f(0.0f));
+            carried.trees.velocity = &out.grids.velocity->tree();
+        }
+        leaves.moveInto(out.grids.density->tree(), out.grids.color->tree(), 0.0f, carried.trees);
         out.grids.extras = std::move(carried.grids);
         if (out.grids.velocity)
             velocity.extend(*out.grids.velocity, r.velocityReachSeconds, mSource.voxelSize());

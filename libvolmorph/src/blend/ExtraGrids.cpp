@@ -111,8 +111,8 @@ ExtraGrids::Outputs ExtraGrids::outputs() const
         trees.push_back(&grid->tree());
         out.grids[e.name] = grid;
     };
-    for (const auto& e : mFloats) add(e, out.floats);
-    for (const auto& e : mVectors) add(e, out.vectors);
+    for (const auto& e : mFloats) add(e, out.trees.floats);
+    for (const auto& e : mVectors) add(e, out.trees.vectors);
     return out;
 }
 

@@ -63,8 +63,7 @@ public:
     /// with the trees that the kept leaves go into (in the order of ExtraLeaves).
     struct Outputs {
         std::map<std::string, openvdb::GridBase::Ptr> grids;
-        std::vector<openvdb::FloatTree*> floats;
-        std::vector<openvdb::Vec3STree*> vectors;
+        ExtraTrees trees; ///< the extras' floats and vectors
     };
     Outputs outputs() const;
 

@@ -46,18 +46,20 @@ void OutputLeaves::insideTile(const openvdb::Coord& origin)
 }
 
 void OutputLeaves::moveInto(openvdb::FloatTree& values, openvdb::Vec3STree& colors,
-                            float insideValue, const std::vector<openvdb::FloatTree*>& floatExtras,
-                            const std::vector<openvdb::Vec3STree*>& vectorExtras,
-                            openvdb::Vec3STree* velocity)
+                            float insideValue, const ExtraTrees& extras)
 {
     for (Kept& k : mLeaves) {
         values.addLeaf(k.value.release());
         colors.addLeaf(k.color.release());
         for (size_t i = 0; i < k.extras.floats.size(); ++i)
-            floatExtras[i]->addLeaf(k.extras.floats[i].release());
+            extras.floats[i]->addLeaf(k.extras.floats[i].release());
         for (size_t i = 0; i < k.extras.vectors.size(); ++i)
-            vectorExtras[i]->addLeaf(k.extras.vectors[i].release());
-        if (velocity && k.extras.velocity) velocity->addLeaf(k.extras.velocity.release());
+            extras.vectors[i]->addLeaf(k.extras.vectors[i].release());
+        if (extras.velocity && k.extras.velocity)
+            extras.velocity->addLeaf(k.extras.velocity.release());
+        for (int side = 0; side < 2; ++side)
+            if (extras.distances[side] && k.extras.distances[side])
+                extras.distances[side]->addLeaf(k.extras.distances[side].release());
     }
     mLeaves.clear();
     for (const openvdb::Coord& origin : mInside) values.addTile(1, origin, insideValue, false);

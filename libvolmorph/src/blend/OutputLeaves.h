@@ -20,6 +20,16 @@ struct ExtraLeaves {
     std::vector<std::unique_ptr<openvdb::Vec3STree::LeafNodeType>> vectors;
     /// The velocity's leaf (VelocityBlend.h), when the frame has one.
     std::unique_ptr<openvdb::Vec3STree::LeafNodeType> velocity;
+    /// sdf mode with velocity: each side's distance at the voxels' warped points (SdfVelocity.h).
+    std::unique_ptr<openvdb::FloatTree::LeafNodeType> distances[2];
+};
+
+/// The trees each kind of ExtraLeaves goes into (null: none kept).
+struct ExtraTrees {
+    std::vector<openvdb::FloatTree*> floats; ///< in ExtraLeaves::floats' order
+    std::vector<openvdb::Vec3STree*> vectors;
+    openvdb::Vec3STree* velocity = nullptr;
+    openvdb::FloatTree* distances[2] = {nullptr, nullptr};
 };
 
 class OutputLeaves {
@@ -47,12 +57,10 @@ public:
     size_t size() const { return mLeaves.size(); }
     const Vec3f& background() const { return mBackground; }
 
-    /// Moves the leaves into the trees (the extras' in ExtraLeaves' order, the velocity's into
-    /// `velocity` when given); inside tiles (leaf-sized) of the value tree get `insideValue`.
+    /// Moves the leaves into the trees (the extras' into `extras`); inside tiles (leaf-sized) of
+    /// the value tree get `insideValue`.
     void moveInto(openvdb::FloatTree& values, openvdb::Vec3STree& colors, float insideValue,
-                  const std::vector<openvdb::FloatTree*>& floatExtras = {},
-                  const std::vector<openvdb::Vec3STree*>& vectorExtras = {},
-                  openvdb::Vec3STree* velocity = nullptr);
+                  const ExtraTrees& extras = {});
 
 private:
     double mT;

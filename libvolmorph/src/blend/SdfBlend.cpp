@@ -6,6 +6,7 @@
 #include "blend/Islands.h"
 #include "blend/Redistance.h"
 #include "blend/SdfFrame.h"
+#include "blend/SdfVelocity.h"
 #include "blend/WithSampler.h"
 
 #include <volmorph/core/Interrupter.h>
@@ -72,17 +73,47 @@ public:
         BlendedFrame out;
         const ExtraGrids extras(mSource, mTarget, mSpec, r.t);
         const std::vector<Coord> evaluate = sortLeaves(blend.classes(), kept != nullptr, leaves);
+        const bool velocity = r.velocityScale > 0.0;
         if (kept) {
-            fromKeptDistances(blend, *kept, evaluate, extras, leaves, r.interrupter);
+            fromKeptDistances(blend, *kept, evaluate, extras, velocity, leaves, r.interrupter);
             out.warp.leaves = evaluate.size();
         } else {
-            throughWarp(blend, r, extras, leaves, out.warp);
+            throughWarp(blend, r, extras, velocity, leaves, out.warp);
         }
-        assemble(blend, extras, leaves, out);
+        Distances distances;
+        assemble(blend, extras, leaves, velocity ? &distances : nullptr, out);
+        if (velocity) {
+            const SdfVelocity v(
+                *r.warp, r.velocityScale, tauS, float(scheduleSlope(mSpec.sdf, r.t)),
+                kSdfRampVoxels * float(mSource.voxelSize()), float(mSource.voxelSize()));
+            out.grids.velocity = v.make(distances.source, distances.target, r.velocityReachSeconds,
+                                        mSource.voxelSize());
+            out.velocityInterpolated = v.interpolatedCubes();
+            out.velocityExact = v.exactCubes();
+        }
         return out;
     }
 
 private:
+    using ValueLeaf = OutputLeaves::ValueLeaf;
+    /// Each side's distance at the warped points of the voxels blended (for the velocity).
+    struct Distances {
+        openvdb::FloatTree source, target;
+    };
+    struct DistanceLeaves {
+        std::unique_ptr<ValueLeaf> source, target;
+        DistanceLeaves(bool wanted, const Coord& origin)
+        {
+            if (!wanted) return;
+            source = std::make_unique<ValueLeaf>(origin, 0.0f, false);
+            target = std::make_unique<ValueLeaf>(origin, 0.0f, false);
+        }
+        typename SdfFrame<Sampler>::Distances record() const
+        {
+            return {source.get(), target.get()};
+        }
+    };
+
     /// Leaves inside as a whole become inside tiles. With kept distances, returns the leaves to
     /// evaluate (the warp's traversal finds them itself otherwise).
     static std::vector<Coord> sortLeaves(const BlockClasses& classes, bool listThem,
@@ -104,14 +135,15 @@ private:
     /// Keeps a filled leaf, with the extras on its kept band (where it has colour), or makes it
     /// an inside tile, or drops it (outside).
     template <typename Points>
-    static void settle(int whole, const Coord& origin,
-                       std::unique_ptr<OutputLeaves::ValueLeaf> value,
-                       std::unique_ptr<OutputLeaves::ColorLeaf> color, const ExtraGrids& extras,
-                       const Points& points, OutputLeaves& leaves)
+    static void settle(int whole, const Coord& origin, std::unique_ptr<ValueLeaf> value,
+                       std::unique_ptr<OutputLeaves::ColorLeaf> color, DistanceLeaves distances,
+                       const ExtraGrids& extras, const Points& points, OutputLeaves& leaves)
     {
         if (whole == 0) {
             ExtraLeaves e = extras.make(origin);
             extras.fill<Sampler>(color->getValueMask(), points, e);
+            e.distances[0] = std::move(distances.source);
+            e.distances[1] = std::move(distances.target);
             leaves.keep(std::move(value), std::move(color), std::move(e));
         } else if (whole < 0) {
             leaves.insideTile(origin);
@@ -121,7 +153,7 @@ private:
     /// The leaves `evaluate`, from the distances kept across frames (no pairs).
     void fromKeptDistances(const SdfFrame<Sampler>& blend, IdentityDistances& kept,
                            const std::vector<Coord>& evaluate, const ExtraGrids& extras,
-                           OutputLeaves& leaves, Interrupter* interrupter) const
+                           bool velocity, OutputLeaves& leaves, Interrupter* interrupter) const
     {
         const float band = blend.computeBand();
         std::atomic<bool> stopped{false};
@@ -140,15 +172,17 @@ private:
                     const auto& distances =
                         kept.get<Sampler>(evaluate[i], a, b, *scratch, computed);
                     auto [value, color] = leaves.make(evaluate[i], band);
-                    const int whole = blend(evaluate[i], distances, *value, *color);
+                    DistanceLeaves recorded(velocity, evaluate[i]);
+                    const int whole =
+                        blend(evaluate[i], distances, *value, *color, recorded.record());
                     // The identity warp: each voxel's points are the voxel itself.
                     const auto atVoxel = [&origin = evaluate[i]](openvdb::Index n) {
                         const openvdb::Vec3R p =
                             (origin + OutputLeaves::ValueLeaf::offsetToLocalCoord(n)).asVec3d();
                         return std::pair{p, p};
                     };
-                    settle(whole, evaluate[i], std::move(value), std::move(color), extras, atVoxel,
-                           leaves);
+                    settle(whole, evaluate[i], std::move(value), std::move(color),
+                           std::move(recorded), extras, atVoxel, leaves);
                 }
                 blend.addSamples(computed);
             });
@@ -157,7 +191,8 @@ private:
 
     /// The leaves the warp's traversal visits (those the classes want, when pruning).
     void throughWarp(const SdfFrame<Sampler>& blend, const BlendRequest& r,
-                     const ExtraGrids& extras, OutputLeaves& leaves, AdaptiveWarpStats& stats) const
+                     const ExtraGrids& extras, bool velocity, OutputLeaves& leaves,
+                     AdaptiveWarpStats& stats) const
     {
         const float band = blend.computeBand();
         const BlockClasses& classes = blend.classes();
@@ -168,17 +203,19 @@ private:
             r.box, nullptr, nullptr,
             [&](const WarpLeaf& w) {
                 auto [value, color] = leaves.make(w.origin, band);
-                const int whole = blend(w, *value, *color);
-                settle(whole, w.origin, std::move(value), std::move(color), extras, WarpedPoints{w},
-                       leaves);
+                DistanceLeaves recorded(velocity, w.origin);
+                const int whole = blend(w, *value, *color, recorded.record());
+                settle(whole, w.origin, std::move(value), std::move(color), std::move(recorded),
+                       extras, WarpedPoints{w}, leaves);
             },
             &stats, r.interrupter, r.prune ? &wanted : nullptr);
     }
 
     /// The grids from the leaves: tiles and the background take the output band's values at once
     /// (+/- its width); the leaves' values beyond the compute band are rewritten by redistance().
+    /// The recorded distances go into `distances` when given.
     void assemble(const SdfFrame<Sampler>& blend, const ExtraGrids& extras, OutputLeaves& leaves,
-                  BlendedFrame& out) const
+                  Distances* distances, BlendedFrame& out) const
     {
         openvdb::FloatGrid::Ptr values = openvdb::FloatGrid::create(blend.width());
         values->setTransform(mSource.density->transform().copy());
@@ -186,8 +223,11 @@ private:
         out.grids.color = openvdb::Vec3SGrid::create(leaves.background());
         out.keptLeaves = leaves.size();
         ExtraGrids::Outputs carried = extras.outputs();
-        leaves.moveInto(values->tree(), out.grids.color->tree(), -blend.width(), carried.floats,
-                        carried.vectors);
+        if (distances) {
+            carried.trees.distances[0] = &distances->source;
+            carried.trees.distances[1] = &distances->target;
+        }
+        leaves.moveInto(values->tree(), out.grids.color->tree(), -blend.width(), carried.trees);
         out.grids.extras = std::move(carried.grids);
         dropIslands(*values, mSpec.minIslandVoxels, blend.computeBand(), blend.deepVoxels());
         const float voxel = float(mSource.voxelSize());

@@ -116,6 +116,19 @@ public:
         }
     };
 
+    /// Where a leaf's fill writes each side's distance (world units) at the voxels it blends
+    /// (for the velocity, SdfVelocity.h); null: not kept.
+    struct Distances {
+        ValueLeaf* source = nullptr;
+        ValueLeaf* target = nullptr;
+        void record(openvdb::Index n, float da, float db) const
+        {
+            if (!source) return;
+            source->setValueOn(n, da);
+            target->setValueOn(n, db);
+        }
+    };
+
     /// The leaf's bands (world units): its compute band, and the band that is kept.
     struct Bands {
         float compute, keep;
@@ -147,9 +160,10 @@ public:
     /// Fills one leaf: the blend within the compute band (active), +/- the compute band beyond
     /// (inactive); colour where the band may be. Returns -1 when every value is inside and none
     /// active, +1 when every value is outside and none active, 0 otherwise (keep the leaf).
-    int operator()(const WarpLeaf& w, ValueLeaf& value, ColorLeaf& color) const
+    int operator()(const WarpLeaf& w, ValueLeaf& value, ColorLeaf& color,
+                   const Distances& distances = {}) const
     {
-        LeafFill fill(*this, w, value, color);
+        LeafFill fill(*this, w, value, color, distances);
         for (int q = 0; q < 8; ++q)
             fill.quarter((q & 1) * 4, ((q >> 1) & 1) * 4, ((q >> 2) & 1) * 4);
         mSamples += fill.samples;
@@ -161,7 +175,7 @@ public:
     /// cheaper than judging quarters and blocks, and gives the same leaf (what those judgements
     /// skip is beyond the compute band, with their sign).
     int operator()(const openvdb::Coord& origin, const IdentityDistances::Leaf& distances,
-                   ValueLeaf& value, ColorLeaf& color) const
+                   ValueLeaf& value, ColorLeaf& color, const Distances& record = {}) const
     {
         ColorBlend<Sampler> colors(mSource, mTarget, mTauColor, mBackground);
         const float ramp = kSdfRampVoxels * mVoxel;
@@ -169,6 +183,7 @@ public:
         const Bands bands = bandsAt(origin);
         for (openvdb::Index n = 0; n < 512; ++n) {
             const float da = distances.source[n], db = distances.target[n];
+            record.record(n, da, db);
             blendVoxel(n, da, db, bands, value, color, seen, [&] {
                 return colors.atVoxel(origin + value.offsetToLocalCoord(n), fogRamp(da, ramp),
                                       fogRamp(db, ramp));
@@ -194,9 +209,10 @@ private:
     /// a quarter or block is inside or outside as a whole. The rest is blended voxel by voxel.
     class LeafFill {
     public:
-        LeafFill(const SdfFrame& f, const WarpLeaf& w, ValueLeaf& value, ColorLeaf& color)
-            : mF(f), mW(w), mValue(value), mColor(color), mA(f.mFarSource), mB(f.mFarTarget),
-              mColors(f.mSource, f.mTarget, f.mTauColor, f.mBackground),
+        LeafFill(const SdfFrame& f, const WarpLeaf& w, ValueLeaf& value, ColorLeaf& color,
+                 const Distances& distances)
+            : mF(f), mW(w), mValue(value), mColor(color), mDistances(distances), mA(f.mFarSource),
+              mB(f.mFarTarget), mColors(f.mSource, f.mTarget, f.mTauColor, f.mBackground),
               // Each side's colour weight is its fog at the warped point, derived from its
               // distance with the output's ramp: what "empty there" means for a surface.
               mRamp(kSdfRampVoxels * f.mVoxel), mBands(f.bandsAt(w.origin))
@@ -241,6 +257,7 @@ private:
                         const openvdb::Vec3R ps(mW.source(n)), pt(mW.target(n));
                         const float da = mA(ps), db = mB(pt);
                         ++samples;
+                        mDistances.record(n, da, db);
                         mF.blendVoxel(n, da, db, mBands, mValue, mColor, seen, [&] {
                             return mColors(ps, pt, fogRamp(da, mRamp), fogRamp(db, mRamp));
                         });
@@ -269,6 +286,7 @@ private:
         const WarpLeaf& mW;
         ValueLeaf& mValue;
         ColorLeaf& mColor;
+        const Distances& mDistances;
         typename ExtendedDistance::template Reader<Sampler> mA, mB;
         ColorBlend<Sampler> mColors;
         float mRamp;

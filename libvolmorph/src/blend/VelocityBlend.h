@@ -38,9 +38,7 @@ public:
                                const float a[512], const float b[512]) const
     {
         Vec3f vs[512], vt[512];
-        const int interpolated = mLeaf.fill(origin, on, vs, vt);
-        mInterpolated += uint64_t(interpolated);
-        mExact += uint64_t(8 - interpolated);
+        count(mLeaf.fill(origin, on, vs, vt));
         auto out = std::make_unique<Leaf>(origin, Vec3f(0.0f), false);
         for (auto it = on.beginOn(); it; ++it) {
             const openvdb::Index n = it.pos();
@@ -58,12 +56,20 @@ public:
     /// reaches in `seconds` either way: dilated by the fastest speed times that, each new voxel
     /// holding the warp's own velocity there ((1 - tau) v_S + tau v_T: both sides are empty); by
     /// at most kMaxReach voxels.
-    /// Eulerian motion blur reads the velocity where the density is about to arrive.
-    void extend(openvdb::Vec3SGrid& velocity, double seconds, double voxelSize) const;
+    /// Eulerian motion blur reads the velocity where the density is about to arrive. Returns the
+    /// voxels it dilated by.
+    int extend(openvdb::Vec3SGrid& velocity, double seconds, double voxelSize) const;
 
     /// Sub-cubes (4^3 voxels) whose warp velocity was interpolated, and evaluated exactly, so far.
     uint64_t interpolatedCubes() const { return mInterpolated; }
     uint64_t exactCubes() const { return mExact; }
+    /// Counts a leaf's sub-cubes, `interpolated` of its 8 (VelocityLeaf::fill).
+    void count(int interpolated) const
+    {
+        mInterpolated += uint64_t(interpolated);
+        mExact += uint64_t(8 - interpolated);
+    }
+    const VelocityLeaf& warpVelocity() const { return mLeaf; }
 
 private:
     VelocityLeaf mLeaf;
@@ -71,15 +77,15 @@ private:
     mutable std::atomic<uint64_t> mInterpolated{0}, mExact{0};
 };
 
-inline void VelocityBlend::extend(openvdb::Vec3SGrid& velocity, double seconds,
-                                  double voxelSize) const
+inline int VelocityBlend::extend(openvdb::Vec3SGrid& velocity, double seconds,
+                                 double voxelSize) const
 {
     const double fastest = openvdb::tools::extrema(velocity.cbeginValueOn(), true).max();
     // At most kMaxReach voxels: near a fold of the warp the speed spikes, and a dilation by it
     // would fill the machine.
     const double voxels = std::ceil(fastest * seconds / voxelSize);
     const int reach = voxels > 0.0 ? int(std::min(voxels, double(kMaxReach))) : 0;
-    if (reach <= 0) return;
+    if (reach <= 0) return 0;
     openvdb::Vec3STree original(velocity.tree(), Vec3f(0.0f), openvdb::TopologyCopy());
     openvdb::tools::dilateActiveValues(velocity.tree(), reach, openvdb::tools::NN_FACE_EDGE_VERTEX,
                                        openvdb::tools::IGNORE_TILES);
@@ -96,6 +102,7 @@ inline void VelocityBlend::extend(openvdb::Vec3SGrid& velocity, double seconds,
     };
     openvdb::tree::LeafManager<openvdb::Vec3STree> leaves(velocity.tree());
     leaves.foreach (fill);
+    return reach;
 }
 
 } // namespace volmorph::detail

@@ -50,13 +50,6 @@ TEST(Morph, SdfModeReproducesTheEndSurfaces)
 
 namespace {
 
-/// Radius of the ball with the fog's enclosed volume (world units).
-double equivalentRadius(const openvdb::FloatGrid& density)
-{
-    const double volume = moments(density).mass * std::pow(density.voxelSize()[0], 3);
-    return std::cbrt(3.0 * volume / (4.0 * M_PI));
-}
-
 /// Euler characteristic V - E + F of a closed triangle mesh: 2 - 2 genus per shell.
 long eulerCharacteristic(const Mesh& mesh)
 {

@@ -26,20 +26,8 @@ MorphOptions withVelocity()
 template <typename Expected>
 double worstError(const VolumeSet& frame, const Expected& expected, int& count)
 {
-    EXPECT_TRUE(frame.velocity);
-    if (!frame.velocity) return 1e9;
-    auto vel = frame.velocity->getConstAccessor();
-    double worst = 0.0, fastest = 0.0;
-    count = 0;
-    for (auto it = frame.density->cbeginValueOn(); it; ++it) {
-        if (*it <= 0.5f || !it.isVoxelValue()) continue;
-        const Vec3d p = frame.density->indexToWorld(it.getCoord());
-        const Vec3d e = expected(p);
-        worst = std::max(worst, (Vec3d(vel.getValue(it.getCoord())) - e).length());
-        fastest = std::max(fastest, e.length());
-        ++count;
-    }
-    return worst / fastest;
+    return worstVelocityError(
+        frame, *frame.density, [](float d) { return d > 0.5f; }, expected, count);
 }
 
 } // namespace

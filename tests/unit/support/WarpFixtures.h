@@ -143,6 +143,36 @@ inline Moments moments(const openvdb::FloatGrid& density)
     return m;
 }
 
+/// Radius of the ball with the fog's enclosed volume (world units).
+inline double equivalentRadius(const openvdb::FloatGrid& density)
+{
+    const double volume = moments(density).mass * std::pow(density.voxelSize()[0], 3);
+    return std::cbrt(3.0 * volume / (4.0 * M_PI));
+}
+
+/// The largest |vel - expected(world point)| over the active voxels of `where` whose value
+/// passes `keep`, relative to the largest expected speed there; also counts those voxels (and
+/// fails the test where one lacks velocity).
+template <typename Keep, typename Expected>
+double worstVelocityError(const VolumeSet& frame, const openvdb::FloatGrid& where, const Keep& keep,
+                          const Expected& expected, int& count)
+{
+    EXPECT_TRUE(frame.velocity);
+    if (!frame.velocity) return 1e9;
+    auto vel = frame.velocity->getConstAccessor();
+    double worst = 0.0, fastest = 0.0;
+    count = 0;
+    for (auto it = where.cbeginValueOn(); it; ++it) {
+        if (!keep(*it) || !it.isVoxelValue()) continue;
+        EXPECT_TRUE(vel.isValueOn(it.getCoord()));
+        const Vec3d e = expected(where.indexToWorld(it.getCoord()));
+        worst = std::max(worst, (Vec3d(vel.getValue(it.getCoord())) - e).length());
+        fastest = std::max(fastest, e.length());
+        ++count;
+    }
+    return worst / fastest;
+}
+
 /// Largest |a - b| of two density grids over the union of their active voxels.
 inline double maxDifference(const openvdb::FloatGrid& a, const openvdb::FloatGrid& b)
 {

@@ -124,6 +124,13 @@ struct ShutterTime {
 /// up to 64, evenly spread over [open, close] (each at the middle of its share).
 std::vector<double> shutterOffsets(double open, double close, int samples);
 
+/// The seed renderMotionBlurred renders shutter time k (from 0) with, from the settings' seed: the
+/// times' samples lie apart.
+inline unsigned shutterSeed(unsigned seed, size_t k)
+{
+    return seed ^ unsigned(0x9E3779B9u * (k + 1));
+}
+
 /// Eulerian motion blur: the mean of one image per time in `times`, each of the density (and
 /// colour) advected along `velocity` (world units per second; null or all zero: the volume stands
 /// still and only the cameras and lights move) by its seconds, rho(p - v(p) s), by
