@@ -4,6 +4,7 @@ usage: blender -b --factory-startup --python tests/bench/cycles_render.py -- IN.
            --voxel V --eye X,Y,Z --lookat X,Y,Z --fov DEG --res WxH --extinction S --albedo A
            [--color-grid Cd] [--sun DX,DY,DZ,STRENGTH[,R,G,B]] [--sky R,G,B] [--bounces N]
            [--samples N] [--step-rate R] [--threads N]
+           [--velocity-grid NAME --shutter FRAMES --fps F]
 
 Every vector is in volmorph's frame (y up, world units); the sun's direction is the way its light
 travels, its strength the irradiance (Cycles' sun strength, as volmorph's intensity). As NOTES.md
@@ -13,6 +14,9 @@ Principled Volume whose Density multiplies the grid (extinction per world unit),
 albedo (times the colour grid when given) and Absorption Color is black: extinction = Density,
 albedo = Color. Linear interpolation, a box pixel filter one pixel wide (volmorph's stratified
 samples), a transparent film (RGB premultiplied, A = coverage), no denoising, float EXR.
+With --velocity-grid, Cycles blurs the volume along that grid (world units per second, Velocity
+Unit = Second, scale 1) over a shutter of FRAMES frames centred on the frame, at F frames per
+second (issue 36's cross-check: tests/bench/blender_motion_blur.sh).
 """
 import argparse
 import math
@@ -56,6 +60,9 @@ def parse():
     p.add_argument("--samples", type=int, default=64)
     p.add_argument("--step-rate", type=float, default=0.1)
     p.add_argument("--threads", type=int, default=2)
+    p.add_argument("--velocity-grid", default="")
+    p.add_argument("--shutter", type=float, default=0.0)
+    p.add_argument("--fps", type=float, default=24.0)
     return p.parse_args(argv)
 
 
@@ -89,6 +96,10 @@ def volume_object(args):
         pv.inputs["Color"].default_value = (a, a, a, 1.0)
     links.new(pv.outputs["Volume"], out.inputs["Volume"])
     obj.data.materials.append(mat)
+    if args.velocity_grid:
+        obj.data.velocity_grid = args.velocity_grid
+        obj.data.velocity_unit = "SECOND"
+        obj.data.velocity_scale = 1.0
 
 
 def camera(args, width):
@@ -154,6 +165,12 @@ def settings(args):
     scene.render.image_settings.color_mode = "RGBA"
     scene.render.image_settings.color_depth = "32"
     scene.render.filepath = args.out
+    if args.velocity_grid and args.shutter > 0.0:
+        scene.render.use_motion_blur = True
+        scene.render.motion_blur_shutter = args.shutter
+        c.motion_blur_position = "CENTER"
+        scene.render.fps = int(round(args.fps))
+        scene.render.fps_base = scene.render.fps / args.fps
     return w
 
 

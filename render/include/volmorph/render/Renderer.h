@@ -133,12 +133,13 @@ inline unsigned shutterSeed(unsigned seed, size_t k)
 
 /// Eulerian motion blur: the mean of one image per time in `times`, each of the density (and
 /// colour) advected along `velocity` (world units per second; null or all zero: the volume stands
-/// still and only the cameras and lights move) by its seconds, rho(p - v(p) s), by
-/// OpenVDB's semi-Lagrangian VolumeAdvection, seen by its camera under its lights, with
+/// still and only the cameras and lights move) by its seconds, rho(p - v(p) s): moved by the
+/// density-weighted mean velocity exactly (the grids' transforms) and by the rest through
+/// OpenVDB's semi-Lagrangian VolumeAdvection; seen by its camera under its lights, with
 /// samples / times.size() samples per pixel (at least 1; set centreSingleSample false to jitter a
-/// lone one), seeded apart. Exact for a
-/// velocity constant along the motion (a translation); `velocity` must cover where the density
-/// arrives within the times (volmorph's vel does: MorphOptions::velocityReachSeconds).
+/// lone one), seeded apart (shutterSeed). Exact for a translation, without resampling;
+/// `velocity` must cover where the density arrives within the times (volmorph's vel does:
+/// MorphOptions::velocityReachSeconds).
 Image renderMotionBlurred(const openvdb::FloatGrid& density, const openvdb::Vec3SGrid* color,
                           const openvdb::Vec3SGrid* velocity, const std::vector<ShutterTime>& times,
                           const Medium& medium, const RenderSettings& settings);
