@@ -9,7 +9,37 @@
 namespace volmorph::detail {
 namespace {
 
-using Accessor = openvdb::tree::ValueAccessor<const openvdb::FloatTree>;
+/// One recorded field around a leaf: within the leaf read from its buffer and mask, beyond it
+/// through an accessor (most of a gradient's reads stay in the leaf).
+class Field {
+public:
+    Field(const openvdb::FloatTree& tree, const openvdb::Coord& origin)
+        : mAccessor(tree), mLeaf(tree.probeConstLeaf(origin)), mOrigin(origin)
+    {
+        if (mLeaf) mValues = mLeaf->buffer().data();
+    }
+
+    /// The value at voxel n of the leaf (recorded there).
+    float at(openvdb::Index n) const { return mValues[n]; }
+
+    /// The value at ijk; false where nothing was recorded.
+    bool probe(const openvdb::Coord& ijk, float& value) const
+    {
+        const openvdb::Coord l = ijk - mOrigin;
+        if (mLeaf && unsigned(l.x()) < 8u && unsigned(l.y()) < 8u && unsigned(l.z()) < 8u) {
+            const openvdb::Index n = openvdb::Index((l.x() << 6) | (l.y() << 3) | l.z());
+            value = mValues[n];
+            return mLeaf->getValueMask().isOn(n);
+        }
+        return mAccessor.probeValue(ijk, value);
+    }
+
+private:
+    mutable openvdb::tree::ValueAccessor<const openvdb::FloatTree> mAccessor;
+    const openvdb::FloatTree::LeafNodeType* mLeaf;
+    const float* mValues = nullptr;
+    openvdb::Coord mOrigin;
+};
 
 /// Where |grad phi| falls below this fraction of a distance's gradient, the normal is undefined.
 constexpr float kMinGradient = 0.25f;
@@ -17,27 +47,27 @@ constexpr float kMinGradient = 0.25f;
 /// The derivative of the recorded field along `axis` at ijk (per index unit): central where both
 /// neighbours were recorded, else one-sided (second order when two voxels on that side were, first
 /// order when one was). False when neither neighbour was.
-bool derivative(const Accessor& a, const openvdb::Coord& ijk, float centre, int axis, float& out)
+bool derivative(const Field& a, const openvdb::Coord& ijk, float centre, int axis, float& out)
 {
     openvdb::Coord step(0);
     step[axis] = 1;
     float p1 = 0.0f, m1 = 0.0f, p2 = 0.0f, m2 = 0.0f;
-    const bool hasP1 = a.probeValue(ijk + step, p1), hasM1 = a.probeValue(ijk - step, m1);
+    const bool hasP1 = a.probe(ijk + step, p1), hasM1 = a.probe(ijk - step, m1);
     if (hasP1 && hasM1) {
         out = 0.5f * (p1 - m1);
     } else if (hasP1) {
-        out = a.probeValue(ijk + step + step, p2) ? 0.5f * (-3.0f * centre + 4.0f * p1 - p2)
-                                                  : p1 - centre;
+        out =
+            a.probe(ijk + step + step, p2) ? 0.5f * (-3.0f * centre + 4.0f * p1 - p2) : p1 - centre;
     } else if (hasM1) {
-        out = a.probeValue(ijk - step - step, m2) ? 0.5f * (3.0f * centre - 4.0f * m1 + m2)
-                                                  : centre - m1;
+        out =
+            a.probe(ijk - step - step, m2) ? 0.5f * (3.0f * centre - 4.0f * m1 + m2) : centre - m1;
     } else {
         return false;
     }
     return true;
 }
 
-bool gradient(const Accessor& a, const openvdb::Coord& ijk, float centre, Vec3f& out)
+bool gradient(const Field& a, const openvdb::Coord& ijk, float centre, Vec3f& out)
 {
     return derivative(a, ijk, centre, 0, out[0]) && derivative(a, ijk, centre, 1, out[1]) &&
            derivative(a, ijk, centre, 2, out[2]);
@@ -50,12 +80,11 @@ void SdfVelocity::leaf(const openvdb::FloatTree& source, const openvdb::FloatTre
                        VectorLeaf& correction) const
 {
     const openvdb::Coord origin = velocity.origin();
-    const Accessor a(source), b(target);
+    const Field a(source, origin), b(target, origin);
     // The shell near the surface; the rest of what was recorded is left to the extension.
     openvdb::util::NodeMask<3> shell;
     for (auto it = on.beginOn(); it; ++it) {
-        const openvdb::Coord ijk = origin + VectorLeaf::offsetToLocalCoord(it.pos());
-        if (std::abs((1.0f - mTau) * a.getValue(ijk) + mTau * b.getValue(ijk)) < mShell)
+        if (std::abs((1.0f - mTau) * a.at(it.pos()) + mTau * b.at(it.pos())) < mShell)
             shell.setOn(it.pos());
         else
             velocity.setValueOff(it.pos());
@@ -66,7 +95,7 @@ void SdfVelocity::leaf(const openvdb::FloatTree& source, const openvdb::FloatTre
     for (auto it = shell.beginOn(); it; ++it) {
         const openvdb::Index n = it.pos();
         const openvdb::Coord ijk = origin + VectorLeaf::offsetToLocalCoord(n);
-        const float da = a.getValue(ijk), db = b.getValue(ijk);
+        const float da = a.at(n), db = b.at(n);
         const float wa = (1.0f - mTau) * fogRamp(da, mRamp), wb = mTau * fogRamp(db, mRamp);
         const Vec3f warp = wa + wb > 0.0f ? (wa * vs[n] + wb * vt[n]) / (wa + wb)
                                           : (1.0f - mTau) * vs[n] + mTau * vt[n];
@@ -135,6 +164,7 @@ openvdb::Vec3SGrid::Ptr SdfVelocity::make(const openvdb::FloatTree& source,
     }
     openvdb::tools::pruneInactive(velocity->tree());
     openvdb::tools::pruneInactive(correction);
+    if (!(seconds > 0.0)) return velocity;
     const openvdb::MaskTree band(velocity->tree(), false, openvdb::TopologyCopy());
     const int reach = mBlend.extend(*velocity, seconds, voxelSize);
     for (int layer = 0; layer < reach; ++layer) extrapolate(correction);

@@ -80,6 +80,7 @@ private:
 inline int VelocityBlend::extend(openvdb::Vec3SGrid& velocity, double seconds,
                                  double voxelSize) const
 {
+    if (!(seconds > 0.0)) return 0;
     const double fastest = openvdb::tools::extrema(velocity.cbeginValueOn(), true).max();
     // At most kMaxReach voxels: near a fold of the warp the speed spikes, and a dilation by it
     // would fill the machine.

@@ -7,10 +7,13 @@
 // independent, so the result does not depend on threads) and interpolates trilinearly between
 // them. The interpolant is checked at each of the eight 4^3 sub-cubes' centres, where its error is
 // largest for a smooth field, against the exact velocity there; a sub-cube whose check is off by
-// more than the tolerance (relative to the largest speed on the leaf's lattice) is evaluated
-// exactly at its active voxels instead, and so is a whole leaf whose lattice touches a fold of the
-// warp (J singular) or that has no more active voxels than the lattice and check together. The
-// check is a posteriori: between its points the error is estimated, not bounded.
+// more than the tolerance (relative to the largest speed on the leaf's lattice) but at most 8
+// times it goes to a lattice 2 voxels apart (19 more exact points; its 8 cells checked at their
+// centres the same way), and one that misses by more, or has no more active voxels than those 27
+// evaluations, or whose fine cell misses, is evaluated exactly at its active voxels; so is a whole
+// leaf whose lattice touches a fold of the warp (J singular) or that has no more active voxels than
+// the lattice and check together. The check is a posteriori: between its points the error is
+// estimated, not bounded.
 #pragma once
 
 #include <volmorph/core/Math.h>
@@ -21,6 +24,8 @@
 #include <cstdint>
 
 namespace volmorph::detail {
+
+struct Lattice; // VelocityLeaf.cpp: both sides' velocities at a leaf's points 4 voxels apart
 
 class VelocityLeaf {
 public:
@@ -41,6 +46,10 @@ private:
     bool exact(const Vec3d& p, Vec3d& source, Vec3d& target) const;
     void fillExact(const openvdb::Coord& origin, const openvdb::util::NodeMask<3>& on,
                    Vec3f source[512], Vec3f target[512]) const;
+    /// Sub-cube c's voxels `on` interpolated on a lattice 2 voxels apart (its 8 cells checked at
+    /// their centres against the tolerance times `speed`; a cell that misses, or a fold, exactly).
+    void refine(const openvdb::Coord& origin, int c, double speed, const Lattice& coarse,
+                const openvdb::util::NodeMask<3>& on, Vec3f source[512], Vec3f target[512]) const;
 
     const InverseWarp& mWarp;
     double mTolerance;
