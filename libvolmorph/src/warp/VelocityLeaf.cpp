@@ -174,6 +174,29 @@ void VelocityLeaf::refine(const openvdb::Coord& origin, int c, double speed, con
     fillExact(origin, rest, source, target);
 }
 
+void VelocityLeaf::finishFailed(const openvdb::Coord& origin, const openvdb::util::NodeMask<3>& on,
+                                const bool passed[8], const double miss[8], double speed,
+                                const Lattice& lattice, Vec3f source[512], Vec3f target[512]) const
+{
+    openvdb::util::NodeMask<3> rest[8];
+    for (auto it = on.beginOn(); it; ++it) {
+        const openvdb::Index n = it.pos();
+        const int c = int((n >> 8) * 4 + ((n >> 5) & 1) * 2 + ((n >> 2) & 1));
+        if (!passed[c]) rest[c].setOn(n);
+    }
+    // A finer lattice costs 19 points and 8 checks: worth it where the sub-cube has more active
+    // voxels and its check missed by little (halving the spacing quarters a smooth field's error).
+    constexpr openvdb::Index kFinePoints = 19 + 8;
+    constexpr double kRefinable = 8.0;
+    for (int c = 0; c < 8; ++c) {
+        if (passed[c] || rest[c].isOff()) continue;
+        if (miss[c] <= kRefinable && rest[c].countOn() > kFinePoints)
+            refine(origin, c, speed, lattice, rest[c], source, target);
+        else
+            fillExact(origin, rest[c], source, target);
+    }
+}
+
 int VelocityLeaf::fill(const openvdb::Coord& origin, const openvdb::util::NodeMask<3>& on,
                        Vec3f source[512], Vec3f target[512]) const
 {
@@ -237,26 +260,7 @@ int VelocityLeaf::fill(const openvdb::Coord& origin, const openvdb::util::NodeMa
         lattice.interpolateAll(0, source);
         lattice.interpolateAll(1, target);
     }
-    if (passing < 8) { // the sub-cubes that failed: on a finer lattice, or exactly
-        openvdb::util::NodeMask<3> rest[8];
-        for (auto it = on.beginOn(); it; ++it) {
-            const openvdb::Index n = it.pos();
-            const int c = int((n >> 8) * 4 + ((n >> 5) & 1) * 2 + ((n >> 2) & 1));
-            if (!passed[c]) rest[c].setOn(n);
-        }
-        // A finer lattice costs 19 points and 8 checks: worth it where the sub-cube has more
-        // active voxels and its check missed by little (halving the spacing quarters a smooth
-        // field's error).
-        constexpr openvdb::Index kFinePoints = 19 + 8;
-        constexpr double kRefinable = 8.0;
-        for (int c = 0; c < 8; ++c) {
-            if (passed[c] || rest[c].isOff()) continue;
-            if (miss[c] <= kRefinable && rest[c].countOn() > kFinePoints)
-                refine(origin, c, speed, lattice, rest[c], source, target);
-            else
-                fillExact(origin, rest[c], source, target);
-        }
-    }
+    if (passing < 8) finishFailed(origin, on, passed, miss, speed, lattice, source, target);
     return passing;
 }
 

@@ -46,6 +46,11 @@ private:
     bool exact(const Vec3d& p, Vec3d& source, Vec3d& target) const;
     void fillExact(const openvdb::Coord& origin, const openvdb::util::NodeMask<3>& on,
                    Vec3f source[512], Vec3f target[512]) const;
+    /// The voxels `on` of the sub-cubes that did not pass (`miss`: their checks' errors in
+    /// tolerances): on a finer lattice, or exactly.
+    void finishFailed(const openvdb::Coord& origin, const openvdb::util::NodeMask<3>& on,
+                      const bool passed[8], const double miss[8], double speed,
+                      const Lattice& lattice, Vec3f source[512], Vec3f target[512]) const;
     /// Sub-cube c's voxels `on` interpolated on a lattice 2 voxels apart (its 8 cells checked at
     /// their centres against the tolerance times `speed`; a cell that misses, or a fold, exactly).
     void refine(const openvdb::Coord& origin, int c, double speed, const Lattice& coarse,
