@@ -80,7 +80,7 @@ public:
         } else {
             throughWarp(blend, r, extras, velocity, leaves, out.warp);
         }
-        Distances distances;
+        DistanceTrees distances;
         assemble(blend, extras, leaves, velocity ? &distances : nullptr, out);
         if (velocity) {
             const SdfVelocity v(
@@ -97,7 +97,7 @@ public:
 private:
     using ValueLeaf = OutputLeaves::ValueLeaf;
     /// Each side's distance at the warped points of the voxels blended (for the velocity).
-    struct Distances {
+    struct DistanceTrees {
         openvdb::FloatTree source, target;
     };
     struct DistanceLeaves {
@@ -215,7 +215,7 @@ private:
     /// (+/- its width); the leaves' values beyond the compute band are rewritten by redistance().
     /// The recorded distances go into `distances` when given.
     void assemble(const SdfFrame<Sampler>& blend, const ExtraGrids& extras, OutputLeaves& leaves,
-                  Distances* distances, BlendedFrame& out) const
+                  DistanceTrees* distances, BlendedFrame& out) const
     {
         openvdb::FloatGrid::Ptr values = openvdb::FloatGrid::create(blend.width());
         values->setTransform(mSource.density->transform().copy());

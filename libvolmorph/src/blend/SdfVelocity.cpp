@@ -150,8 +150,7 @@ openvdb::Vec3SGrid::Ptr SdfVelocity::make(const openvdb::FloatTree& source,
                                           double voxelSize) const
 {
     auto velocity = openvdb::Vec3SGrid::create(Vec3f(0.0f));
-    velocity->tree().topologyUnion(source);
-    velocity->tree().topologyIntersection(target);
+    velocity->tree().topologyUnion(source); // the target's was recorded at the same voxels
     openvdb::Vec3STree correction(velocity->tree(), Vec3f(0.0f), openvdb::TopologyCopy());
     {
         openvdb::tree::LeafManager<openvdb::Vec3STree> leaves(velocity->tree());
