@@ -15,6 +15,8 @@
 #include <volmorph/Warp.h>
 
 #include "warp/AdaptiveWarp.h"
+#include "warp/VelocityKernel.h"
+#include "warp/VelocityLeaf.h"
 
 #include <benchmark/benchmark.h>
 #include <openvdb/tools/Interpolation.h>
@@ -132,14 +134,29 @@ uint64_t leafHash(const detail::WarpLeaf& leaf)
 }
 
 /// The warp alone over the frame's candidate domain: positions are computed and consumed.
+/// The warp of a frame at t = 0.5 with `pairs` of pairsFor, 256 voxels across, in index space, and
+/// the frame's candidate box.
+struct FrameWarp {
+    const Setup& s = setup(256);
+    const openvdb::CoordBBox box;
+    const InverseWarp warp;
+    explicit FrameWarp(int pairs) : FrameWarp(pairsFor(setup(256).scene, pairs)) {}
+
+private:
+    explicit FrameWarp(const std::vector<FeaturePairSpec>& pairs)
+        : box(Morpher(s.volumes.source, s.volumes.target, pairs, s.scene.warp, s.scene.blend)
+                  .candidateBounds(0.5)),
+          warp(pairs, s.scene.warp, 0.5, 1.0 / s.volumes.source.voxelSize())
+    {
+    }
+};
+
 void warpOnly(benchmark::State& state, double tolerance)
 {
-    const Setup& s = setup(256);
-    const auto pairs = pairsFor(s.scene, int(state.range(0)));
-    const double t = 0.5, voxel = s.volumes.source.voxelSize();
-    const Morpher morpher(s.volumes.source, s.volumes.target, pairs, s.scene.warp, s.scene.blend);
-    const openvdb::CoordBBox box = morpher.candidateBounds(t);
-    const InverseWarp warp(pairs, s.scene.warp, t, 1.0 / voxel);
+    const FrameWarp frame(int(state.range(0)));
+    const Setup& s = frame.s;
+    const openvdb::CoordBBox& box = frame.box;
+    const InverseWarp& warp = frame.warp;
     const detail::Occupancy occS(s.volumes.source.density->tree()),
         occT(s.volumes.target.density->tree());
     const detail::AdaptiveWarp adaptive(warp, tolerance);
@@ -185,6 +202,36 @@ void exactWarp(benchmark::State& state)
 void approximatedWarp(benchmark::State& state)
 {
     warpOnly(state, 0.25);
+}
+
+/// The warp's exact derivatives (the velocity's hot loop) at 4096 points of the frame's candidate
+/// box at t = 0.5 with range(0) pairs: InverseWarp::derivatives (range(1) = 0) and its vector
+/// kernel over the pairs' columns (1), in nanoseconds per point, one thread.
+void warpDerivatives(benchmark::State& state)
+{
+    const FrameWarp frame(int(state.range(0)));
+    const openvdb::CoordBBox& box = frame.box;
+    const InverseWarp& warp = frame.warp;
+    const detail::VelocityKernel kernel(warp, detail::VelocityLeaf::kExactWithin);
+    std::mt19937 random(3);
+    std::vector<Vec3d> points(4096);
+    for (Vec3d& p : points)
+        for (int a = 0; a < 3; ++a)
+            p[a] = std::uniform_real_distribution<double>(box.min()[a], box.max()[a])(random);
+    double sink = 0.0;
+    for (auto _ : state)
+        for (const Vec3d& p : points) {
+            InverseWarp::Derivatives ds, dt;
+            if (state.range(1))
+                kernel.derivatives(p, ds, dt);
+            else
+                warp.derivatives(p, ds, dt);
+            sink += ds.rate.x() + dt.jacobian(0, 0);
+        }
+    benchmark::DoNotOptimize(sink);
+    state.counters["ns_per_point"] = benchmark::Counter(
+        double(points.size()) * 1e-9,
+        benchmark::Counter::kIsIterationInvariantRate | benchmark::Counter::kInvert);
 }
 
 /// One whole frame at t = 0.5 with the scene's pairs (or `pairs` of pairsFor), in the given blend
@@ -340,6 +387,7 @@ void extraGrids(benchmark::internal::Benchmark* b)
 }
 BENCHMARK(morphFrameExtras)->Apply(extraGrids);
 /// The scene's 3 pairs and 16 pairs, without and with velocity, density and sdf mode.
+BENCHMARK(warpDerivatives)->ArgsProduct({{3, 16, 64}, {0, 1}})->Unit(benchmark::kMicrosecond);
 BENCHMARK(morphFrameVelocity)
     ->ArgsProduct({{3, 16}, {0, 1}, {0, 1}})
     ->Unit(benchmark::kMillisecond)

@@ -67,6 +67,18 @@ public:
     Affine sourceAffine(size_t i) const;
     Affine targetAffine(size_t i) const;
 
+    /// How pair i's interpolated element moves per unit t, for the velocity's vector kernel
+    /// (derivatives() written over the pairs' columns): its origin and scales change linearly and
+    /// its frame turns at omega; the maps from frame coordinates q take each side to
+    /// origin + sum_k to[k] q_k; the weight's own rate (Beier-Neely's length term) is
+    /// lengthWeightRate times the weight.
+    struct Motion {
+        Vec3d originRate, scaleRate, omega;
+        Vec3d toSource[3], toTarget[3];
+        double lengthWeightRate = 0.0;
+    };
+    Motion motion(size_t i) const;
+
 private:
     struct Pair {
         Feature element;   ///< interpolated at t

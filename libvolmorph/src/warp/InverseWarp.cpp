@@ -120,4 +120,27 @@ InverseWarp::Affine InverseWarp::targetAffine(size_t i) const
     return affineOf(mPairs[i].element, mPairs[i].toTarget, mPairs[i].targetOrigin);
 }
 
+InverseWarp::Motion InverseWarp::motion(size_t i) const
+{
+    const Pair& pair = mPairs[i];
+    Motion m;
+    m.originRate = pair.originRate;
+    m.scaleRate = pair.scaleRate;
+    m.omega = pair.omega;
+    for (int k = 0; k < 3; ++k) {
+        m.toSource[k] = pair.toSource[k];
+        m.toTarget[k] = pair.toTarget[k];
+    }
+    if (mWeighting == Weighting::BeierNeely) { // as derivatives() takes it
+        const Feature& e = pair.element;
+        double lengthRate = 0.0, lengthSquared = 0.0;
+        for (int k = 0; k < e.extendedAxes(); ++k) {
+            lengthRate += e.scale[k] * pair.scaleRate[k];
+            lengthSquared += e.scale[k] * e.scale[k];
+        }
+        if (lengthSquared > 0.0) m.lengthWeightRate = mB * mP * lengthRate / lengthSquared;
+    }
+    return m;
+}
+
 } // namespace volmorph

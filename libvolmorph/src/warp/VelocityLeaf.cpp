@@ -95,7 +95,7 @@ openvdb::Coord checkPoint(int c)
 bool VelocityLeaf::exact(const Vec3d& p, Vec3d& source, Vec3d& target) const
 {
     InverseWarp::Derivatives ds, dt;
-    mWarp.derivatives(p, ds, dt);
+    mKernel.derivatives(p, ds, dt);
     const bool s = InverseWarp::velocity(ds, source);
     const bool t = InverseWarp::velocity(dt, target);
     return s && t;

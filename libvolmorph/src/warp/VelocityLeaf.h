@@ -1,5 +1,6 @@
 // The velocity of the material each side shows at the voxels of one output leaf: v = -J^-1 dW/dt
-// of the exact warp (InverseWarp::derivatives), in index units per unit of t.
+// of the exact warp (InverseWarp::derivatives, over the pairs' columns: warp/VelocityKernel.h), in
+// index units per unit of t.
 //
 // Evaluating it at every voxel costs O(pairs) per voxel. Velocity is smooth wherever the warp is
 // (it has the warp's own scale of variation, the distance to the nearest element), so a leaf takes
@@ -16,6 +17,8 @@
 // estimated, not bounded.
 #pragma once
 
+#include "warp/VelocityKernel.h"
+
 #include <volmorph/core/Math.h>
 #include <volmorph/Warp.h>
 
@@ -29,10 +32,14 @@ struct Lattice; // VelocityLeaf.cpp: both sides' velocities at a leaf's points 4
 
 class VelocityLeaf {
 public:
+    /// Where a pair's d + offset is under this many voxels, the exact velocity is taken in double
+    /// precision (VelocityKernel).
+    static constexpr double kExactWithin = 1.0;
+
     /// `warp` maps output index space at the frame's t (built with unit 1 / voxel size).
     /// tolerance: the check's allowed error, relative to the leaf's largest lattice speed.
     explicit VelocityLeaf(const InverseWarp& warp, double tolerance = 2e-3)
-        : mWarp(warp), mTolerance(tolerance)
+        : mKernel(warp, kExactWithin), mTolerance(tolerance)
     {
     }
 
@@ -56,7 +63,7 @@ private:
     void refine(const openvdb::Coord& origin, int c, double speed, const Lattice& coarse,
                 const openvdb::util::NodeMask<3>& on, Vec3f source[512], Vec3f target[512]) const;
 
-    const InverseWarp& mWarp;
+    VelocityKernel mKernel;
     double mTolerance;
 };
 

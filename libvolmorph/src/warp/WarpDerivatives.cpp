@@ -139,12 +139,15 @@ void InverseWarp::derivatives(const Vec3d& p, Derivatives& source, Derivatives& 
 
 bool InverseWarp::velocity(const Derivatives& d, Vec3d& v)
 {
-    const double det = d.jacobian.det();
+    // J^-1 by its columns' cross products: the rows of adj(J) are c1 x c2, c2 x c0, c0 x c1.
+    const Vec3d c0 = d.jacobian.col(0), c1 = d.jacobian.col(1), c2 = d.jacobian.col(2);
+    const Vec3d a0 = c1.cross(c2), a1 = c2.cross(c0), a2 = c0.cross(c1);
+    const double det = c0.dot(a0);
     if (!(std::abs(det) > 1e-12)) {
         v = Vec3d(0.0);
         return false;
     }
-    v = -(d.jacobian.inverse() * d.rate);
+    v = Vec3d(a0.dot(d.rate), a1.dot(d.rate), a2.dot(d.rate)) * (-1.0 / det);
     return true;
 }
 

@@ -235,6 +235,21 @@ inline std::vector<FeaturePairSpec> randomPairs(std::mt19937& random, int n, dou
     return pairs;
 }
 
+/// The largest entry of J and of dW/dt off the reference, relative to the reference's largest.
+inline double relativeError(const InverseWarp::Derivatives& a, const InverseWarp::Derivatives& b)
+{
+    double err = 0.0, size = 0.0;
+    for (int i = 0; i < 3; ++i) {
+        for (int j = 0; j < 3; ++j) {
+            err = std::max(err, std::abs(a.jacobian(i, j) - b.jacobian(i, j)));
+            size = std::max(size, std::abs(b.jacobian(i, j)));
+        }
+        err = std::max(err, std::abs(a.rate[i] - b.rate[i]));
+        size = std::max(size, std::abs(b.rate[i]));
+    }
+    return err / size;
+}
+
 /// The largest distance between a leaf's approximated points and the exact warp's, on either side,
 /// over every `stride`-th voxel.
 inline double leafError(const InverseWarp& warp, const detail::WarpLeaf& leaf, int stride)

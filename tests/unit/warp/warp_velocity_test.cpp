@@ -37,21 +37,6 @@ Differenced differenced(const std::vector<FeaturePairSpec>& pairs, const WarpSpe
     return out;
 }
 
-/// The largest entry of J and of dW/dt off the reference, relative to the reference's largest.
-double relativeError(const InverseWarp::Derivatives& a, const InverseWarp::Derivatives& b)
-{
-    double err = 0.0, size = 0.0;
-    for (int i = 0; i < 3; ++i) {
-        for (int j = 0; j < 3; ++j) {
-            err = std::max(err, std::abs(a.jacobian(i, j) - b.jacobian(i, j)));
-            size = std::max(size, std::abs(b.jacobian(i, j)));
-        }
-        err = std::max(err, std::abs(a.rate[i] - b.rate[i]));
-        size = std::max(size, std::abs(b.rate[i]));
-    }
-    return err / size;
-}
-
 Vec3d velocityAt(const InverseWarp& w, const Vec3d& p, bool source = true)
 {
     InverseWarp::Derivatives ds, dt;
