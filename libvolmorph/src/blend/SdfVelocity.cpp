@@ -6,71 +6,109 @@
 #include <openvdb/tools/Prune.h>
 #include <openvdb/tree/LeafManager.h>
 
+#include <algorithm>
+#include <cmath>
+#include <iterator>
+#include <limits>
+
 namespace volmorph::detail {
 namespace {
 
-/// One recorded field around a leaf: within the leaf read from its buffer and mask, beyond it
-/// through an accessor (most of a gradient's reads stay in the leaf).
+/// One recorded field around a leaf, dense: the leaf and two layers of each of its six face
+/// neighbours (all that a second-order one-sided difference along an axis reaches), and which of
+/// those voxels were recorded (NaN where not). Copied once per leaf from the leaves' buffers: a
+/// gradient's twelve reads are then array reads, not tree probes.
 class Field {
 public:
+    static constexpr int kPad = 2, kSide = 8 + 2 * kPad;
+
     Field(const openvdb::FloatTree& tree, const openvdb::Coord& origin)
-        : mAccessor(tree), mLeaf(tree.probeConstLeaf(origin)), mOrigin(origin)
     {
-        if (mLeaf) mValues = mLeaf->buffer().data();
+        std::fill(std::begin(mValues), std::end(mValues), kUnknown);
+        copy(tree.probeConstLeaf(origin), openvdb::Coord(0), 0, 8);
+        for (int axis = 0; axis < 3; ++axis)
+            for (const int side : {-1, 1}) {
+                openvdb::Coord step(0);
+                step[axis] = side * 8;
+                // The two layers of the neighbour next to this leaf: its local 0..1 or 6..7.
+                const int first = side > 0 ? 0 : 6;
+                copy(tree.probeConstLeaf(origin + step), step, axis, first);
+            }
     }
 
     /// The value at voxel n of the leaf (recorded there).
-    float at(openvdb::Index n) const { return mValues[n]; }
+    float at(openvdb::Index n) const { return mValues[index(n)]; }
 
-    /// The value at ijk; false where nothing was recorded.
-    bool probe(const openvdb::Coord& ijk, float& value) const
+    /// The value at index i of the dense block (index()); false where nothing was recorded.
+    bool probe(int i, float& value) const
     {
-        const openvdb::Coord l = ijk - mOrigin;
-        if (mLeaf && unsigned(l.x()) < 8u && unsigned(l.y()) < 8u && unsigned(l.z()) < 8u) {
-            const openvdb::Index n = openvdb::Index((l.x() << 6) | (l.y() << 3) | l.z());
-            value = mValues[n];
-            return mLeaf->getValueMask().isOn(n);
-        }
-        return mAccessor.probeValue(ijk, value);
+        value = mValues[i];
+        return !std::isnan(value);
     }
 
+    /// The dense block's index of the leaf's local (x, y, z), each in -2..9.
+    static int index(int x, int y, int z)
+    {
+        return ((x + kPad) * kSide + (y + kPad)) * kSide + (z + kPad);
+    }
+    static int index(openvdb::Index n) { return index(int(n >> 6), int((n >> 3) & 7), int(n & 7)); }
+
 private:
-    mutable openvdb::tree::ValueAccessor<const openvdb::FloatTree> mAccessor;
-    const openvdb::FloatTree::LeafNodeType* mLeaf;
-    const float* mValues = nullptr;
-    openvdb::Coord mOrigin;
+    /// Copies `leaf` (at `offset` from this leaf, in voxels) into the dense block: all of it when
+    /// `first` is 0 and 8 voxels are wanted, else the two layers from `first` along `axis`.
+    void copy(const openvdb::FloatTree::LeafNodeType* leaf, const openvdb::Coord& offset, int axis,
+              int first)
+    {
+        if (!leaf) return;
+        const float* values = leaf->buffer().data();
+        const auto& mask = leaf->getValueMask();
+        int lo[3] = {0, 0, 0}, hi[3] = {8, 8, 8};
+        if (offset != openvdb::Coord(0)) {
+            lo[axis] = first;
+            hi[axis] = first + kPad;
+        }
+        for (int x = lo[0]; x < hi[0]; ++x)
+            for (int y = lo[1]; y < hi[1]; ++y)
+                for (int z = lo[2]; z < hi[2]; ++z) {
+                    const openvdb::Index n = openvdb::Index((x << 6) | (y << 3) | z);
+                    const int i = index(x + offset.x(), y + offset.y(), z + offset.z());
+                    mValues[i] = mask.isOn(n) ? values[n] : kUnknown;
+                }
+    }
+
+    static constexpr float kUnknown = std::numeric_limits<float>::quiet_NaN(); ///< not recorded
+    float mValues[kSide * kSide * kSide];
 };
 
 /// Where |grad phi| falls below this fraction of a distance's gradient, the normal is undefined.
 constexpr float kMinGradient = 0.25f;
 
-/// The derivative of the recorded field along `axis` at ijk (per index unit): central where both
-/// neighbours were recorded, else one-sided (second order when two voxels on that side were, first
-/// order when one was). False when neither neighbour was.
-bool derivative(const Field& a, const openvdb::Coord& ijk, float centre, int axis, float& out)
+/// The derivative of the recorded field along an axis at the dense block's index i, `step` apart
+/// along the axis (per index unit): central where both neighbours were recorded, else one-sided
+/// (second order when two voxels on that side were, first order when one was). False when
+/// neither neighbour was.
+inline bool derivative(const Field& a, int i, int step, float centre, float& out)
 {
-    openvdb::Coord step(0);
-    step[axis] = 1;
     float p1 = 0.0f, m1 = 0.0f, p2 = 0.0f, m2 = 0.0f;
-    const bool hasP1 = a.probe(ijk + step, p1), hasM1 = a.probe(ijk - step, m1);
+    const bool hasP1 = a.probe(i + step, p1), hasM1 = a.probe(i - step, m1);
     if (hasP1 && hasM1) {
         out = 0.5f * (p1 - m1);
     } else if (hasP1) {
-        out =
-            a.probe(ijk + step + step, p2) ? 0.5f * (-3.0f * centre + 4.0f * p1 - p2) : p1 - centre;
+        out = a.probe(i + 2 * step, p2) ? 0.5f * (-3.0f * centre + 4.0f * p1 - p2) : p1 - centre;
     } else if (hasM1) {
-        out =
-            a.probe(ijk - step - step, m2) ? 0.5f * (3.0f * centre - 4.0f * m1 + m2) : centre - m1;
+        out = a.probe(i - 2 * step, m2) ? 0.5f * (3.0f * centre - 4.0f * m1 + m2) : centre - m1;
     } else {
         return false;
     }
     return true;
 }
 
-bool gradient(const Field& a, const openvdb::Coord& ijk, float centre, Vec3f& out)
+/// The gradient at the leaf's voxel n.
+inline bool gradient(const Field& a, openvdb::Index n, float centre, Vec3f& out)
 {
-    return derivative(a, ijk, centre, 0, out[0]) && derivative(a, ijk, centre, 1, out[1]) &&
-           derivative(a, ijk, centre, 2, out[2]);
+    const int i = Field::index(n);
+    return derivative(a, i, Field::kSide * Field::kSide, centre, out[0]) &&
+           derivative(a, i, Field::kSide, centre, out[1]) && derivative(a, i, 1, centre, out[2]);
 }
 
 } // namespace
@@ -80,27 +118,32 @@ void SdfVelocity::leaf(const openvdb::FloatTree& source, const openvdb::FloatTre
                        VectorLeaf& correction) const
 {
     const openvdb::Coord origin = velocity.origin();
-    const Field a(source, origin), b(target, origin);
+    const auto* sourceLeaf = source.probeConstLeaf(origin);
+    const auto* targetLeaf = target.probeConstLeaf(origin);
+    if (!sourceLeaf || !targetLeaf) { // recorded together: never one without the other
+        velocity.setValueMask(openvdb::util::NodeMask<3>());
+        return;
+    }
     // The shell near the surface; the rest of what was recorded is left to the extension.
     openvdb::util::NodeMask<3> shell;
     for (auto it = on.beginOn(); it; ++it) {
-        if (std::abs((1.0f - mTau) * a.at(it.pos()) + mTau * b.at(it.pos())) < mShell)
-            shell.setOn(it.pos());
-        else
-            velocity.setValueOff(it.pos());
+        const float phi =
+            (1.0f - mTau) * sourceLeaf->getValue(it.pos()) + mTau * targetLeaf->getValue(it.pos());
+        if (std::abs(phi) < mShell) shell.setOn(it.pos());
     }
+    velocity.setValueMask(shell);
     if (shell.isOff()) return;
+    const Field a(source, origin), b(target, origin);
     Vec3f vs[512], vt[512];
     mBlend.count(mBlend.warpVelocity().fill(origin, shell, vs, vt));
     for (auto it = shell.beginOn(); it; ++it) {
         const openvdb::Index n = it.pos();
-        const openvdb::Coord ijk = origin + VectorLeaf::offsetToLocalCoord(n);
         const float da = a.at(n), db = b.at(n);
         const float wa = (1.0f - mTau) * fogRamp(da, mRamp), wb = mTau * fogRamp(db, mRamp);
         const Vec3f warp = wa + wb > 0.0f ? (wa * vs[n] + wb * vt[n]) / (wa + wb)
                                           : (1.0f - mTau) * vs[n] + mTau * vt[n];
         Vec3f fix(0.0f), ga, gb;
-        if (gradient(a, ijk, da, ga) && gradient(b, ijk, db, gb)) {
+        if (gradient(a, n, da, ga) && gradient(b, n, db, gb)) {
             const Vec3f normal = (1.0f - mTau) * ga + mTau * gb;
             const float length2 = normal.lengthSqr();
             const float floor = kMinGradient * std::max(ga.length(), gb.length());
@@ -110,8 +153,8 @@ void SdfVelocity::leaf(const openvdb::FloatTree& source, const openvdb::FloatTre
                 fix = ((-rate - warp.dot(normal)) / length2) * normal;
             }
         }
-        velocity.setValueOn(n, (warp + fix) * mScale);
-        correction.setValueOn(n, fix);
+        velocity.setValueOnly(n, (warp + fix) * mScale);
+        correction.setValueOnly(n, fix); // make() copies the velocity's mask
     }
 }
 

@@ -87,22 +87,18 @@ struct Sums {
     }
 };
 
-} // namespace
+/// One group's pairs at a point: the weights and their gradients and rates, and the frame
+/// coordinates and their rates (WarpDerivatives.cpp's names), a lane per pair.
+struct PairTerms {
+    v8f w, wRate, gw[3], q[3], qRate[3];
+    v8i tooNear; ///< live lanes whose d + offset is under the kernel's `near`
 
-VOLMORPH_ALWAYS_INLINE inline bool VelocityKernel::sumsBody(const Vec3d& x,
-                                                            InverseWarp::Derivatives d[2]) const
-{
-    using G = Group;
-    const v8f zero = splat8(0.0f), one = splat8(1.0f);
-    const float offset = float(mWarp.weightOffset()), exponent = float(mWarp.weightExponent());
-    const float near = float(std::max(mExactWithin, InverseWarp::kOnElement));
-    const bool inverseSquare = mWarp.weighting() == Weighting::InverseSquare;
-    const float y[3] = {float(x.x() - mReference.x()), float(x.y() - mReference.y()),
-                        float(x.z() - mReference.z())};
-    Sums sums;
-    v8i tooNear = v8i{};
-    for (size_t gi = 0; gi < mGroups.size(); ++gi) {
-        const G& g = mGroups[gi];
+    /// y: the point relative to the kernel's reference; firstPair: the group's first pair.
+    VOLMORPH_ALWAYS_INLINE PairTerms(const VelocityKernel::Group& g, const float y[3],
+                                     const InverseWarp& warp, size_t firstPair, float near)
+    {
+        using G = VelocityKernel::Group;
+        const v8f zero = splat8(0.0f), one = splat8(1.0f);
         auto col = [&g](int c) { return load8(g.v[c]); };
         const v8f dx[3] = {y[0] - col(G::Origin), y[1] - col(G::Origin + 1),
                            y[2] - col(G::Origin + 2)};
@@ -111,7 +107,7 @@ VOLMORPH_ALWAYS_INLINE inline bool VelocityKernel::sumsBody(const Vec3d& x,
         const v8f u[3] = {dx[1] * om[2] - dx[2] * om[1] - col(G::OriginRate),
                           dx[2] * om[0] - dx[0] * om[2] - col(G::OriginRate + 1),
                           dx[0] * om[1] - dx[1] * om[0] - col(G::OriginRate + 2)};
-        v8f q[3], qRate[3], off[3], d2 = zero;
+        v8f off[3], d2 = zero;
         for (int k = 0; k < 3; ++k) {
             const v8f a0 = col(G::Axis + 3 * k), a1 = col(G::Axis + 3 * k + 1),
                       a2 = col(G::Axis + 3 * k + 2);
@@ -121,9 +117,9 @@ VOLMORPH_ALWAYS_INLINE inline bool VelocityKernel::sumsBody(const Vec3d& x,
             off[k] = q[k] - vmin(vmax(q[k], -h), h);
             d2 += off[k] * off[k];
         }
-        const v8f dist = vsqrt(d2), r = dist + offset;
+        const v8f dist = vsqrt(d2), r = dist + float(warp.weightOffset());
         const v8i live = col(G::Live) != zero;
-        tooNear |= live & (r < near);
+        tooNear = live & (r < near);
         const v8f invD = dist > zero ? one / (dist > zero ? dist : one) : zero;
         const v8f invR = one / (live ? r : one);
         v8f dRate = zero, gn[3];
@@ -131,21 +127,27 @@ VOLMORPH_ALWAYS_INLINE inline bool VelocityKernel::sumsBody(const Vec3d& x,
             gn[k] = off[k] * invD; // the distance's gradient in the frame
             dRate += gn[k] * qRate[k] - vabs(gn[k]) * col(G::HalfRate + k);
         }
-        v8f w;
-        if (inverseSquare) {
+        if (warp.weighting() == Weighting::InverseSquare) {
             w = invR * invR;
         } else {
             for (int l = 0; l < 8; ++l)
                 w[l] = float(
-                    mWarp.weightAt(std::min(8 * gi + l, mWarp.pairCount() - 1), double(dist[l])));
+                    warp.weightAt(std::min(firstPair + l, warp.pairCount() - 1), double(dist[l])));
         }
         w = live ? w : zero;
-        const v8f dwdd = -exponent * w * invR;
-        const v8f wRate = dwdd * dRate + w * col(G::LengthRate);
-        v8f gw[3]; // grad w_i, world axes
-        for (int a = 0; a < 3; ++a)
+        const v8f dwdd = -float(warp.weightExponent()) * w * invR;
+        wRate = dwdd * dRate + w * col(G::LengthRate);
+        for (int a = 0; a < 3; ++a) // grad w_i, world axes
             gw[a] = dwdd * (col(G::Axis + a) * gn[0] + col(G::Axis + 3 + a) * gn[1] +
                             col(G::Axis + 6 + a) * gn[2]);
+    }
+
+    /// Adds the group's terms to `sums`: both sides' maps at y.
+    VOLMORPH_ALWAYS_INLINE void addTo(Sums& sums, const VelocityKernel::Group& g,
+                                      const float y[3]) const
+    {
+        using G = VelocityKernel::Group;
+        auto col = [&g](int c) { return load8(g.v[c]); };
         sums.add(Sums::W, w);
         sums.add(Sums::Q, wRate);
         for (int a = 0; a < 3; ++a) sums.add(Sums::Grad + a, gw[a]);
@@ -167,8 +169,12 @@ VOLMORPH_ALWAYS_INLINE inline bool VelocityKernel::sumsBody(const Vec3d& x,
         }
         sums.first = false;
     }
-    for (int l = 0; l < 8; ++l)
-        if (tooNear[l]) return false;
+};
+
+/// Both sides' derivatives from the sums' totals (the header's quotient rule); false without a
+/// finite positive weight.
+VOLMORPH_ALWAYS_INLINE inline bool quotientRule(const Sums& sums, InverseWarp::Derivatives d[2])
+{
     float total[Sums::Count];
     sums.totals(total);
     const double sumW = total[Sums::W];
@@ -185,6 +191,24 @@ VOLMORPH_ALWAYS_INLINE inline bool VelocityKernel::sumsBody(const Vec3d& x,
         }
     }
     return true;
+}
+
+} // namespace
+
+VOLMORPH_ALWAYS_INLINE inline bool VelocityKernel::sumsBody(const Vec3d& x,
+                                                            InverseWarp::Derivatives d[2]) const
+{
+    const float near = float(std::max(mExactWithin, InverseWarp::kOnElement));
+    const float y[3] = {float(x.x() - mReference.x()), float(x.y() - mReference.y()),
+                        float(x.z() - mReference.z())};
+    Sums sums;
+    for (size_t gi = 0; gi < mGroups.size(); ++gi) {
+        const PairTerms terms(mGroups[gi], y, mWarp, 8 * gi, near);
+        for (int l = 0; l < 8; ++l)
+            if (terms.tooNear[l]) return false;
+        terms.addTo(sums, mGroups[gi], y);
+    }
+    return quotientRule(sums, d);
 }
 
 #ifdef VOLMORPH_HAVE_AVX2_KERNEL
