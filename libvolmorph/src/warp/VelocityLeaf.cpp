@@ -1,6 +1,7 @@
 #include "warp/VelocityLeaf.h"
 
 #include <algorithm>
+#include <vector>
 
 namespace volmorph::detail {
 
@@ -90,26 +91,57 @@ openvdb::Coord checkPoint(int c)
     return openvdb::Coord((c >> 2) ? 6 : 2, ((c >> 1) & 1) ? 6 : 2, (c & 1) ? 6 : 2);
 }
 
-} // namespace
-
-bool VelocityLeaf::exact(const Vec3d& p, Vec3d& source, Vec3d& target) const
+/// The lattice's points (i, j, k in 0..2): its 8 corners, or the 19 others.
+std::vector<openvdb::Coord> latticePoints(bool middles)
 {
-    InverseWarp::Derivatives ds, dt;
-    mKernel.derivatives(p, ds, dt);
-    const bool s = InverseWarp::velocity(ds, source);
-    const bool t = InverseWarp::velocity(dt, target);
-    return s && t;
+    std::vector<openvdb::Coord> out;
+    for (int i = 0; i < 3; ++i)
+        for (int j = 0; j < 3; ++j)
+            for (int k = 0; k < 3; ++k)
+                if ((i == 1 || j == 1 || k == 1) == middles) out.emplace_back(i, j, k);
+    return out;
 }
+
+/// Points whose exact velocities are taken together: one call of the kernel (8 points to a vector).
+struct Batch {
+    static constexpr int kCapacity = 64;
+    Vec3d p[kCapacity];
+    Vec3d v[2][kCapacity]; ///< both sides' velocities
+    bool ok[kCapacity];    ///< false where J is singular (a fold: the velocity is 0)
+    int n = 0;
+
+    /// Adds point p; returns its index.
+    int add(const Vec3d& point)
+    {
+        p[n] = point;
+        return n++;
+    }
+    /// Evaluates the points; false if any lies on a fold.
+    bool run(const VelocityKernel& kernel)
+    {
+        kernel.velocities(p, size_t(n), v[0], v[1], ok);
+        return std::all_of(ok, ok + n, [](bool b) { return b; });
+    }
+};
+
+} // namespace
 
 void VelocityLeaf::fillExact(const openvdb::Coord& origin, const openvdb::util::NodeMask<3>& on,
                              Vec3f source[512], Vec3f target[512]) const
 {
-    for (auto it = on.beginOn(); it; ++it) {
-        const openvdb::Index n = it.pos();
-        Vec3d s, t;
-        exact(at(origin, int(n >> 6), int((n >> 3) & 7), int(n & 7)), s, t);
-        source[n] = Vec3f(s);
-        target[n] = Vec3f(t);
+    auto it = on.beginOn();
+    while (it) {
+        Batch batch;
+        openvdb::Index voxels[Batch::kCapacity];
+        for (; it && batch.n < Batch::kCapacity; ++it) {
+            const openvdb::Index n = it.pos();
+            voxels[batch.add(at(origin, int(n >> 6), int((n >> 3) & 7), int(n & 7)))] = n;
+        }
+        batch.run(mKernel);
+        for (int i = 0; i < batch.n; ++i) {
+            source[voxels[i]] = Vec3f(batch.v[0][i]);
+            target[voxels[i]] = Vec3f(batch.v[1][i]);
+        }
     }
 }
 
@@ -118,19 +150,33 @@ void VelocityLeaf::refine(const openvdb::Coord& origin, int c, double speed, con
                           Vec3f target[512]) const
 {
     const int ox = (c >> 2) * 4, oy = ((c >> 1) & 1) * 4, oz = (c & 1) * 4;
+    // The 19 new lattice points and the 8 cells' centres, in one batch.
+    Batch batch;
+    int index[3][3][3];
+    for (int i = 0; i < 3; ++i)
+        for (int j = 0; j < 3; ++j)
+            for (int k = 0; k < 3; ++k)
+                if (i == 1 || j == 1 || k == 1)
+                    index[i][j][k] = batch.add(at(origin, ox + 2 * i, oy + 2 * j, oz + 2 * k));
+    const int firstCheck = batch.n;
+    for (int q = 0; q < 8; ++q)
+        batch.add(
+            at(origin, ox + 2 * (q >> 2) + 1, oy + 2 * ((q >> 1) & 1) + 1, oz + 2 * (q & 1) + 1));
+    batch.run(mKernel);
     Vec3d fine[2][3][3][3];
     for (int i = 0; i < 3; ++i)
         for (int j = 0; j < 3; ++j)
-            for (int k = 0; k < 3; ++k) {
-                if (i != 1 && j != 1 && k != 1) { // a point of the coarse lattice
-                    for (int s = 0; s < 2; ++s)
+            for (int k = 0; k < 3; ++k)
+                for (int s = 0; s < 2; ++s) {
+                    if (i != 1 && j != 1 && k != 1) { // a point of the coarse lattice
                         fine[s][i][j][k] =
                             coarse.v[s][ox / 4 + i / 2][oy / 4 + j / 2][oz / 4 + k / 2];
-                } else if (!exact(at(origin, ox + 2 * i, oy + 2 * j, oz + 2 * k), fine[0][i][j][k],
-                                  fine[1][i][j][k])) {
-                    return fillExact(origin, on, source, target); // a fold
+                    } else if (!batch.ok[index[i][j][k]]) {
+                        return fillExact(origin, on, source, target); // a fold
+                    } else {
+                        fine[s][i][j][k] = batch.v[s][index[i][j][k]];
+                    }
                 }
-            }
     // The trilinear interpolant of side s in fine cell `cell` at fractions f.
     auto interpolate = [&fine](int s, const int cell[3], const double f[3]) {
         Vec3d v(0.0);
@@ -147,12 +193,10 @@ void VelocityLeaf::refine(const openvdb::Coord& origin, int c, double speed, con
     for (int q = 0; q < 8; ++q) {
         const int cell[3] = {q >> 2, (q >> 1) & 1, q & 1};
         const double half[3] = {0.5, 0.5, 0.5};
-        Vec3d e[2];
-        passed[q] =
-            exact(at(origin, ox + 2 * cell[0] + 1, oy + 2 * cell[1] + 1, oz + 2 * cell[2] + 1),
-                  e[0], e[1]);
+        passed[q] = batch.ok[firstCheck + q];
         for (int s = 0; s < 2 && passed[q]; ++s)
-            passed[q] = (interpolate(s, cell, half) - e[s]).length() <= mTolerance * speed;
+            passed[q] = (interpolate(s, cell, half) - batch.v[s][firstCheck + q]).length() <=
+                        mTolerance * speed;
     }
     openvdb::util::NodeMask<3> rest;
     for (auto it = on.beginOn(); it; ++it) {
@@ -208,24 +252,38 @@ int VelocityLeaf::fill(const openvdb::Coord& origin, const openvdb::util::NodeMa
     }
     Lattice lattice;
     double speed = 0.0;
-    auto evaluate = [&](int i, int j, int k) {
-        Vec3d& s = lattice.v[0][i][j][k];
-        Vec3d& t = lattice.v[1][i][j][k];
-        const bool ok = exact(at(origin, 4 * i, 4 * j, 4 * k), s, t);
-        speed = std::max({speed, s.length(), t.length()});
-        return ok;
+    // Evaluates the lattice points (i, j, k) `points` in `batch` with the points it holds; false
+    // at a fold.
+    auto evaluate = [&](const std::vector<openvdb::Coord>& points, Batch& batch) {
+        const int base = batch.n;
+        for (const openvdb::Coord& l : points)
+            batch.add(at(origin, 4 * l.x(), 4 * l.y(), 4 * l.z()));
+        if (!batch.run(mKernel)) return false;
+        for (size_t i = 0; i < points.size(); ++i) {
+            const openvdb::Coord& l = points[i];
+            for (int s = 0; s < 2; ++s) {
+                const Vec3d& v = batch.v[s][base + int(i)];
+                lattice.v[s][l.x()][l.y()][l.z()] = v;
+                speed = std::max(speed, v.length());
+            }
+        }
+        return true;
     };
-    bool regular = true;
-    for (int c = 0; c < 8; ++c) regular &= evaluate((c >> 2) * 2, ((c >> 1) & 1) * 2, (c & 1) * 2);
-    Vec3d checks[2][8];
+    // The 8 checks and the corners, then if needed the other 19 points.
+    static const std::vector<openvdb::Coord> corners = latticePoints(false),
+                                             middles = latticePoints(true);
+    Batch first;
     for (int c = 0; c < 8; ++c) {
         const openvdb::Coord p = checkPoint(c);
-        regular &= exact(at(origin, p.x(), p.y(), p.z()), checks[0][c], checks[1][c]);
+        first.add(at(origin, p.x(), p.y(), p.z()));
     }
-    if (!regular) { // a fold of the warp: no interpolation across it
+    if (!evaluate(corners, first)) { // a fold of the warp: no interpolation across it
         fillExact(origin, on, source, target);
         return 0;
     }
+    Vec3d checks[2][8];
+    for (int c = 0; c < 8; ++c)
+        for (int s = 0; s < 2; ++s) checks[s][c] = first.v[s][c];
     // Each sub-cube passes when the interpolant at its centre is within the tolerance of both
     // sides' exact velocities there (relative to the largest speed met on the lattice).
     bool passed[8];
@@ -247,13 +305,11 @@ int VelocityLeaf::fill(const openvdb::Coord& origin, const openvdb::util::NodeMa
     lattice.fillFromCorners();
     int passing = check();
     if (passing < 8) {
-        for (int i = 0; i < 3; ++i)
-            for (int j = 0; j < 3; ++j)
-                for (int k = 0; k < 3; ++k)
-                    if ((i == 1 || j == 1 || k == 1) && !evaluate(i, j, k)) {
-                        fillExact(origin, on, source, target);
-                        return 0;
-                    }
+        Batch rest;
+        if (!evaluate(middles, rest)) {
+            fillExact(origin, on, source, target);
+            return 0;
+        }
         passing = check();
     }
     if (passing > 0) {

@@ -49,8 +49,6 @@ public:
              Vec3f target[512]) const;
 
 private:
-    /// Exact velocities of both sides at p (index space); false at a fold.
-    bool exact(const Vec3d& p, Vec3d& source, Vec3d& target) const;
     void fillExact(const openvdb::Coord& origin, const openvdb::util::NodeMask<3>& on,
                    Vec3f source[512], Vec3f target[512]) const;
     /// The voxels `on` of the sub-cubes that did not pass (`miss`: their checks' errors in
