@@ -1,5 +1,5 @@
 // The velocity of the material each side shows at the voxels of one output leaf: v = -J^-1 dW/dt
-// of the exact warp (InverseWarp::derivatives, over the pairs' columns: warp/VelocityKernel.h), in
+// of the exact warp (InverseWarp::derivatives, 8 points to a vector: warp/VelocityKernel.h), in
 // index units per unit of t.
 //
 // Evaluating it at every voxel costs O(pairs) per voxel. Velocity is smooth wherever the warp is
