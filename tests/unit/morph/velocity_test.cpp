@@ -4,7 +4,8 @@
 // derivative at random voxels of a 16-pair warp.
 #include "support/WarpFixtures.h"
 
-#include "warp/VelocityLeaf.h" // private to the library; tested directly
+#include "blend/VelocityBlend.h" // private to the library; tested directly
+#include "warp/VelocityLeaf.h"
 
 using namespace volmorph;
 using namespace volmorph::test;
@@ -160,4 +161,19 @@ TEST(Velocity, InterpolatedLeavesMatchTheExactDerivative)
     for (const auto& [got, exact] : samples)
         if ((got - exact).length() > 0.01 * exact.length() + 1e-3 * fastest) ++bad;
     EXPECT_EQ(bad, 0) << "of " << samples.size() << "; sub-cubes interpolated: " << interpolated;
+}
+
+TEST(Velocity, AFewSpikesDoNotSetTheReach)
+{
+    // 300 leaves moving at 1 unit per second and 2 where the speed spikes to 500 (a fold, a surface
+    // splitting): the reach is made for 1. When a tenth of the leaves move at 2, for 2.
+    openvdb::Vec3SGrid grid(Vec3f(0.0f));
+    for (int i = 0; i < 302; ++i)
+        grid.tree().setValueOn(openvdb::Coord(8 * i, 0, 0), Vec3f(i < 300 ? 1.0f : 500.0f, 0, 0));
+    EXPECT_FLOAT_EQ(float(detail::VelocityBlend::reachSpeed(grid)), 1.0f);
+    for (int i = 270; i < 302; ++i)
+        grid.tree().setValueOn(openvdb::Coord(8 * i, 1, 0), Vec3f(0, 2, 0));
+    for (int i = 300; i < 302; ++i) grid.tree().setValueOff(openvdb::Coord(8 * i, 0, 0));
+    EXPECT_FLOAT_EQ(float(detail::VelocityBlend::reachSpeed(grid)), 2.0f);
+    EXPECT_EQ(detail::VelocityBlend::reachSpeed(openvdb::Vec3SGrid(Vec3f(0.0f))), 0.0);
 }
