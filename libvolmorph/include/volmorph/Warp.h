@@ -68,9 +68,9 @@ public:
     Affine targetAffine(size_t i) const;
 
     /// How pair i's interpolated element moves per unit t, for the velocity's vector kernel
-    /// (derivatives() written over the pairs' columns): its origin and scales change linearly and
-    /// its frame turns at omega; the maps from frame coordinates q take each side to
-    /// origin + sum_k to[k] q_k; the weight's own rate (Beier-Neely's length term) is
+    /// (derivatives() and velocity() written for 8 points at a time): its origin and scales
+    /// change linearly and its frame turns at omega; the maps from frame coordinates q take each
+    /// side to origin + sum_k to[k] q_k; the weight's own rate (Beier-Neely's length term) is
     /// lengthWeightRate times the weight.
     struct Motion {
         Vec3d originRate, scaleRate, omega;
