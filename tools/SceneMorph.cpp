@@ -34,8 +34,10 @@ void SceneMorph::load(int frame)
     mMorpher.reset();
     SceneVolumes volumes =
         loadSceneVolumes(scene, mCache, mInterrupter, mOptions.memoryLimitBytes, mQuiet);
+    MorphOptions options = mOptions;
+    options.setupInterrupter = &mInterrupter;
     mMorpher.emplace(std::move(volumes.source), std::move(volumes.target), scene.pairs, scene.warp,
-                     scene.blend, mOptions);
+                     scene.blend, options);
     mLoaded = inputs;
 }
 

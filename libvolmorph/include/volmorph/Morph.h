@@ -37,6 +37,9 @@ struct MorphOptions {
     /// frame (the shutter's reach), with the warp's own velocity there: Eulerian motion blur reads
     /// the velocity where the density is about to arrive.
     double velocityReachSeconds = 0.0;
+    /// Stops the one-time setup of the blend (sdf mode's extended distances) when it asks to,
+    /// with volmorph::Interrupted; null: never stops. Frames take their own.
+    Interrupter* setupInterrupter = nullptr;
 };
 
 /// What one kept output leaf costs while a frame is made: density, colour and, in sdf mode, the

@@ -29,9 +29,10 @@ struct BlendSetup {
     const VolumeSet& target;
     const BlendSpec& spec;
     Interpolation interpolation = Interpolation::Trilinear;
-    size_t pairCount = 0;          ///< no pairs: the warp is the identity at every t
-    openvdb::CoordBBox candidates; ///< the domain at t = 0 (index space), for kept values
-    uint64_t memoryLimitBytes = 0; ///< resolved (never 0)
+    size_t pairCount = 0;               ///< no pairs: the warp is the identity at every t
+    openvdb::CoordBBox candidates;      ///< the domain at t = 0 (index space), for kept values
+    uint64_t memoryLimitBytes = 0;      ///< resolved (never 0)
+    Interrupter* interrupter = nullptr; ///< stops the method's one-time work (null: never)
 };
 
 /// One frame's request.

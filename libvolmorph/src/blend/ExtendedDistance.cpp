@@ -11,6 +11,7 @@
 #include <tbb/parallel_for.h>
 #include <tbb/parallel_reduce.h>
 
+#include <atomic>
 #include <memory>
 #include <stdexcept>
 #include <utility>
@@ -142,11 +143,15 @@ private:
 
 } // namespace
 
-ExtendedDistance::ExtendedDistance(openvdb::FloatGrid::ConstPtr band, const CoordBBox& box)
+ExtendedDistance::ExtendedDistance(openvdb::FloatGrid::ConstPtr band, const CoordBBox& box,
+                                   Interrupter* interrupter)
     : mBand(std::move(band))
 {
     mVoxel = float(mBand->voxelSize()[0]);
     if (box.empty()) return;
+    const auto check = [interrupter] {
+        if (interrupter && interrupter->wasInterrupted()) throw Interrupted();
+    };
     // The shell: the seeds' band dilated by kShellCells lattice cells, every way.
     const openvdb::FloatGrid::Ptr shell =
         openvdb::tools::dilateSdf(*shellSeeds(), kShellCells, openvdb::tools::NN_FACE_EDGE_VERTEX);
@@ -156,13 +161,16 @@ ExtendedDistance::ExtendedDistance(openvdb::FloatGrid::ConstPtr band, const Coor
     // Beyond the shell, +/- a value no read takes for a distance (see Reader::extended).
     openvdb::tools::signedFloodFill(shell->tree());
     openvdb::tools::changeLevelSetBackground(shell->tree(), 1.0e6f * mVoxel);
-    toSurfacePoints(shell->tree());
+    check();
+    toSurfacePoints(shell->tree(), interrupter);
+    check();
     const CoordBBox far(
         Coord(floorDiv(box.min().x(), kFarSpacing), floorDiv(box.min().y(), kFarSpacing),
               floorDiv(box.min().z(), kFarSpacing)),
         Coord(floorDiv(box.max().x(), kFarSpacing) + 1, floorDiv(box.max().y(), kFarSpacing) + 1,
               floorDiv(box.max().z(), kFarSpacing) + 1));
     const openvdb::FloatGrid::Ptr seeds = farSeeds(far, shell->tree());
+    check();
     openvdb::BoolGrid mask(false);
     mask.setTransform(seeds->transform().copy());
     mask.sparseFill(far, true, true);
@@ -176,10 +184,13 @@ ExtendedDistance::ExtendedDistance(openvdb::FloatGrid::ConstPtr band, const Coor
     // instead (tools::sdfToExt): each point of the lattice's zero crossing projected onto the
     // band's zero set, p - phi grad phi. A carried point is smeared sideways along the surface,
     // which changes |x - point| only to second order.
+    check();
     const FootPoint foot(mBand, kFarSpacing);
     const openvdb::Vec3SGrid::Ptr feet =
         openvdb::tools::sdfToExt(*wide, foot, openvdb::Vec3s(kNoFoot), 0.0f);
+    check();
     makeDense(*wide, *feet, shell->tree(), far);
+    check();
     makeBlocks(shell->tree());
     measureErrors();
 }
@@ -206,7 +217,7 @@ openvdb::FloatGrid::Ptr ExtendedDistance::shellSeeds() const
     return seeds;
 }
 
-void ExtendedDistance::toSurfacePoints(openvdb::FloatTree& shell) const
+void ExtendedDistance::toSurfacePoints(openvdb::FloatTree& shell, Interrupter* interrupter) const
 {
     // Each lattice point steps along the swept field's gradient to near the surface, then onto
     // the band's zero set; its distance to that point replaces the swept one (first order,
@@ -214,7 +225,12 @@ void ExtendedDistance::toSurfacePoints(openvdb::FloatTree& shell) const
     // gradient, and a point a little off sideways changes the distance only to second order.
     const FootPoint prototype(mBand, 1.0);
     openvdb::tree::LeafManager<openvdb::FloatTree> leaves(shell, 1);
+    std::atomic<bool> stopped{false};
     leaves.foreach ([&](openvdb::FloatTree::LeafNodeType& leaf, size_t i) {
+        if (stopped || (interrupter && (i & 63) == 0 && interrupter->wasInterrupted())) {
+            stopped = true;
+            return;
+        }
         const FootPoint surface(prototype); // its own accessor
         float* out = leaves.getBuffer(i, 1).data();
         openvdb::tree::ValueAccessor<const openvdb::FloatTree, false> acc(shell);
@@ -225,6 +241,7 @@ void ExtendedDistance::toSurfacePoints(openvdb::FloatTree& shell) const
             if (near) out[it.pos()] = std::copysign(float((p - foot).length()) * mVoxel, *it);
         }
     });
+    if (stopped) throw Interrupted();
     leaves.swapLeafBuffer(1);
 }
 

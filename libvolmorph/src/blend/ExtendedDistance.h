@@ -27,6 +27,8 @@
 
 #include "blend/Sample.h"
 
+#include <volmorph/core/Interrupter.h>
+
 #include <openvdb/openvdb.h>
 
 #include <algorithm>
@@ -46,8 +48,10 @@ public:
     static constexpr float kNear = 2.0f, kFar = 2.9f;              // voxels
 
     /// `band`: a level set; `box`: where to extend it (its index space). An empty box extends
-    /// nothing: reads are the band's.
-    ExtendedDistance(openvdb::FloatGrid::ConstPtr band, const openvdb::CoordBBox& box);
+    /// nothing: reads are the band's. `interrupter`: asked between the steps and within
+    /// volmorph's own loops (OpenVDB 10's fast sweeping takes none), throws Interrupted.
+    ExtendedDistance(openvdb::FloatGrid::ConstPtr band, const openvdb::CoordBBox& box,
+                     Interrupter* interrupter = nullptr);
 
     /// The largest difference between the extended field and the band where the extended field
     /// is used, voxels.
@@ -163,7 +167,7 @@ private:
                    : mBlocks.data() + size_t(it->second) * kApron * kApron * kApron;
     }
     /// The shell's swept distances replaced by distances to surface points (see the .cpp).
-    void toSurfacePoints(openvdb::FloatTree& shell) const;
+    void toSurfacePoints(openvdb::FloatTree& shell, Interrupter* interrupter) const;
     /// The shell's blocks, from its tree.
     void makeBlocks(const openvdb::FloatTree& shell);
 

@@ -52,8 +52,14 @@ public:
         const CoordBBox box = extensionBox(mSource, mTarget, setup.pairCount);
         // Both at once: fast sweeping is partly serial.
         tbb::parallel_invoke(
-            [&] { mFarSource = std::make_unique<const ExtendedDistance>(mSource.sdf, box); },
-            [&] { mFarTarget = std::make_unique<const ExtendedDistance>(mTarget.sdf, box); });
+            [&] {
+                mFarSource =
+                    std::make_unique<const ExtendedDistance>(mSource.sdf, box, setup.interrupter);
+            },
+            [&] {
+                mFarTarget =
+                    std::make_unique<const ExtendedDistance>(mTarget.sdf, box, setup.interrupter);
+            });
         if (setup.pairCount == 0)
             mIdentity = std::make_unique<IdentityDistances>(
                 setup.candidates,

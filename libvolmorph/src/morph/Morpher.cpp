@@ -103,7 +103,8 @@ Morpher::Morpher(VolumeSet source, VolumeSet target, std::vector<FeaturePairSpec
                                        : detail::Interpolation::Trilinear,
                                    mPairs.size(),
                                    mPairs.empty() ? candidateBounds(0.0) : CoordBBox(),
-                                   mOptions.memoryLimitBytes};
+                                   mOptions.memoryLimitBytes,
+                                   mOptions.setupInterrupter};
     mMethod = detail::makeBlendMethod(setup);
 }
 

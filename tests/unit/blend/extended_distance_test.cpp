@@ -71,3 +71,16 @@ TEST(ExtendedDistance, NoStepWhereTheFarLatticeTakesOver)
         }
     }
 }
+
+TEST(ExtendedDistance, StopsWhenAsked)
+{
+    // SIGINT's path: the interrupter asked to stop before the work, and the work throws
+    // Interrupted instead of finishing (the command then exits with status 130).
+    const auto band = openvdb::tools::createLevelSetSphere<openvdb::FloatGrid>(
+        float(kRadius), openvdb::Vec3f(0.0f), float(kVoxel), 3.0f);
+    volmorph::Interrupter stop;
+    stop.requestStop();
+    EXPECT_THROW(ExtendedDistance(
+                     band, openvdb::CoordBBox(openvdb::Coord(-150), openvdb::Coord(150)), &stop),
+                 volmorph::Interrupted);
+}
