@@ -1,5 +1,6 @@
 #include "blend/ExtendedDistance.h"
 
+#include <openvdb/math/Stencils.h>
 #include <openvdb/tools/ChangeBackground.h>
 #include <openvdb/tools/FastSweeping.h>
 #include <openvdb/tree/LeafManager.h>
@@ -44,7 +45,7 @@ openvdb::FloatGrid::Ptr lattice(float background, double spacing)
 class FootPoint {
 public:
     FootPoint(const openvdb::FloatGrid::ConstPtr& band, double scale)
-        : mBand(band), mAcc(band->tree()), mVoxel(band->voxelSize()[0]), mScale(scale)
+        : mBand(band), mStencil(*band), mVoxel(band->voxelSize()[0]), mScale(scale)
     {
     }
     FootPoint(const FootPoint& o) : FootPoint(o.mBand, o.mScale) {}
@@ -88,30 +89,15 @@ public:
 
 private:
     /// The band's step from p, `near` when p lies well inside the band. The value and gradient
-    /// are the trilinear cell's around p: p lies within a voxel or two of the surface by now, so
-    /// the gradient's first-order error moves the point sideways by a fraction of that, which
-    /// changes a distance only to second order.
+    /// are the trilinear cell's around p (math::BoxStencil): p lies within a voxel or two of the
+    /// surface by now, so the gradient's first-order error moves the point sideways by a fraction
+    /// of that, which changes a distance only to second order.
     openvdb::Vec3d onBand(const openvdb::Vec3d& p, bool& near) const
     {
-        const openvdb::Coord c = openvdb::Coord::floor(p);
-        const openvdb::Vec3d f = p - c.asVec3d();
-        double v[2][2][2];
-        for (int i = 0; i < 2; ++i)
-            for (int j = 0; j < 2; ++j)
-                for (int k = 0; k < 2; ++k) v[i][j][k] = mAcc.getValue(c.offsetBy(i, j, k));
-        auto lerp = [](double a, double b, double t) { return a + t * (b - a); };
-        // Along x, then y, then z; the gradient from the differences across each axis.
-        double yz[2][2], dx[2][2];
-        for (int j = 0; j < 2; ++j)
-            for (int k = 0; k < 2; ++k) {
-                yz[j][k] = lerp(v[0][j][k], v[1][j][k], f.x());
-                dx[j][k] = v[1][j][k] - v[0][j][k];
-            }
-        const double z0 = lerp(yz[0][0], yz[1][0], f.y()), z1 = lerp(yz[0][1], yz[1][1], f.y());
-        const double phi = lerp(z0, z1, f.z()) / mVoxel;
-        const openvdb::Vec3d g(
-            lerp(lerp(dx[0][0], dx[1][0], f.y()), lerp(dx[0][1], dx[1][1], f.y()), f.z()),
-            lerp(yz[1][0] - yz[0][0], yz[1][1] - yz[0][1], f.z()), z1 - z0);
+        const openvdb::Vec3s q(p);
+        mStencil.moveTo(q);
+        const double phi = mStencil.interpolation(q) / mVoxel;
+        const openvdb::Vec3d g(mStencil.gradient(q));
         near = std::abs(phi) < mBand->background() / mVoxel - 1.0;
         const double length = g.length();
         return near && length > 0.0 ? p - g * (phi / length) : p;
@@ -137,7 +123,7 @@ private:
     }
 
     openvdb::FloatGrid::ConstPtr mBand;
-    mutable openvdb::tree::ValueAccessor<const openvdb::FloatTree, false> mAcc; ///< one thread's
+    mutable openvdb::math::BoxStencil<openvdb::FloatGrid, false> mStencil; ///< one thread's
     double mVoxel, mScale;
 };
 

@@ -171,14 +171,6 @@ private:
     /// The shell's blocks, from its tree.
     void makeBlocks(const openvdb::FloatTree& shell);
 
-    struct CoordHash {
-        size_t operator()(const openvdb::Coord& c) const
-        {
-            return size_t(c.x()) * 73856093u ^ size_t(c.y()) * 19349663u ^
-                   size_t(c.z()) * 83492791u;
-        }
-    };
-
     /// The far lattice, dense over its box.
     struct DenseField {
         std::vector<float> values;  ///< x-major
@@ -204,7 +196,7 @@ private:
     void measureErrors();
 
     openvdb::FloatGrid::ConstPtr mBand;
-    std::unordered_map<openvdb::Coord, uint32_t, CoordHash> mBlockIndex; ///< empty: not extended
+    std::unordered_map<openvdb::Coord, uint32_t> mBlockIndex; ///< empty: not extended
     std::vector<float> mBlocks; ///< kApron^3 values per block, x-major
     DenseField mFarField;
     float mExtendedError = 0.0f;   ///< max |extended - band| over the band's voxels, voxels
