@@ -4,6 +4,7 @@
 #include "blend/ExtraGrids.h"
 #include "blend/Sample.h"
 #include "blend/VelocityBlend.h"
+#include "blend/VelocityReach.h"
 #include "blend/WithSampler.h"
 
 #include <volmorph/Schedule.h>
@@ -84,7 +85,8 @@ public:
         leaves.moveInto(out.grids.density->tree(), out.grids.color->tree(), 0.0f, carried.trees);
         out.grids.extras = std::move(carried.grids);
         if (out.grids.velocity)
-            velocity.extend(*out.grids.velocity, r.velocityReachSeconds, mSource.voxelSize());
+            VelocityReach(velocity, r.velocityReachSeconds, mSource.voxelSize())
+                .grow(*out.grids.velocity, nullptr);
         // Leaves of constant interior collapse into tiles.
         openvdb::tools::prune(out.grids.density->tree());
         return out;

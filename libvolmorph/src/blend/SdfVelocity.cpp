@@ -1,8 +1,9 @@
 #include "blend/SdfVelocity.h"
 
+#include "blend/VelocityReach.h"
+
 #include <volmorph/Voxelize.h>
 
-#include <openvdb/tools/Morphology.h>
 #include <openvdb/tools/Prune.h>
 #include <openvdb/tree/LeafManager.h>
 
@@ -10,6 +11,7 @@
 #include <cmath>
 #include <iterator>
 #include <limits>
+#include <memory>
 
 namespace volmorph::detail {
 namespace {
@@ -115,7 +117,7 @@ inline bool gradient(const Field& a, openvdb::Index n, float centre, Vec3f& out)
 
 void SdfVelocity::leaf(const openvdb::FloatTree& source, const openvdb::FloatTree& target,
                        const openvdb::util::NodeMask<3>& on, VectorLeaf& velocity,
-                       VectorLeaf& correction) const
+                       VectorLeaf* correction) const
 {
     const openvdb::Coord origin = velocity.origin();
     const auto* sourceLeaf = source.probeConstLeaf(origin);
@@ -154,38 +156,8 @@ void SdfVelocity::leaf(const openvdb::FloatTree& source, const openvdb::FloatTre
             }
         }
         velocity.setValueOnly(n, (warp + fix) * mScale);
-        correction.setValueOnly(n, fix); // make() copies the velocity's mask
+        if (correction) correction->setValueOnly(n, fix); // make() copies the velocity's mask
     }
-}
-
-void SdfVelocity::extrapolate(openvdb::Vec3STree& correction)
-{
-    const openvdb::MaskTree before(correction, false, openvdb::TopologyCopy());
-    openvdb::tools::dilateActiveValues(correction, 1, openvdb::tools::NN_FACE_EDGE_VERTEX,
-                                       openvdb::tools::IGNORE_TILES);
-    openvdb::tree::LeafManager<openvdb::Vec3STree> leaves(correction);
-    // Each new voxel reads only voxels of the layer before, which no thread writes.
-    leaves.foreach ([&](VectorLeaf& leaf, size_t) {
-        openvdb::util::NodeMask<3> added = leaf.getValueMask();
-        if (const auto* old = before.probeConstLeaf(leaf.origin())) added -= old->getValueMask();
-        if (added.isOff()) return;
-        const openvdb::tree::ValueAccessor<const openvdb::MaskTree> known(before);
-        const openvdb::tree::ValueAccessor<const openvdb::Vec3STree> values(correction);
-        for (auto it = added.beginOn(); it; ++it) {
-            const openvdb::Coord ijk = leaf.offsetToGlobalCoord(it.pos());
-            Vec3f sum(0.0f);
-            int count = 0;
-            for (int dx = -1; dx <= 1; ++dx)
-                for (int dy = -1; dy <= 1; ++dy)
-                    for (int dz = -1; dz <= 1; ++dz) {
-                        const openvdb::Coord q = ijk.offsetBy(dx, dy, dz);
-                        if (!known.isValueOn(q)) continue;
-                        sum += values.getValue(q);
-                        ++count;
-                    }
-            leaf.setValueOnly(it.pos(), count > 0 ? sum / float(count) : Vec3f(0.0f));
-        }
-    });
 }
 
 openvdb::Vec3SGrid::Ptr SdfVelocity::make(const openvdb::FloatTree& source,
@@ -194,31 +166,24 @@ openvdb::Vec3SGrid::Ptr SdfVelocity::make(const openvdb::FloatTree& source,
 {
     auto velocity = openvdb::Vec3SGrid::create(Vec3f(0.0f));
     velocity->tree().topologyUnion(source); // the target's was recorded at the same voxels
-    openvdb::Vec3STree correction(velocity->tree(), Vec3f(0.0f), openvdb::TopologyCopy());
+    const bool reach = seconds > 0.0;
+    std::unique_ptr<openvdb::Vec3STree> correction;
+    if (reach)
+        correction = std::make_unique<openvdb::Vec3STree>(velocity->tree(), Vec3f(0.0f),
+                                                          openvdb::TopologyCopy());
     {
         openvdb::tree::LeafManager<openvdb::Vec3STree> leaves(velocity->tree());
         leaves.foreach ([&](VectorLeaf& v, size_t) {
             const openvdb::util::NodeMask<3> recorded = v.getValueMask();
-            VectorLeaf& fix = *correction.probeLeaf(v.origin());
+            VectorLeaf* fix = reach ? correction->probeLeaf(v.origin()) : nullptr;
             leaf(source, target, recorded, v, fix);
-            fix.setValueMask(v.getValueMask());
+            if (fix) fix->setValueMask(v.getValueMask());
         });
     }
     openvdb::tools::pruneInactive(velocity->tree());
-    openvdb::tools::pruneInactive(correction);
-    if (!(seconds > 0.0)) return velocity;
-    const openvdb::MaskTree band(velocity->tree(), false, openvdb::TopologyCopy());
-    const int reach = mBlend.extend(*velocity, seconds, voxelSize);
-    for (int layer = 0; layer < reach; ++layer) extrapolate(correction);
-    openvdb::tree::LeafManager<openvdb::Vec3STree> leaves(velocity->tree());
-    leaves.foreach ([&](VectorLeaf& v, size_t) {
-        openvdb::util::NodeMask<3> added = v.getValueMask();
-        if (const auto* old = band.probeConstLeaf(v.origin())) added -= old->getValueMask();
-        const VectorLeaf* fix = correction.probeConstLeaf(v.origin());
-        if (!fix) return;
-        for (auto it = added.beginOn(); it; ++it)
-            v.setValueOnly(it.pos(), v.getValue(it.pos()) + fix->getValue(it.pos()) * mScale);
-    });
+    if (!reach) return velocity;
+    openvdb::tools::pruneInactive(*correction);
+    VelocityReach(mBlend, seconds, voxelSize).grow(*velocity, std::move(correction));
     return velocity;
 }
 

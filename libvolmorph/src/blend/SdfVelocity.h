@@ -13,9 +13,9 @@
 // of a distance's (the sides' gradients cancel, as where a surface splits in two), the normal is
 // undefined and the voxel keeps v_w.
 //
-// Beyond the voxels blended, out to the shutter's reach (VelocityBlend::extend), the velocity is
-// the warp's, (1 - tau) v_S + tau v_T, plus the normal correction v - v_w extended outward layer
-// by layer, each new voxel taking the mean of its 26 neighbours' from the layer before: nearly
+// Beyond the voxels blended, out to the shutter's reach (VelocityReach.h), the velocity is the
+// warp's, (1 - tau) v_S + tau v_T, plus the normal correction v - v_w extended outward layer by
+// layer, each new voxel taking the mean of its 26 neighbours' from the layer before: nearly
 // constant along the normals, as level-set methods extend a front's speed.
 // Units: index units per unit t inside, world units per second in the grid.
 #pragma once
@@ -49,13 +49,11 @@ public:
 
 private:
     using VectorLeaf = openvdb::Vec3STree::LeafNodeType;
-    /// One leaf of the velocity (world units per second) and of the correction v - v_w (index
-    /// units per unit t), at the voxels `on`.
+    /// One leaf of the velocity (world units per second) and, unless null, of the correction
+    /// v - v_w (index units per unit t), at the voxels `on`.
     void leaf(const openvdb::FloatTree& source, const openvdb::FloatTree& target,
               const openvdb::util::NodeMask<3>& on, VectorLeaf& velocity,
-              VectorLeaf& correction) const;
-    /// Extends `correction` by one layer of voxels (26 neighbours) from its active ones.
-    static void extrapolate(openvdb::Vec3STree& correction);
+              VectorLeaf* correction) const;
 
     VelocityBlend mBlend;
     float mScale, mTau, mSlope, mRamp;

@@ -9,7 +9,6 @@
 #include "warp/VelocityLeaf.h"
 
 #include <openvdb/openvdb.h>
-#include <openvdb/tools/Morphology.h>
 #include <openvdb/tree/LeafManager.h>
 
 #include <algorithm>
@@ -50,15 +49,20 @@ public:
         return out;
     }
 
-    static constexpr int kMaxReach = 64; ///< voxels
+    static constexpr int kMaxReach = 64; ///< voxels (VelocityReach)
 
-    /// Extends `velocity` (this blend's, in world units per second) by the voxels the motion
-    /// reaches in `seconds` either way: dilated by reachSpeed times that, each new voxel holding
-    /// the warp's own velocity there ((1 - tau) v_S + tau v_T: both sides are empty); by at most
-    /// kMaxReach voxels.
-    /// Eulerian motion blur reads the velocity where the density is about to arrive. Returns the
-    /// voxels it dilated by.
-    int extend(openvdb::Vec3SGrid& velocity, double seconds, double voxelSize) const;
+    /// The warp's own velocity where both sides are empty, (1 - tau) v_S + tau v_T (index units
+    /// per unit t), at the voxels `on` of the leaf at `origin`.
+    void emptySides(const openvdb::Coord& origin, const openvdb::util::NodeMask<3>& on,
+                    Vec3f out[512]) const
+    {
+        Vec3f vs[512], vt[512];
+        mLeaf.fill(origin, on, vs, vt);
+        for (auto it = on.beginOn(); it; ++it)
+            out[it.pos()] = (1.0f - mTau) * vs[it.pos()] + mTau * vt[it.pos()];
+    }
+    /// World units per second of one index unit per unit t.
+    float scale() const { return mScale; }
 
     /// The speed the reach is made for: the fastest but for the fastest 1% of leaves. Near a fold
     /// of the warp, or where sdf mode's surface splits or closes (its normal speed unbounded
@@ -95,31 +99,5 @@ private:
     float mScale, mTau;
     mutable std::atomic<uint64_t> mInterpolated{0}, mExact{0};
 };
-
-inline int VelocityBlend::extend(openvdb::Vec3SGrid& velocity, double seconds,
-                                 double voxelSize) const
-{
-    if (!(seconds > 0.0)) return 0;
-    const double voxels = std::ceil(reachSpeed(velocity) * seconds / voxelSize);
-    const int reach = voxels > 0.0 ? int(std::min(voxels, double(kMaxReach))) : 0;
-    if (reach <= 0) return 0;
-    openvdb::Vec3STree original(velocity.tree(), Vec3f(0.0f), openvdb::TopologyCopy());
-    openvdb::tools::dilateActiveValues(velocity.tree(), reach, openvdb::tools::NN_FACE_EDGE_VERTEX,
-                                       openvdb::tools::IGNORE_TILES);
-    auto fill = [&](Leaf& leaf, size_t) {
-        openvdb::util::NodeMask<3> added = leaf.getValueMask();
-        if (const auto* before = original.probeConstLeaf(leaf.origin()))
-            added -= before->getValueMask();
-        if (added.isOff()) return;
-        Vec3f vs[512], vt[512];
-        mLeaf.fill(leaf.origin(), added, vs, vt);
-        for (auto it = added.beginOn(); it; ++it)
-            leaf.setValueOnly(it.pos(),
-                              ((1.0f - mTau) * vs[it.pos()] + mTau * vt[it.pos()]) * mScale);
-    };
-    openvdb::tree::LeafManager<openvdb::Vec3STree> leaves(velocity.tree());
-    leaves.foreach (fill);
-    return reach;
-}
 
 } // namespace volmorph::detail

@@ -177,3 +177,41 @@ TEST(Velocity, AFewSpikesDoNotSetTheReach)
     EXPECT_FLOAT_EQ(float(detail::VelocityBlend::reachSpeed(grid)), 2.0f);
     EXPECT_EQ(detail::VelocityBlend::reachSpeed(openvdb::Vec3SGrid(Vec3f(0.0f))), 0.0);
 }
+
+TEST(Velocity, TheReachFollowsTheLocalSpeed)
+{
+    // The bar turning a quarter turn in one second (omega = pi / 2 a second), voxels of 0.02, a
+    // reach of 0.25 s: its ends (r = 0.5) move 9.8 voxels within the reach, the middles of its
+    // long sides (r = 0.15) 2.9. The velocity reaches past each part of the surface as far as
+    // that part moves: far past the ends, close along the middles (a uniform reach, made for the
+    // ends, would cover 10 voxels everywhere).
+    const double voxel = 0.02;
+    const OnePairMorph bar = turningBar(voxel);
+    MorphOptions options = withVelocity();
+    options.velocityReachSeconds = 0.25;
+    const Morpher morpher(bar.source, bar.target, {bar.pair}, WarpSpec{}, BlendSpec{}, options);
+    const VolumeSet frame = morpher.frame(0.5); // the bar at 45 degrees
+    const Vec3d omega(0, 0, M_PI / 2 / kSecondsPerT);
+    const Vec3d along = Vec3d(1, 1, 0).unit(), across = Vec3d(-1, 1, 0).unit();
+    auto vel = frame.velocity->getConstAccessor();
+    auto density = frame.density->getConstAccessor();
+    const auto reached = [&](const Vec3d& from, const Vec3d& direction) {
+        int last = -1;
+        for (int k = 0; k < 20; ++k) {
+            const Vec3d p = from + direction * (k * voxel);
+            const openvdb::Coord ijk = frame.velocity->transform().worldToIndexCellCentered(p);
+            if (!vel.isValueOn(ijk)) break;
+            last = k;
+            const Vec3d v = omega.cross(frame.velocity->transform().indexToWorld(ijk));
+            if (density.getValue(ijk) == 0.0f) {
+                EXPECT_NEAR((Vec3d(vel.getValue(ijk)) - v).length(), 0.0, 0.01 * v.length()) << k;
+            }
+        }
+        return last;
+    };
+    const int end = reached(along * 0.5, along), side = reached(across * 0.15, across);
+    // Steps along the diagonals of x and y: a layer of 26 neighbours is 1.41 of them.
+    EXPECT_GE(end, 14); // 2.5 to the density's edge, 11 layers (a 99th-percentile speed)
+    EXPECT_LE(side, 9); // 1.5 to the edge, 4 layers (the face's speed within 4 voxels)
+    EXPECT_GE(side, 4);
+}
