@@ -115,26 +115,31 @@ inline bool gradient(const Field& a, openvdb::Index n, float centre, Vec3f& out)
 
 } // namespace
 
+openvdb::MaskTree SdfVelocity::shell(const openvdb::FloatTree& source,
+                                     const openvdb::FloatTree& target) const
+{
+    openvdb::MaskTree out(source, false, openvdb::TopologyCopy()); // the target's: the same
+    openvdb::tree::LeafManager<openvdb::MaskTree> leaves(out);
+    leaves.foreach ([&](openvdb::MaskTree::LeafNodeType& leaf, size_t) {
+        const auto* a = source.probeConstLeaf(leaf.origin());
+        const auto* b = target.probeConstLeaf(leaf.origin());
+        openvdb::util::NodeMask<3> near;
+        if (a && b) // recorded together: never one without the other
+            for (auto it = a->cbeginValueOn(); it; ++it) {
+                const float phi = (1.0f - mTau) * *it + mTau * b->getValue(it.pos());
+                if (std::abs(phi) < mShell) near.setOn(it.pos());
+            }
+        leaf.setValueMask(near);
+    });
+    openvdb::tools::pruneInactive(out);
+    return out;
+}
+
 void SdfVelocity::leaf(const openvdb::FloatTree& source, const openvdb::FloatTree& target,
-                       const openvdb::util::NodeMask<3>& on, VectorLeaf& velocity,
-                       VectorLeaf* correction) const
+                       VectorLeaf& velocity, VectorLeaf* correction) const
 {
     const openvdb::Coord origin = velocity.origin();
-    const auto* sourceLeaf = source.probeConstLeaf(origin);
-    const auto* targetLeaf = target.probeConstLeaf(origin);
-    if (!sourceLeaf || !targetLeaf) { // recorded together: never one without the other
-        velocity.setValueMask(openvdb::util::NodeMask<3>());
-        return;
-    }
-    // The shell near the surface; the rest of what was recorded is left to the extension.
-    openvdb::util::NodeMask<3> shell;
-    for (auto it = on.beginOn(); it; ++it) {
-        const float phi =
-            (1.0f - mTau) * sourceLeaf->getValue(it.pos()) + mTau * targetLeaf->getValue(it.pos());
-        if (std::abs(phi) < mShell) shell.setOn(it.pos());
-    }
-    velocity.setValueMask(shell);
-    if (shell.isOff()) return;
+    const openvdb::util::NodeMask<3> shell = velocity.getValueMask();
     const Field a(source, origin), b(target, origin);
     Vec3f vs[512], vt[512];
     mBlend.count(mBlend.warpVelocity().fill(origin, shell, vs, vt));
@@ -156,7 +161,7 @@ void SdfVelocity::leaf(const openvdb::FloatTree& source, const openvdb::FloatTre
             }
         }
         velocity.setValueOnly(n, (warp + fix) * mScale);
-        if (correction) correction->setValueOnly(n, fix); // make() copies the velocity's mask
+        if (correction) correction->setValueOnly(n, fix); // its mask: the velocity's (a copy)
     }
 }
 
@@ -164,8 +169,11 @@ openvdb::Vec3SGrid::Ptr SdfVelocity::make(const openvdb::FloatTree& source,
                                           const openvdb::FloatTree& target, double seconds,
                                           double voxelSize) const
 {
+    // Leaves are made only where the shell is: the rest of what was recorded is left to the
+    // extension (a Vec3 leaf is 6 KB; the recorded leaves are some twice the shell's).
+    const openvdb::MaskTree near = shell(source, target);
     auto velocity = openvdb::Vec3SGrid::create(Vec3f(0.0f));
-    velocity->tree().topologyUnion(source); // the target's was recorded at the same voxels
+    velocity->tree().topologyUnion(near);
     const bool reach = seconds > 0.0;
     std::unique_ptr<openvdb::Vec3STree> correction;
     if (reach)
@@ -174,15 +182,10 @@ openvdb::Vec3SGrid::Ptr SdfVelocity::make(const openvdb::FloatTree& source,
     {
         openvdb::tree::LeafManager<openvdb::Vec3STree> leaves(velocity->tree());
         leaves.foreach ([&](VectorLeaf& v, size_t) {
-            const openvdb::util::NodeMask<3> recorded = v.getValueMask();
-            VectorLeaf* fix = reach ? correction->probeLeaf(v.origin()) : nullptr;
-            leaf(source, target, recorded, v, fix);
-            if (fix) fix->setValueMask(v.getValueMask());
+            leaf(source, target, v, reach ? correction->probeLeaf(v.origin()) : nullptr);
         });
     }
-    openvdb::tools::pruneInactive(velocity->tree());
     if (!reach) return velocity;
-    openvdb::tools::pruneInactive(*correction);
     VelocityReach(mBlend, seconds, voxelSize).grow(*velocity, std::move(correction));
     return velocity;
 }

@@ -49,11 +49,13 @@ public:
 
 private:
     using VectorLeaf = openvdb::Vec3STree::LeafNodeType;
+    /// Where the formula holds: the voxels recorded whose blend is within mShell of zero.
+    openvdb::MaskTree shell(const openvdb::FloatTree& source,
+                            const openvdb::FloatTree& target) const;
     /// One leaf of the velocity (world units per second) and, unless null, of the correction
-    /// v - v_w (index units per unit t), at the voxels `on`.
+    /// v - v_w (index units per unit t), at the velocity leaf's active voxels.
     void leaf(const openvdb::FloatTree& source, const openvdb::FloatTree& target,
-              const openvdb::util::NodeMask<3>& on, VectorLeaf& velocity,
-              VectorLeaf* correction) const;
+              VectorLeaf& velocity, VectorLeaf* correction) const;
 
     VelocityBlend mBlend;
     float mScale, mTau, mSlope, mRamp;
