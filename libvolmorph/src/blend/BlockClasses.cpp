@@ -43,21 +43,27 @@ std::vector<float> neighbourhoodMax(const std::vector<float>& values, const Coor
 }
 
 std::vector<float> leafStretch(const std::vector<Vec3d>& ps, const std::vector<Vec3d>& pt,
-                               const Coord& n, float tau)
+                               const Coord& n, float tau, double spacing,
+                               const std::vector<uint8_t>& known)
 {
     auto index = [&n](int x, int y, int z) { return (size_t(x) * n.y() + y) * n.z() + z; };
-    auto norm = [](const Vec3d& dx, const Vec3d& dy, const Vec3d& dz) {
-        return spectralNorm(dx, dy, dz) / 8.0;
+    auto has = [&](const Coord& c) {
+        return known.empty() || known[index(c.x(), c.y(), c.z())] != 0;
     };
-    // The difference along `axis` between the neighbouring centres (one-sided at the box's faces).
+    auto norm = [spacing](const Vec3d& dx, const Vec3d& dy, const Vec3d& dz) {
+        return spectralNorm(dx, dy, dz) / spacing;
+    };
+    // The difference along `axis` between the neighbouring centres (one-sided at the box's faces
+    // and beside centres not known).
     auto diff = [&](const std::vector<Vec3d>& p, int x, int y, int z, int axis) {
         Coord a(x, y, z), b(x, y, z);
-        if (b[axis] + 1 < n[axis])
-            b[axis] += 1;
-        else if (a[axis] > 0)
+        if (!has(a)) return Vec3d(0.0);
+        b[axis] += 1;
+        if (b[axis] >= n[axis] || !has(b)) {
+            b = a;
             a[axis] -= 1;
-        else
-            return Vec3d(0.0);
+            if (a[axis] < 0 || !has(a)) return Vec3d(0.0);
+        }
         return p[index(b.x(), b.y(), b.z())] - p[index(a.x(), a.y(), a.z())];
     };
     std::vector<float> own(ps.size(), 1.0f);
@@ -75,6 +81,29 @@ std::vector<float> leafStretch(const std::vector<Vec3d>& ps, const std::vector<V
     std::vector<float> stretch = neighbourhoodMax(own, n);
     for (float& g : stretch) g = std::max(1.0f, 1.25f * g);
     return stretch;
+}
+
+} // namespace volmorph::detail
+
+namespace volmorph::detail {
+
+std::vector<uint8_t> CoarseBlocks::wanted(const Coord& n) const
+{
+    auto index = [&n](int x, int y, int z) { return (size_t(x) * n.y() + y) * n.z() + z; };
+    std::vector<uint8_t> out(size_t(n.x()) * n.y() * n.z(), 0);
+    constexpr int kApron = 2; // a leaf's stretch reads its neighbours', which read theirs
+    for (int bx = 0; bx < dim.x(); ++bx)
+        for (int by = 0; by < dim.y(); ++by)
+            for (int bz = 0; bz < dim.z(); ++bz) {
+                if (kind[(size_t(bx) * dim.y() + by) * dim.z() + bz] != 0) continue;
+                const Coord lo(bx * kLeaves - kApron, by * kLeaves - kApron, bz * kLeaves - kApron);
+                const Coord hi = lo + Coord(kLeaves - 1 + 2 * kApron);
+                for (int x = std::max(0, lo.x()); x <= std::min(n.x() - 1, hi.x()); ++x)
+                    for (int y = std::max(0, lo.y()); y <= std::min(n.y() - 1, hi.y()); ++y)
+                        for (int z = std::max(0, lo.z()); z <= std::min(n.z() - 1, hi.z()); ++z)
+                            out[index(x, y, z)] = 1;
+            }
+    return out;
 }
 
 } // namespace volmorph::detail

@@ -59,13 +59,22 @@ public:
         c.leaves = box >> size_t(3);
         const openvdb::Coord n = c.leaves.dim();
         const size_t count = size_t(n.x()) * n.y() * n.z();
+        const bool warped = mWarp.pairCount() > 0;
+        // With pairs, blocks of leaves first: only the leaves near the band are warped one by one.
+        const CoarseBlocks coarse = prune && warped && !identity ? coarseBlocks() : CoarseBlocks{};
+        const std::vector<uint8_t> wanted =
+            coarse.empty() ? std::vector<uint8_t>{} : coarse.wanted(n);
         std::vector<Vec3d> ps, pt; // the warped centres (with pairs)
         const std::vector<float> blend =
-            identity ? keptCentreBlends(box, *identity) : centreBlends(ps, pt);
+            identity ? keptCentreBlends(box, *identity) : centreBlends(ps, pt, wanted);
+        mSamples += wanted.empty() ? count : size_t(std::count(wanted.begin(), wanted.end(), 1));
         // The warp's stretch per leaf; the identity's is 1 exactly.
         std::vector<float> stretch =
-            mWarp.pairCount() > 0 ? leafStretch(ps, pt, n, mTau) : std::vector<float>(count, 1.0f);
-        c.maxStretch = *std::max_element(stretch.begin(), stretch.end());
+            warped ? leafStretch(ps, pt, n, mTau, 8.0, wanted) : std::vector<float>(count, 1.0f);
+        c.maxStretch = 1.0;
+        for (size_t i = 0; i < count; ++i)
+            if (wanted.empty() || wanted[i])
+                c.maxStretch = std::max(c.maxStretch, double(stretch[i]));
         // Values are computed within the compute band of each leaf: the band and one voxel more,
         // so that every band voxel's neighbours are known. A voxel of leaf L is in the band that
         // is kept when its value is within G_L width voxels of zero (G_L the leaf's stretch), and
@@ -85,6 +94,7 @@ public:
         for (size_t i = 0; i < count; ++i)
             if (!(std::abs(blend[i]) < limit(c.stretch[i], 3.5f * kSqrt3, c.band[i])))
                 c.kind[i] = blend[i] < 0.0f ? -1 : 1;
+        if (!coarse.empty()) takeCoarse(coarse);
     }
 
     /// Beyond this blend (world units) at a point, no voxel within `reach` voxels of it is in the
@@ -101,7 +111,8 @@ public:
     float computeBand() const { return mComputeBand; }
     /// The output band's half width, world units.
     float width() const { return mWidth * mVoxel; }
-    uint64_t samples() const { return mSamples + mClasses.kind.size(); }
+    /// The points where the blend was evaluated: centres classified and voxels filled.
+    uint64_t samples() const { return mSamples; }
     /// Inactive values lie at least this many voxels from the zero set (compute band / G).
     int deepVoxels() const { return int(mWidth + 1.0f); }
 
@@ -294,9 +305,64 @@ private:
         float mQuarterLimit = 0.0f, mBlockLimit = 0.0f;
     };
 
-    /// The blend at the centres of the classified box's leaves through the exact warp, and the
-    /// warped centres (index space) into ps and pt.
-    std::vector<float> centreBlends(std::vector<Vec3d>& ps, std::vector<Vec3d>& pt) const
+    /// The coarse pass (BlockClasses.h) over the box's leaves.
+    CoarseBlocks coarseBlocks() const
+    {
+        constexpr int K = CoarseBlocks::kLeaves;
+        const openvdb::Coord n = mClasses.leaves.dim(), first = mClasses.leaves.min();
+        CoarseBlocks out;
+        out.dim = openvdb::Coord((n.x() + K - 1) / K, (n.y() + K - 1) / K, (n.z() + K - 1) / K);
+        const openvdb::Coord d = out.dim;
+        const size_t count = size_t(d.x()) * d.y() * d.z();
+        std::vector<Vec3d> ps(count), pt(count);
+        std::vector<float> blend(count);
+        const double half = 4.0 * K - 0.5; // from a block's first voxel to its centre
+        tbb::parallel_for(tbb::blocked_range<int>(0, d.x()), [&](const tbb::blocked_range<int>& r) {
+            typename ExtendedDistance::template Reader<Sampler> a(mFarSource), b(mFarTarget);
+            for (int x = r.begin(); x != r.end(); ++x)
+                for (int y = 0; y < d.y(); ++y)
+                    for (int z = 0; z < d.z(); ++z) {
+                        const size_t i = (size_t(x) * d.y() + y) * d.z() + z;
+                        const openvdb::Coord leaf = first.offsetBy(x * K, y * K, z * K);
+                        const Vec3d centre = leaf.asVec3d() * 8.0 + Vec3d(half);
+                        mWarp.map(centre, ps[i], pt[i]);
+                        blend[i] = (1.0f - mTau) * a(ps[i]) + mTau * b(pt[i]);
+                    }
+        });
+        mSamples += count;
+        out.stretch = leafStretch(ps, pt, d, mTau, 8.0 * K);
+        for (float& g : out.stretch) g *= CoarseBlocks::kSafety;
+        out.band = neighbourhoodMax(out.stretch, d);
+        for (float& g : out.band) g *= (mWidth + 1.0f) * mVoxel;
+        out.kind.assign(count, 0);
+        const float reach = float(half) * kSqrt3; // from the centre to a corner voxel
+        for (size_t i = 0; i < count; ++i)
+            if (!(std::abs(blend[i]) < limit(out.stretch[i], reach, out.band[i])))
+                out.kind[i] = blend[i] < 0.0f ? -1 : 1;
+        return out;
+    }
+
+    /// The leaves of blocks the coarse pass judged whole take their block's sign.
+    void takeCoarse(const CoarseBlocks& coarse)
+    {
+        BlockClasses& c = mClasses;
+        const openvdb::Coord n = c.leaves.dim();
+        for (int x = 0; x < n.x(); ++x)
+            for (int y = 0; y < n.y(); ++y)
+                for (int z = 0; z < n.z(); ++z) {
+                    const size_t b = coarse.of(openvdb::Coord(x, y, z));
+                    if (coarse.kind[b] == 0) continue;
+                    const size_t i = (size_t(x) * n.y() + y) * n.z() + z;
+                    c.kind[i] = coarse.kind[b];
+                    c.stretch[i] = coarse.stretch[b];
+                    c.band[i] = coarse.band[b];
+                }
+    }
+
+    /// The blend at the centres of the classified box's leaves (`wanted`, unless empty, says which)
+    /// through the exact warp, and the warped centres (index space) into ps and pt.
+    std::vector<float> centreBlends(std::vector<Vec3d>& ps, std::vector<Vec3d>& pt,
+                                    const std::vector<uint8_t>& wanted) const
     {
         const BlockClasses& c = mClasses;
         const openvdb::Coord n = c.leaves.dim();
@@ -311,6 +377,7 @@ private:
                 for (int y = 0; y < n.y(); ++y)
                     for (int z = 0; z < n.z(); ++z) {
                         const size_t i = index(x, y, z);
+                        if (!wanted.empty() && !wanted[i]) continue;
                         const openvdb::Coord leaf = c.leaves.min().offsetBy(x, y, z);
                         const Vec3d centre(leaf.x() * 8 + 3.5, leaf.y() * 8 + 3.5,
                                            leaf.z() * 8 + 3.5);
