@@ -54,7 +54,7 @@ class ExtendedDistance {
 public:
     static constexpr int kShell = 2, kShellCells = 24, kFarSpacing = 8;
     static constexpr int kSharePasses = 4;      ///< of shareFeet over the far lattice
-    static constexpr int kShellSharePasses = 2; ///< of shareShellFeet over the shell
+    static constexpr int kShellSharePasses = 1; ///< of shareShellFeet over the shell
     /// The shell is read within kShellUse voxels of the surface, alone within kShellBlend.
     static constexpr float kShellBlend = 32.0f, kShellUse = 40.0f; // under kShell * kShellCells
     static constexpr float kNear = 2.0f, kFar = 2.9f;              // voxels
