@@ -6,8 +6,8 @@ The default scene (scenes/bunny-to-knot.toml, about 1 world unit across) at N vo
   setup   wall time of `volmorph morph --frames 12` until frame 12 starts, with an empty voxel cache
           (voxelization, the blend's one-time work);
   frame   frame 12's own morph time, as the command reports it;
-  render  wall time of `volmorph render --frames 12` beyond its own setup and morph (the voxel cache
-          of the morph run is reused, so its setup is the blend's alone);
+  render  wall time of `volmorph render --frames 12` from its first render stage on (after its own
+          setup and morph; the voxel cache of the morph run is reused);
   peak    each command's peak resident memory (getrusage of the child, ru_maxrss).
 Prints a Markdown table. A run that fails (for example refused by the memory guard) prints its
 message in the row.
@@ -93,8 +93,10 @@ def measure(build, across, mode, resolution, render):
             if code != 0:
                 row["error"] = err.strip().splitlines()[-1] if err.strip() else "exit %d" % code
                 return row
-            morph_start = stage_start(err, "frame %d: morph" % FRAME)
-            row["render"] = wall - morph_start - (frame_seconds(err) or 0.0)
+            # `render` reports the whole frame (morph and render) on its frame line: the render
+            # is what follows the morph, from its first render stage on.
+            render_start = stage_start(err, "render: ")
+            row["render"] = wall - render_start if render_start is not None else None
             row["render_peak"] = peak
         return row
 
