@@ -67,8 +67,8 @@ public:
     /// The speed the reach is made for: the fastest but for the fastest 1% of leaves. Near a fold
     /// of the warp, or where sdf mode's surface splits or closes (its normal speed unbounded
     /// there), the speed spikes at a few voxels, 100 times the motion's elsewhere in the default
-    /// scene; a dilation by it (every layer the whole tree's) would cost the frame many times over,
-    /// for the blur of those few voxels' density alone.
+    /// scene; a reach made for it would cost the frame many times over (VelocityReach's layers
+    /// around those voxels), for the blur of those few voxels' density alone.
     static double reachSpeed(const openvdb::Vec3SGrid& velocity)
     {
         openvdb::tree::LeafManager<const openvdb::Vec3STree> leaves(velocity.tree());

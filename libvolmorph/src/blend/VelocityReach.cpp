@@ -179,7 +179,6 @@ VelocityReach::Layer VelocityReach::next(openvdb::Vec3STree& velocity, openvdb::
 
     Layer out;
     out.reach = std::make_unique<FloatTree>(candidates, 0.0f, TopologyCopy());
-
     out.corrections = last.corrections ? &velocity : nullptr;
     const float perSpeed = float(mSeconds / mVoxel); // voxels reached per world unit a second
     std::atomic<uint64_t> kept{0};
