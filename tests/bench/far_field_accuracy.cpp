@@ -34,16 +34,6 @@ namespace {
 const std::filesystem::path kScene =
     std::filesystem::path(VOLMORPH_SOURCE_DIR) / "scenes" / "bunny-to-knot.toml";
 
-/// The box the blend extends both fields over (SdfBlend.cpp's extensionBox, with pairs).
-openvdb::CoordBBox extensionBox(const VolumeSet& source, const VolumeSet& target)
-{
-    openvdb::CoordBBox box = source.sdf->evalActiveVoxelBoundingBox();
-    box.expand(target.sdf->evalActiveVoxelBoundingBox());
-    const openvdb::Coord dim = box.dim();
-    box.expand(std::max(8, std::max({dim.x(), dim.y(), dim.z()}) / 8));
-    return box;
-}
-
 /// A mesh's distances at every voxel of `box` (world units): a band as wide as the box.
 openvdb::FloatGrid::Ptr exactDistances(const Mesh& mesh, double voxel,
                                        const openvdb::CoordBBox& box)
@@ -116,7 +106,8 @@ int main(int argc, char** argv)
     scene.blend.mode = BlendMode::Sdf;
     const SceneVolumes volumes = voxelizeScene(scene);
     const double voxel = volumes.source.voxelSize();
-    const openvdb::CoordBBox box = extensionBox(volumes.source, volumes.target);
+    const openvdb::CoordBBox box = detail::ExtendedDistance::boxFor(
+        *volumes.source.sdf, *volumes.target.sdf, scene.pairs.size());
     const detail::ExtendedDistance farS(volumes.source.sdf, box), farT(volumes.target.sdf, box);
     std::printf("default scene at %d voxels across (voxel %.5g); reference over %d x %d x %d\n",
                 across, voxel, box.dim().x(), box.dim().y(), box.dim().z());

@@ -83,10 +83,6 @@ std::vector<float> leafStretch(const std::vector<Vec3d>& ps, const std::vector<V
     return stretch;
 }
 
-} // namespace volmorph::detail
-
-namespace volmorph::detail {
-
 std::vector<uint8_t> CoarseBlocks::wanted(const Coord& n) const
 {
     auto index = [&n](int x, int y, int z) { return (size_t(x) * n.y() + y) * n.z() + z; };

@@ -1,5 +1,7 @@
 #include "blend/ExtendedDistance.h"
 
+#include "blend/LeafApron.h"
+
 #include <openvdb/math/Stencils.h>
 #include <openvdb/tools/ChangeBackground.h>
 #include <openvdb/tools/FastSweeping.h>
@@ -129,6 +131,18 @@ private:
 
 } // namespace
 
+CoordBBox ExtendedDistance::boxFor(const openvdb::FloatGrid& sourceBand,
+                                   const openvdb::FloatGrid& targetBand, size_t pairCount)
+{
+    CoordBBox box = sourceBand.evalActiveVoxelBoundingBox();
+    box.expand(targetBand.evalActiveVoxelBoundingBox());
+    if (box.empty()) return box;
+    const Coord dim = box.dim();
+    const int margin = pairCount == 0 ? 8 : std::max(8, std::max({dim.x(), dim.y(), dim.z()}) / 8);
+    box.expand(margin);
+    return box;
+}
+
 ExtendedDistance::ExtendedDistance(openvdb::FloatGrid::ConstPtr band, const CoordBBox& box,
                                    Interrupter* interrupter)
     : mBand(std::move(band))
@@ -248,43 +262,27 @@ void ExtendedDistance::shareShellFeet(openvdb::tree::LeafManager<openvdb::Vec3ST
     // As shareFeet does on the far lattice: a shell point whose own surface point is not its
     // nearest (across the shell's medial axes, inside a thin part or between two) takes the
     // nearest of its neighbours'. Each leaf first copies its neighbours' points next to it into
-    // a dense block (one tree lookup per neighbour leaf, not per point).
-    constexpr int kSide = 10;
-    const auto index = [](int x, int y, int z) {
-        return ((x + 1) * kSide + y + 1) * kSide + z + 1;
-    };
+    // a dense block (LeafApron.h: one tree lookup per neighbour leaf, not per point).
     const openvdb::Vec3STree& feet = leaves.tree();
     leaves.foreach ([&](openvdb::Vec3STree::LeafNodeType& leaf, size_t i) {
         openvdb::tree::ValueAccessor<const openvdb::Vec3STree, false> acc(feet);
-        std::vector<openvdb::Vec3s> near(kSide * kSide * kSide, openvdb::Vec3s(kNoFoot));
-        for (int dx = -1; dx <= 1; ++dx)
-            for (int dy = -1; dy <= 1; ++dy)
-                for (int dz = -1; dz <= 1; ++dz) {
-                    const auto* n =
-                        acc.probeConstLeaf(leaf.origin().offsetBy(8 * dx, 8 * dy, 8 * dz));
-                    if (!n) continue;
-                    const auto lo = [](int d) { return d < 0 ? 7 : 0; };
-                    const auto hi = [](int d) { return d > 0 ? 0 : 7; };
-                    for (int x = lo(dx); x <= hi(dx); ++x)
-                        for (int y = lo(dy); y <= hi(dy); ++y)
-                            for (int z = lo(dz); z <= hi(dz); ++z)
-                                near[size_t(index(x + 8 * dx, y + 8 * dy, z + 8 * dz))] =
-                                    n->getValue(openvdb::Index((x << 6) | (y << 3) | z));
-                }
+        std::vector<openvdb::Vec3s> near(apron::kCount, openvdb::Vec3s(kNoFoot));
+        const openvdb::Vec3STree::LeafNodeType* from = nullptr;
+        apron::gather(
+            leaf.origin(),
+            [&](const Coord& origin) { return (from = acc.probeConstLeaf(origin)) != nullptr; },
+            [&](openvdb::Index n, int d) { near[size_t(d)] = from->getValue(n); });
         openvdb::Vec3s* out = leaves.getBuffer(i, 1).data();
         for (auto it = leaf.cbeginValueOn(); it; ++it) {
-            const Coord local = it.getCoord() - leaf.origin();
             const openvdb::Vec3s p(it.getCoord().asVec3s() * float(kShell));
+            const int centre = apron::index(it.pos());
             float best = std::numeric_limits<float>::max();
             openvdb::Vec3s foot(kNoFoot);
-            for (int dx = -1; dx <= 1; ++dx)
-                for (int dy = -1; dy <= 1; ++dy)
-                    for (int dz = -1; dz <= 1; ++dz) {
-                        const openvdb::Vec3s& f =
-                            near[size_t(index(local.x() + dx, local.y() + dy, local.z() + dz))];
-                        const float e = (p - f).lengthSqr(); // huge where f is kNoFoot
-                        if (e < best) best = e, foot = f;
-                    }
+            for (const int d : apron::neighbours()) {
+                const openvdb::Vec3s& f = near[size_t(centre + d)];
+                const float e = (p - f).lengthSqr(); // huge where f is kNoFoot
+                if (e < best) best = e, foot = f;
+            }
             out[it.pos()] = foot;
         }
     });

@@ -25,23 +25,6 @@ using openvdb::CoordBBox;
 
 namespace {
 
-/// The box both distance fields are extended over: the objects' box and a margin for warped points
-/// that leave it, an eighth of its size, at least 8 voxels. With no pairs the points are the
-/// output's voxels: the blend's zero set lies within the objects' box (the band's active voxels),
-/// and 8 voxels more hold its compute band. Beyond the box a read takes the nearest face's value,
-/// which underestimates a distance outside: leaves there are judged, if anything, too near
-/// (4 voxels: 15% more leaves evaluated, for a setup hardly cheaper).
-CoordBBox extensionBox(const VolumeSet& source, const VolumeSet& target, size_t pairCount)
-{
-    CoordBBox box = source.sdf->evalActiveVoxelBoundingBox();
-    box.expand(target.sdf->evalActiveVoxelBoundingBox());
-    if (box.empty()) return box;
-    const Coord dim = box.dim();
-    const int margin = pairCount == 0 ? 8 : std::max(8, std::max({dim.x(), dim.y(), dim.z()}) / 8);
-    box.expand(margin);
-    return box;
-}
-
 template <typename Sampler>
 class SdfBlend final : public TwoSidedBlend {
 public:
@@ -49,7 +32,7 @@ public:
     {
         if (!mSource.sdf || !mTarget.sdf)
             throw std::invalid_argument("sdf blending needs sdf grids on both sides");
-        const CoordBBox box = extensionBox(mSource, mTarget, setup.pairCount);
+        const CoordBBox box = ExtendedDistance::boxFor(*mSource.sdf, *mTarget.sdf, setup.pairCount);
         // Both at once: fast sweeping is partly serial.
         tbb::parallel_invoke(
             [&] {

@@ -1,5 +1,7 @@
 #include "blend/VelocityReach.h"
 
+#include "blend/LeafApron.h"
+
 #include <openvdb/tools/Morphology.h>
 #include <openvdb/tools/Prune.h>
 #include <openvdb/tree/LeafManager.h>
@@ -106,60 +108,37 @@ private:
     const openvdb::Vec3STree::LeafNodeType* mFix = nullptr;
 };
 
-/// The last layer around one leaf of the next, dense: the leaf and one voxel of each of its 26
-/// neighbours. Copied once per leaf: a voxel's 26 reads are then array reads, not tree probes.
+/// The last layer around one leaf of the next, dense (LeafApron.h).
 class Halo {
 public:
     template <typename Source>
     void load(const Coord& origin, Source& source)
     {
         std::fill(std::begin(mKept), std::end(mKept), false);
-        for (int dx = -1; dx <= 1; ++dx)
-            for (int dy = -1; dy <= 1; ++dy)
-                for (int dz = -1; dz <= 1; ++dz)
-                    if (source.bind(origin.offsetBy(8 * dx, 8 * dy, 8 * dz)))
-                        copy(source, dx, dy, dz);
+        apron::gather(
+            origin, [&](const Coord& leaf) { return source.bind(leaf); },
+            [&](Index n, int i) { mKept[i] = source.at(n, mReach[i], mFix[i]); });
     }
 
     /// The neighbours of the leaf's voxel n, in the order x, y, z from -1 to 1.
     Neighbours around(Index n) const
     {
-        const int centre = index(int(n >> 6), int((n >> 3) & 7), int(n & 7));
+        const int centre = apron::index(n);
         Neighbours out;
-        for (int dx = -1; dx <= 1; ++dx)
-            for (int dy = -1; dy <= 1; ++dy)
-                for (int dz = -1; dz <= 1; ++dz) {
-                    const int i = centre + (dx * kSide + dy) * kSide + dz;
-                    if (!mKept[i]) continue;
-                    out.reach = std::max(out.reach, mReach[i]);
-                    out.sum += mFix[i];
-                    ++out.count;
-                }
+        for (const int d : apron::neighbours()) {
+            const int i = centre + d;
+            if (!mKept[i]) continue;
+            out.reach = std::max(out.reach, mReach[i]);
+            out.sum += mFix[i];
+            ++out.count;
+        }
         return out;
     }
 
 private:
-    static constexpr int kSide = 10;
-    /// The dense index of the leaf's local (x, y, z), each in -1..8.
-    static int index(int x, int y, int z) { return ((x + 1) * kSide + (y + 1)) * kSide + (z + 1); }
-
-    /// The voxels of the neighbour leaf at (dx, dy, dz) leaves' offset that touch this leaf.
-    template <typename Source>
-    void copy(const Source& source, int dx, int dy, int dz)
-    {
-        const auto lo = [](int d) { return d < 0 ? 7 : 0; };
-        const auto hi = [](int d) { return d > 0 ? 0 : 7; };
-        for (int x = lo(dx); x <= hi(dx); ++x)
-            for (int y = lo(dy); y <= hi(dy); ++y)
-                for (int z = lo(dz); z <= hi(dz); ++z) {
-                    const int i = index(x + 8 * dx, y + 8 * dy, z + 8 * dz);
-                    mKept[i] = source.at(Index((x << 6) | (y << 3) | z), mReach[i], mFix[i]);
-                }
-    }
-
-    bool mKept[kSide * kSide * kSide];
-    float mReach[kSide * kSide * kSide];
-    Vec3f mFix[kSide * kSide * kSide];
+    bool mKept[apron::kCount];
+    float mReach[apron::kCount];
+    Vec3f mFix[apron::kCount];
 };
 
 } // namespace
