@@ -353,11 +353,10 @@ Command addRenderVdbCommand(CLI::App& app)
     sub->add_option("--step", a->step,
                     "longest step of the scattering integral, in voxels (optical depth is exact)")
         ->check(CLI::Range(0.01, 8.0));
-    sub->add_option(
-           "--shadow-cache", a->shadowCache,
-           "single scattering's shadow map (directional) or grid (point light) spacing, in "
-           "voxels (0: exact transmittance per sample, slow: the reference); traced paths "
-           "use ratio tracking")
+    sub->add_option("--shadow-cache", a->shadowCache,
+                    "single scattering's shadow maps' spacing (directional and point lights), in "
+                    "voxels (0: exact transmittance per sample, slow: the reference); traced paths "
+                    "use ratio tracking")
         ->check(CLI::Range(0, 16));
     sub->add_option("--threads", a->threads, "threads (0 = all cores)")->check(CLI::Range(0, 1024));
     sub->add_option("--grid", a->grid, "name of the float grid (default: the first)");

@@ -14,14 +14,11 @@ namespace volmorph::render {
 ThreadReaders::ThreadReaders(const FrameInputs& frame)
     : in(frame), inter(frame.master), density(frame.density.tree(), frame.padded),
       shadowInter(frame.master), shadowDensity(frame.density.tree(), frame.padded),
-      shadowCaches(frame.lights.size()), perRay(frame.lights.size())
+      perRay(frame.lights.size())
 {
     if (frame.color) colors = std::make_unique<ColorReader>(frame.color->tree());
     if (frame.majorants)
         majorants = std::make_unique<Majorants::Accessor>(frame.majorants->accessor());
-    for (size_t l = 0; l < frame.lights.size(); ++l)
-        if (frame.shadows[l].cache)
-            shadowCaches[l] = std::make_unique<CacheAccessor>(frame.shadows[l].cache->tree());
 }
 
 Vec3d towardLight(const Light& light, const Vec3d& p, double& distance)
@@ -70,14 +67,12 @@ double lightArriving(ThreadReaders& readers, size_t l, const Vec3d& ip, const Ve
 {
     const FrameInputs& in = readers.in;
     const Light& light = in.lights[l];
-    const bool exact = !in.shadows[l].map && !in.shadows[l].cache;
+    const Shadow& shadow = in.shadows[l];
     phased = directional && light.type != Light::Type::Point ? *directional
                                                              : lightPhased(in, l, ip, direction);
-    if (exact) return exactTransmittance(readers, light, ip);
-    // The point light's cache shares the density's origin, at `factor` times its voxel.
-    return light.type == Light::Type::Point
-               ? openvdb::tools::BoxSampler::sample(*readers.shadowCaches[l], ip * in.inverseFactor)
-               : in.shadows[l].map->lookup(ip);
+    if (shadow.map) return shadow.map->lookup(ip);
+    if (shadow.point) return shadow.point->lookup(ip);
+    return exactTransmittance(readers, light, ip);
 }
 
 namespace {

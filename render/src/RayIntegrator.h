@@ -27,7 +27,6 @@ struct FrameInputs {
     bool levelSet;
     double sigmaPerVoxel; ///< extinction per index unit at density 1
     double stepVoxels;    ///< longest step of the scattering integral
-    double inverseFactor; ///< 1 / the point lights' shadow grid spacing in voxels
     const PaddedLeaves& padded;
     const Intersector& master;
     const std::vector<Shadow>& shadows;
@@ -45,16 +44,12 @@ struct TracedPiece {
 
 /// One thread's readers of the frame's grids (accessors keep per-thread caches).
 struct ThreadReaders {
-    using CacheAccessor = openvdb::tree::ValueAccessor<const openvdb::FloatTree>;
-
     const FrameInputs& in;
     Intersector inter;
     DensityReader density;
     Intersector shadowInter;     ///< exact transmittance toward lights (shadowCacheVoxels 0)
     DensityReader shadowDensity; ///< the same
     std::unique_ptr<ColorReader> colors;
-    std::vector<std::unique_ptr<CacheAccessor>>
-        shadowCaches;                               ///< per light: its point-light grid, or null
     std::vector<Vec3d> perRay;                      ///< per light: scratch for one ray
     std::unique_ptr<Majorants::Accessor> majorants; ///< when paths are traced
     std::vector<TracedPiece> pieces;                ///< scratch for one camera ray

@@ -106,8 +106,9 @@ void renderFrame(const openvdb::FloatGrid& density, const openvdb::Vec3SGrid* co
         majorants = std::make_unique<const Majorants>(density, padded, levelSet);
     } else {
         stage(settings.interrupter, "render: shadows");
-        shadows = buildShadows(density, padded, *mask, levelSet, lights, sigmaPerVoxel,
-                               settings.shadowCacheVoxels, settings.interrupter);
+        shadows =
+            buildShadows({density, padded, *mask, levelSet, sigmaPerVoxel, settings.interrupter},
+                         lights, settings.shadowCacheVoxels);
     }
     if (interrupted(settings.interrupter)) throw Interrupted();
     const Intersector master(*mask);
@@ -118,7 +119,6 @@ void renderFrame(const openvdb::FloatGrid& density, const openvdb::Vec3SGrid* co
                             levelSet,
                             sigmaPerVoxel,
                             settings.stepVoxels > 0.0 ? settings.stepVoxels : 0.5,
-                            1.0 / double(std::max(1, settings.shadowCacheVoxels)),
                             padded,
                             master,
                             shadows,

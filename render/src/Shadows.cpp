@@ -2,12 +2,6 @@
 
 #include "CellWalk.h"
 
-#include <openvdb/tools/Morphology.h>
-#include <openvdb/tree/LeafManager.h>
-
-#include <tbb/blocked_range.h>
-#include <tbb/parallel_for.h>
-
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -35,69 +29,19 @@ double opticalDepth(Intersector& inter, bool levelSet, DensityReader& acc, const
     return tau;
 }
 
-namespace {
-
-/// Transmittance toward a point light, on a coarse grid over the occupied region: one march toward
-/// the light per grid point, sampled trilinearly.
-FloatGrid::Ptr pointLightCache(const FloatGrid& density, const PaddedLeaves& padded,
-                               const openvdb::BoolGrid& mask, bool levelSet, const Light& light,
-                               double sigmaPerVoxel, int shadowCacheVoxels,
-                               openvdb::util::NullInterrupter* interrupter)
+ShadowMap::ShadowMap(const MarchInputs& in, const Vec3d& travel, double spacing)
+    : mDensity(in.density), mSpacing(spacing)
 {
-    const int factor = std::max(1, shadowCacheVoxels);
-    const double voxel = density.voxelSize()[0];
-    FloatGrid::Ptr cache = FloatGrid::create(1.0f);
-    cache->setTransform(openvdb::math::Transform::createLinearTransform(voxel * factor));
-    auto coarse = [factor](const Coord& c) {
-        auto f = [factor](int v) { return v >= 0 ? v / factor : -((-v + factor - 1) / factor); };
-        return Coord(f(c.x()), f(c.y()), f(c.z()));
-    };
-    for (auto leaf = mask.tree().cbeginLeaf(); leaf; ++leaf) {
-        const CoordBBox b = leaf->getNodeBoundingBox();
-        cache->tree().fill(CoordBBox(coarse(b.min()), coarse(b.max())), 1.0f, true);
-    }
-    auto tiles = mask.tree().cbeginValueOn();
-    tiles.setMaxDepth(openvdb::BoolTree::ValueOnCIter::LEAF_DEPTH - 1);
-    for (; tiles; ++tiles) {
-        if (tiles.isVoxelValue()) continue;
-        const CoordBBox b = tiles.getBoundingBox();
-        cache->tree().fill(CoordBBox(coarse(b.min()), coarse(b.max())), 1.0f, true);
-    }
-    openvdb::tools::dilateActiveValues(cache->tree(), 1, openvdb::tools::NN_FACE_EDGE_VERTEX,
-                                       openvdb::tools::IGNORE_TILES);
-    cache->tree().voxelizeActiveTiles();
-
-    const Intersector master(mask);
-    openvdb::tree::LeafManager<openvdb::FloatTree> leaves(cache->tree());
-    leaves.foreach ([&](openvdb::FloatTree::LeafNodeType& leaf, size_t) {
-        if (interrupter && interrupter->wasInterrupted()) return;
-        Intersector inter(master);
-        DensityReader acc(density.tree(), padded);
-        for (auto it = leaf.beginValueOn(); it; ++it) {
-            const Vec3d p = cache->indexToWorld(it.getCoord());
-            Vec3d toward = light.position - p;
-            const double distance = toward.length();
-            if (distance <= 0.0) continue;
-            toward /= distance;
-            it.setValue(float(
-                std::exp(-opticalDepth(inter, levelSet, acc, p, toward, distance, sigmaPerVoxel))));
-        }
-    });
-    return cache;
-}
-
-} // namespace
-
-ShadowMap::ShadowMap(const FloatGrid& density, const PaddedLeaves& padded,
-                     const openvdb::BoolGrid& mask, bool levelSet, const Vec3d& travel,
-                     double sigmaPerVoxel, double spacing,
-                     openvdb::util::NullInterrupter* interrupter)
-    : mDensity(density), mSpacing(spacing)
-{
-    const double length = placeLattice(density, mask, travel);
-    std::vector<Column> columns(size_t(mCount[0]) * size_t(mCount[1]));
-    marchColumns(density, padded, mask, levelSet, length, sigmaPerVoxel, interrupter, columns);
-    pack(columns);
+    const double length = placeLattice(in.density, in.mask, travel);
+    mColumns = std::make_unique<ShadowColumns>(
+        in, size_t(mCount[0]) * size_t(mCount[1]),
+        [this](size_t c, Vec3d& start, Vec3d& direction) {
+            const int i = int(c % size_t(mCount[0])), j = int(c / size_t(mCount[0]));
+            start = mU * (mOrigin.x() + i * mSpacing) + mV * (mOrigin.y() + j * mSpacing) +
+                    mW * mOrigin.z();
+            direction = mW;
+        },
+        length, spacing);
 }
 
 double ShadowMap::placeLattice(const FloatGrid& density, const openvdb::BoolGrid& mask,
@@ -136,94 +80,18 @@ double ShadowMap::placeLattice(const FloatGrid& density, const openvdb::BoolGrid
     return hi.z() - mOrigin.z() + 2.0 * mSpacing;
 }
 
-void ShadowMap::marchColumns(const FloatGrid& density, const PaddedLeaves& padded,
-                             const openvdb::BoolGrid& mask, bool levelSet, double length,
-                             double sigmaPerVoxel, openvdb::util::NullInterrupter* interrupter,
-                             std::vector<Column>& columns) const
+std::vector<Shadow> buildShadows(const MarchInputs& in, const std::vector<Light>& lights,
+                                 int shadowCacheVoxels)
 {
-    const Intersector master(mask);
-    tbb::parallel_for(tbb::blocked_range<size_t>(0, columns.size(), 64),
-                      [&](const tbb::blocked_range<size_t>& range) {
-                          Intersector inter(master);
-                          DensityReader acc(density.tree(), padded);
-                          for (size_t c = range.begin(); c != range.end(); ++c) {
-                              if (interrupter && interrupter->wasInterrupted()) return;
-                              const int i = int(c % size_t(mCount[0])),
-                                        j = int(c / size_t(mCount[0]));
-                              const Vec3d start = mU * (mOrigin.x() + i * mSpacing) +
-                                                  mV * (mOrigin.y() + j * mSpacing) +
-                                                  mW * mOrigin.z();
-                              march(inter, acc, levelSet, start, length, sigmaPerVoxel, columns[c]);
-                          }
-                      });
-}
-
-void ShadowMap::pack(const std::vector<Column>& columns)
-{
-    size_t total = 0;
-    for (const Column& c : columns) total += c.values.size();
-    mData.reserve(total);
-    mSpans.resize(columns.size());
-    for (size_t c = 0; c < columns.size(); ++c) {
-        const Column& col = columns[c];
-        mSpans[c] = Span{col.first, int(col.values.size()), col.last, uint32_t(mData.size())};
-        mData.insert(mData.end(), col.values.begin(), col.values.end());
-    }
-}
-
-void ShadowMap::march(Intersector& inter, DensityReader& acc, bool levelSet, const Vec3d& start,
-                      double length, double sigmaPerVoxel, Column& column) const
-{
-    if (!inter.setWorldRay(VdbRay(start, mW, 0.0, length))) return;
-    const Medium1D ray{inter.getIndexPos(0.0), inter.getIndexPos(1.0) - inter.getIndexPos(0.0),
-                       levelSet};
-    // Index time per lattice step (the index ray has unit speed in voxels).
-    const double h = inter.getWorldTime(1.0) > 0.0 ? mSpacing / inter.getWorldTime(1.0) : mSpacing;
-    double tau = 0.0, t0 = 0.0, t1 = 0.0;
-    int k = -1; // the last lattice index stored
-    auto push = [&] {
-        column.values.push_back(float(std::exp(-tau)));
-        ++k;
-    };
-    bool going = true;
-    while (going && inter.march(t0, t1)) {
-        if (k < 0) { // nothing is absorbed before the first span: the column starts there
-            column.first = int(std::floor(t0 / h));
-            k = column.first - 1;
-        }
-        going = walkCells(acc, ray, t0, t1, [&](const Cell& cell, double ta, double tb) {
-            // Split the piece at the lattice points inside it.
-            for (double tk = (k + 1) * h; tk <= tb; tk = (k + 1) * h) {
-                if (tk > ta) {
-                    tau += sigmaPerVoxel * ray.mass(cell, ta, tk);
-                    ta = tk;
-                }
-                push();
-            }
-            tau += sigmaPerVoxel * ray.mass(cell, ta, tb);
-            return tau <= kMaxOpticalDepth + 2.0;
-        });
-        while ((k + 1) * h <= t1) push();
-    }
-    column.last = float(std::exp(-tau));
-}
-std::vector<Shadow> buildShadows(const FloatGrid& density, const PaddedLeaves& padded,
-                                 const openvdb::BoolGrid& mask, bool levelSet,
-                                 const std::vector<Light>& lights, double sigmaPerVoxel,
-                                 int shadowCacheVoxels, openvdb::util::NullInterrupter* interrupter)
-{
-    const double voxel = density.voxelSize()[0];
     std::vector<Shadow> shadows(lights.size());
+    if (shadowCacheVoxels <= 0) return shadows; // exact transmittance per sample: nothing to build
+    const double spacing = in.density.voxelSize()[0] * shadowCacheVoxels;
     for (size_t l = 0; l < lights.size(); ++l) {
-        if (interrupter && interrupter->wasInterrupted()) break;
-        if (shadowCacheVoxels <= 0) break; // exact transmittance per sample: nothing to build
+        if (in.interrupter && in.interrupter->wasInterrupted()) break;
         if (lights[l].type == Light::Type::Directional)
-            shadows[l].map = std::make_unique<ShadowMap>(
-                density, padded, mask, levelSet, lights[l].direction, sigmaPerVoxel,
-                voxel * std::max(1, shadowCacheVoxels), interrupter);
+            shadows[l].map = std::make_unique<ShadowMap>(in, lights[l].direction, spacing);
         else if (lights[l].type == Light::Type::Point)
-            shadows[l].cache = pointLightCache(density, padded, mask, levelSet, lights[l],
-                                               sigmaPerVoxel, shadowCacheVoxels, interrupter);
+            shadows[l].point = std::make_unique<PointShadowMap>(in, lights[l].position, spacing);
     }
     return shadows;
 }

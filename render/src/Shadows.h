@@ -1,11 +1,14 @@
 // Shadows: the transmittance from a point of the volume toward each light, precomputed once per
-// image. For a directional light, a deep shadow map (Lokovic and Veach 2000); for a point light, a
-// grid of exact marches toward it. Both are built in parallel and stop early when interrupted.
+// image: a deep shadow map (Lokovic and Veach 2000) of parallel rays for a directional light, of
+// rays leaving the light for a point light. Both are built in parallel and stop early when
+// interrupted.
 #pragma once
 
 #include <volmorph/render/Renderer.h>
 
 #include "GridReaders.h"
+#include "PointShadowMap.h"
+#include "ShadowColumns.h"
 
 #include <openvdb/util/NullInterrupter.h>
 
@@ -22,15 +25,12 @@ double opticalDepth(Intersector& inter, bool levelSet, DensityReader& acc, const
 /// Transmittance toward a directional light: a deep shadow map (Lokovic and Veach). A lattice of
 /// columns parallel to the light, `spacing` world units apart, each marched once through the
 /// volume cell by cell, keeping the transmittance every `spacing` along it; looked up by bilinear
-/// interpolation across columns and linear along them. Only the span of each column that crosses
-/// the occupied region is stored.
+/// interpolation across columns and linear along them.
 class ShadowMap {
 public:
-    /// `travel`: the way the light travels. Columns are skipped once `interrupter` asks to stop
+    /// `travel`: the way the light travels. Columns are skipped once the interrupter asks to stop
     /// (the map is then incomplete: the caller checks the interrupter and discards it).
-    ShadowMap(const openvdb::FloatGrid& density, const PaddedLeaves& padded,
-              const openvdb::BoolGrid& mask, bool levelSet, const Vec3d& travel,
-              double sigmaPerVoxel, double spacing, openvdb::util::NullInterrupter* interrupter);
+    ShadowMap(const MarchInputs& in, const Vec3d& travel, double spacing);
 
     /// Transmittance toward the light at index point ip of the density grid.
     double lookup(const Vec3d& ip) const
@@ -52,40 +52,17 @@ public:
         auto column = [&](int ci, int cj) __attribute__((always_inline))
         {
             if (ci < 0 || cj < 0 || ci >= mCount[0] || cj >= mCount[1]) return 1.0;
-            const Span& span = mSpans[size_t(cj) * size_t(mCount[0]) + size_t(ci)];
-            const float* data = mData.data() + span.offset;
-            auto at = [&](int kk) {
-                const int i = kk - span.first;
-                return i < 0 ? 1.0 : i < span.count ? double(data[i]) : double(span.last);
-            };
-            return (1.0 - w) * at(k) + w * at(k + 1);
+            return mColumns->along(size_t(cj) * size_t(mCount[0]) + size_t(ci), k, w);
         };
         return (1.0 - v) * ((1.0 - u) * column(i, j) + u * column(i + 1, j)) +
                v * ((1.0 - u) * column(i, j + 1) + u * column(i + 1, j + 1));
     }
 
 private:
-    struct Column {
-        int first = 0;     ///< lattice index of values[0]; before it the transmittance is 1
-        float last = 1.0f; ///< the transmittance after the stored span
-        std::vector<float> values;
-    };
-
     /// The light's frame, the lattice's origin, size and index-space map; returns the columns'
     /// length in world units.
     double placeLattice(const openvdb::FloatGrid& density, const openvdb::BoolGrid& mask,
                         const Vec3d& travel);
-    /// Marches every column (in parallel) into `columns`.
-    void marchColumns(const openvdb::FloatGrid& density, const PaddedLeaves& padded,
-                      const openvdb::BoolGrid& mask, bool levelSet, double length,
-                      double sigmaPerVoxel, openvdb::util::NullInterrupter* interrupter,
-                      std::vector<Column>& columns) const;
-    /// One column: the transmittance at each lattice point from `start` along the light for
-    /// `length`.
-    void march(Intersector& inter, DensityReader& acc, bool levelSet, const Vec3d& start,
-               double length, double sigmaPerVoxel, Column& column) const;
-    /// The columns packed into one contiguous array for lookups.
-    void pack(const std::vector<Column>& columns);
 
     const openvdb::FloatGrid& mDensity;
     Vec3d mU, mV, mW, mOrigin; ///< light frame; origin in its coordinates (world units)
@@ -93,28 +70,18 @@ private:
     bool mLinear = false;
     Vec3d mRow[3], mOffset; ///< index space to lattice coordinates, for a linear transform
     int mCount[2];
-    struct Span {         ///< a column in mData
-        int first, count; ///< lattice index of its first value, and how many
-        float last;       ///< the transmittance past its last value
-        uint32_t offset;
-    };
-    std::vector<Span> mSpans;
-    std::vector<float> mData;
+    std::unique_ptr<ShadowColumns> mColumns;
 };
 
-/// One light's shadow: a deep shadow map for a directional light, a grid of marches for a point
-/// light.
+/// One light's shadow: a deep shadow map, parallel for a directional light, around a point light.
 struct Shadow {
     std::unique_ptr<ShadowMap> map;
-    openvdb::FloatGrid::Ptr cache; ///< transmittance, `shadowCacheVoxels` times the density's voxel
+    std::unique_ptr<PointShadowMap> point;
 };
 
 /// The shadows of every light, in the order of `lights`; spacing `shadowCacheVoxels` voxels.
 /// Returns early (with incomplete shadows) once `interrupter` asks to stop: the caller checks it.
-std::vector<Shadow> buildShadows(const openvdb::FloatGrid& density, const PaddedLeaves& padded,
-                                 const openvdb::BoolGrid& mask, bool levelSet,
-                                 const std::vector<Light>& lights, double sigmaPerVoxel,
-                                 int shadowCacheVoxels,
-                                 openvdb::util::NullInterrupter* interrupter);
+std::vector<Shadow> buildShadows(const MarchInputs& in, const std::vector<Light>& lights,
+                                 int shadowCacheVoxels);
 
 } // namespace volmorph::render

@@ -20,10 +20,12 @@
 // Shadows: for a directional light, a deep shadow map (Lokovic and Veach 2000): columns parallel to
 // the light every `shadowCacheVoxels` voxels, each integrated exactly cell by cell through the
 // volume once per image, keeping the transmittance every `shadowCacheVoxels` along it, and looked
-// up with trilinear interpolation in the light's frame. For a point light, a grid of the same
-// spacing over the occupied region, one exact march toward the light per grid point. The error of
-// both is the interpolation of transmittance over that spacing (smooth fields: second order; a
-// sharp shadow edge is blurred over the spacing); the tests measure it against a closed form.
+// up with trilinear interpolation in the light's frame. For a point light, the same with rays
+// leaving the light through a cube map's lattice, at most that spacing apart across the occupied
+// region, sampled every `shadowCacheVoxels` of distance from the light: the cost grows with the
+// region's cross-section, not its volume. The error of both is the interpolation of transmittance
+// over that spacing (smooth fields: second order; a sharp shadow edge is blurred over the
+// spacing); the tests measure it against the exact march and a closed form.
 //
 // Sampling: one ray through each pixel centre for samples = 1; otherwise stratified, jittered
 // positions seeded by pixel, sample, frame and seed. Nothing depends on the thread count, so
@@ -67,7 +69,7 @@ struct Medium {
 struct RenderSettings {
     int samples = 4;         ///< per pixel, stratified and jittered; 1 = through the pixel centre
     double stepVoxels = 0.5; ///< longest step of the scattering integral along a primary ray
-    /// The single-scattering estimator's shadow map and point-light grid spacing, in voxels (1 =
+    /// The single-scattering estimator's shadow maps' spacing, in voxels (1 =
     /// every voxel); 0: no cache, the exact transmittance toward each light marched per sample (the
     /// reference the caches are judged by). Traced paths need none: they estimate the
     /// transmittance toward lights by ratio tracking, without bias.

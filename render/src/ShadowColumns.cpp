@@ -1,0 +1,93 @@
+#include "ShadowColumns.h"
+
+#include "CellWalk.h"
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+#include <cmath>
+
+namespace volmorph::render {
+
+namespace {
+/// Rays marched before their values are packed: bounds the unpacked copies held at once.
+constexpr size_t kBatch = size_t(1) << 16;
+} // namespace
+
+ShadowColumns::ShadowColumns(const MarchInputs& in, size_t count, const RayOf& rayOf, double length,
+                             double spacing)
+{
+    mSpans.reserve(count);
+    const Intersector master(in.mask);
+    std::vector<Column> columns;
+    for (size_t first = 0; first < count; first += kBatch) {
+        if (in.interrupter && in.interrupter->wasInterrupted()) return;
+        columns.assign(std::min(kBatch, count - first), Column());
+        tbb::parallel_for(tbb::blocked_range<size_t>(0, columns.size(), 64),
+                          [&](const tbb::blocked_range<size_t>& range) {
+                              Intersector inter(master);
+                              DensityReader acc(in.density.tree(), in.padded);
+                              for (size_t c = range.begin(); c != range.end(); ++c) {
+                                  if (in.interrupter && in.interrupter->wasInterrupted()) return;
+                                  Vec3d start, direction;
+                                  rayOf(first + c, start, direction);
+                                  march(inter, acc, in, start, direction, length, spacing,
+                                        columns[c]);
+                              }
+                          });
+        pack(columns);
+    }
+}
+
+void ShadowColumns::pack(std::vector<Column>& columns)
+{
+    size_t total = mData.size();
+    for (const Column& c : columns) total += c.values.size();
+    if (total > mData.capacity()) mData.reserve(std::max(total, mData.capacity() * 3 / 2));
+    for (Column& col : columns) {
+        mSpans.push_back(Span{col.first, int(col.values.size()), col.last, mData.size()});
+        mData.insert(mData.end(), col.values.begin(), col.values.end());
+        std::vector<uint16_t>().swap(col.values);
+    }
+}
+
+void ShadowColumns::march(Intersector& inter, DensityReader& acc, const MarchInputs& in,
+                          const Vec3d& start, const Vec3d& direction, double length, double spacing,
+                          Column& column)
+{
+    if (!inter.setWorldRay(VdbRay(start, direction, 0.0, length))) return;
+    const Medium1D ray{inter.getIndexPos(0.0), inter.getIndexPos(1.0) - inter.getIndexPos(0.0),
+                       in.levelSet};
+    // Index time per step (the index ray has unit speed in voxels).
+    const double h = inter.getWorldTime(1.0) > 0.0 ? spacing / inter.getWorldTime(1.0) : spacing;
+    double tau = 0.0, t0 = 0.0, t1 = 0.0;
+    int k = -1; // the last step index stored
+    auto push = [&] {
+        column.values.push_back(uint16_t(std::lround(std::exp(-tau) * 65535.0)));
+        ++k;
+    };
+    bool going = true;
+    while (going && inter.march(t0, t1)) {
+        if (k < 0) { // nothing is absorbed before the first span: the column starts there
+            column.first = int(std::floor(t0 / h));
+            k = column.first - 1;
+        }
+        going = walkCells(acc, ray, t0, t1, [&](const Cell& cell, double ta, double tb) {
+            // Split the piece at the steps inside it.
+            for (double tk = (k + 1) * h; tk <= tb; tk = (k + 1) * h) {
+                if (tk > ta) {
+                    tau += in.sigmaPerVoxel * ray.mass(cell, ta, tk);
+                    ta = tk;
+                }
+                push();
+            }
+            tau += in.sigmaPerVoxel * ray.mass(cell, ta, tb);
+            return tau <= kMaxOpticalDepth + 2.0;
+        });
+        while ((k + 1) * h <= t1) push();
+    }
+    column.last = float(std::exp(-tau));
+}
+
+} // namespace volmorph::render
