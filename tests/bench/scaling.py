@@ -13,7 +13,10 @@ Prints a Markdown table. A run that fails (for example refused by the memory gua
 message in the row.
 
 usage: tests/bench/scaling.py [--build build] [--across 250,500,1000] [--modes sdf,density]
-                              [--resolution 640x360] [--no-render]
+                              [--resolution 640x360] [--no-render] [--memory-limit GIB]
+
+--memory-limit is passed to both commands (their default is half the machine's memory: 2048 across
+needs more).
 """
 import argparse
 import os
@@ -72,15 +75,17 @@ def frame_seconds(err):
     return float(m.group(1)) if m else None
 
 
-def measure(build, across, mode, resolution, render):
+def measure(build, across, mode, resolution, render, limit):
     volmorph = os.path.join(build, "bin", "volmorph")
     with tempfile.TemporaryDirectory() as tmp:
         scene = os.path.join(tmp, "scene.toml")
         open(scene, "w").write(scene_text(across, mode, resolution))
         cache = os.path.join(tmp, "cache")
         row = {"across": across, "mode": mode}
+        extra = ["--memory-limit", str(limit)] if limit else []
         wall, peak, err, code = run([volmorph, "morph", scene, "--frames", str(FRAME), "-v",
-                                     "--cache", cache, "-o", os.path.join(tmp, "m.####.vdb")])
+                                     "--cache", cache, "-o", os.path.join(tmp, "m.####.vdb")] +
+                                    extra)
         if code != 0:
             row["error"] = err.strip().splitlines()[-1] if err.strip() else "exit %d" % code
             return row
@@ -89,7 +94,8 @@ def measure(build, across, mode, resolution, render):
         row["morph_peak"] = peak
         if render:
             wall, peak, err, code = run([volmorph, "render", scene, "--frames", str(FRAME), "-v",
-                                         "--cache", cache, "-o", os.path.join(tmp, "r.####.exr")])
+                                         "--cache", cache, "-o", os.path.join(tmp, "r.####.exr")] +
+                                        extra)
             if code != 0:
                 row["error"] = err.strip().splitlines()[-1] if err.strip() else "exit %d" % code
                 return row
@@ -112,13 +118,15 @@ def main():
     parser.add_argument("--modes", default="sdf,density")
     parser.add_argument("--resolution", default="640x360")
     parser.add_argument("--no-render", action="store_true")
+    parser.add_argument("--memory-limit", type=float, default=0.0)
     args = parser.parse_args()
     print("| across | mode | setup (s) | frame %d (s) | render (s) | morph peak (GB) | "
           "render peak (GB) |" % FRAME)
     print("|---|---|---:|---:|---:|---:|---:|")
     for across in [int(a) for a in args.across.split(",")]:
         for mode in args.modes.split(","):
-            row = measure(args.build, across, mode, args.resolution, not args.no_render)
+            row = measure(args.build, across, mode, args.resolution, not args.no_render,
+                          args.memory_limit)
             if "error" in row and "setup" not in row:
                 print("| %d | %s | %s |" % (across, mode, row["error"]))
             else:

@@ -27,8 +27,10 @@ class BlendMethod;
 struct MorphOptions {
     enum class Sampling { Trilinear, Triquadratic };
     Sampling sampling = Sampling::Trilinear;
-    /// A frame stops with a UserError once its output would need more than this many bytes
-    /// (kMorphBytesPerLeaf per kept 8^3 leaf); 0 = half the machine's memory.
+    /// A frame stops with a UserError once the process would hold more than this many bytes: what
+    /// it holds when the frame starts (the inputs, the setup, residentBytes()) plus its output,
+    /// kMorphBytesPerLeaf and the carried grids' bytes per kept 8^3 leaf; 0 = half the machine's
+    /// memory.
     uint64_t memoryLimitBytes = 0;
     /// The `vel` grid's time unit: the seconds one unit of t lasts ((last - first) / fps for a
     /// frame range). 0: no velocity grid.

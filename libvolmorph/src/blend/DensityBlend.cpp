@@ -3,6 +3,7 @@
 #include "blend/ColorBlend.h"
 #include "blend/ExtraGrids.h"
 #include "blend/Sample.h"
+#include "blend/UniformBlocks.h"
 #include "blend/VelocityBlend.h"
 #include "blend/VelocityReach.h"
 #include "blend/WithSampler.h"
@@ -11,6 +12,8 @@
 
 #include <openvdb/tools/Interpolation.h>
 #include <openvdb/tools/Prune.h>
+
+#include <optional>
 
 namespace volmorph::detail {
 namespace {
@@ -22,6 +25,33 @@ struct Resampler {
     const VolumeSet& target;
     float tauDensity, tauColor;
     Vec3f background;
+
+    struct Uniform {
+        float density;
+        Vec3f color;
+    };
+    /// The leaf's one density and colour, when all its points warp into blocks of one value on
+    /// both sides (the colour's only where that side weighs); nothing when some point may not.
+    std::optional<Uniform> uniform(const WarpLeaf& w) const
+    {
+        const openvdb::CoordBBox boxS = warpedBox(w.s), boxT = warpedBox(w.t);
+        auto ds = source.density->getConstAccessor();
+        auto dt = target.density->getConstAccessor();
+        float a, b;
+        if (!uniformOver(ds, boxS, a) || !uniformOver(dt, boxT, b)) return std::nullopt;
+        Uniform u{(1.0f - tauDensity) * a + tauDensity * b, background};
+        if (!(u.density > kEmpty)) return u;
+        // ColorBlend's mix, of each side's one colour.
+        const float wa = (1.0f - tauColor) * std::max(a, 0.0f), wb = tauColor * std::max(b, 0.0f);
+        if (!(wa + wb > 0.0f)) return u;
+        Vec3f ca(0.0f), cb(0.0f);
+        auto cs = source.color->getConstAccessor();
+        auto ct = target.color->getConstAccessor();
+        if (wa > 0.0f && !uniformOver(cs, boxS, ca)) return std::nullopt;
+        if (wb > 0.0f && !uniformOver(ct, boxT, cb)) return std::nullopt;
+        u.color = (wa * ca + wb * cb) / (wa + wb);
+        return u;
+    }
 
     /// Returns false when the leaf holds nothing. a, b: each side's density at the voxels'
     /// warped points, where the output is kept.
@@ -62,6 +92,12 @@ public:
         r.adaptive->forEachLeaf(
             r.box, r.sourceBlocks, r.targetBlocks,
             [&](const WarpLeaf& w) {
+                // A uniform interior is one tile (without `vel`: any velocity transports a
+                // uniform density), unless carried grids need the leaf's samples.
+                if (const auto u = extras.empty() ? resample.uniform(w) : std::nullopt) {
+                    if (u->density > kEmpty) leaves.uniformTile(w.origin, u->density, u->color);
+                    return;
+                }
                 auto [density, color] = leaves.make(w.origin, 0.0f);
                 float a[512], b[512];
                 if (!resample(w, *density, *color, a, b)) return;

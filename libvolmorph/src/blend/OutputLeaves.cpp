@@ -7,9 +7,12 @@
 
 namespace volmorph::detail {
 
-OutputLeaves::OutputLeaves(double t, uint64_t limitBytes, uint64_t bytesPerLeaf, Vec3f background)
-    : mT(t), mLimit(limitBytes),
-      mMaxLeaves(size_t(std::max<uint64_t>(1, limitBytes / bytesPerLeaf))), mBackground(background)
+OutputLeaves::OutputLeaves(double t, uint64_t limitBytes, uint64_t residentBytes,
+                           uint64_t bytesPerLeaf, Vec3f background)
+    : mT(t), mLimit(limitBytes), mResident(residentBytes),
+      mMaxLeaves(size_t(std::max<uint64_t>(
+          1, (limitBytes > residentBytes ? limitBytes - residentBytes : 0) / bytesPerLeaf))),
+      mBackground(background)
 {
 }
 
@@ -27,13 +30,14 @@ void OutputLeaves::keep(std::unique_ptr<ValueLeaf> value, std::unique_ptr<ColorL
 {
     std::lock_guard<std::mutex> lock(mMutex);
     if (mLeaves.size() >= mMaxLeaves) {
-        char text[300];
+        char text[400];
         std::snprintf(text, sizeof text,
                       "the in-between at t = %.4f needs more than the memory limit of %.1f GiB "
-                      "(over %zu blocks of 8^3 voxels); use a larger voxel size, check the "
-                      "feature pairs' scales, or raise --memory-limit (default: half the "
-                      "machine's memory)",
-                      mT, double(mLimit) / double(1ull << 30), mMaxLeaves);
+                      "(%.1f GiB in use before it, and over %zu blocks of 8^3 voxels); use a "
+                      "larger voxel size, check the feature pairs' scales, or raise "
+                      "--memory-limit (default: half the machine's memory)",
+                      mT, double(mLimit) / double(1ull << 30),
+                      double(mResident) / double(1ull << 30), mMaxLeaves);
         throw UserError(SourceLocation{"morph"}, text);
     }
     mLeaves.push_back(Kept{std::move(value), std::move(color), std::move(extras)});
@@ -43,6 +47,12 @@ void OutputLeaves::insideTile(const openvdb::Coord& origin)
 {
     std::lock_guard<std::mutex> lock(mMutex);
     mInside.push_back(origin);
+}
+
+void OutputLeaves::uniformTile(const openvdb::Coord& origin, float value, const Vec3f& color)
+{
+    std::lock_guard<std::mutex> lock(mMutex);
+    mUniform.push_back(Uniform{origin, value, color});
 }
 
 void OutputLeaves::moveInto(openvdb::FloatTree& values, openvdb::Vec3STree& colors,
@@ -63,6 +73,11 @@ void OutputLeaves::moveInto(openvdb::FloatTree& values, openvdb::Vec3STree& colo
     }
     mLeaves.clear();
     for (const openvdb::Coord& origin : mInside) values.addTile(1, origin, insideValue, false);
+    for (const Uniform& u : mUniform) {
+        values.addTile(1, u.origin, u.value, true);
+        colors.addTile(1, u.origin, u.color, true);
+    }
+    mUniform.clear();
 }
 
 } // namespace volmorph::detail

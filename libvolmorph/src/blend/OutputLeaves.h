@@ -37,9 +37,11 @@ public:
     using ValueLeaf = openvdb::FloatTree::LeafNodeType;
     using ColorLeaf = openvdb::Vec3STree::LeafNodeType;
 
-    /// t: the frame's, for the message; at most `limitBytes / bytesPerLeaf` leaves are kept;
-    /// colour leaves start at `background`.
-    OutputLeaves(double t, uint64_t limitBytes, uint64_t bytesPerLeaf, Vec3f background);
+    /// t: the frame's, for the message; at most `(limitBytes - residentBytes) / bytesPerLeaf`
+    /// leaves are kept (`residentBytes`: what the process holds before the frame); colour leaves
+    /// start at `background`.
+    OutputLeaves(double t, uint64_t limitBytes, uint64_t residentBytes, uint64_t bytesPerLeaf,
+                 Vec3f background);
     ~OutputLeaves();
     OutputLeaves(const OutputLeaves&) = delete;
     OutputLeaves& operator=(const OutputLeaves&) = delete;
@@ -53,6 +55,9 @@ public:
               ExtraLeaves extras = {});
     /// A leaf-sized tile inside the object (sdf mode).
     void insideTile(const openvdb::Coord& origin);
+    /// A leaf-sized block of one value and colour (density mode's uniform interiors): active
+    /// tiles of both trees.
+    void uniformTile(const openvdb::Coord& origin, float value, const Vec3f& color);
 
     size_t size() const { return mLeaves.size(); }
     const Vec3f& background() const { return mBackground; }
@@ -64,7 +69,7 @@ public:
 
 private:
     double mT;
-    uint64_t mLimit;
+    uint64_t mLimit, mResident;
     size_t mMaxLeaves;
     Vec3f mBackground;
     std::mutex mMutex;
@@ -75,6 +80,12 @@ private:
     };
     std::vector<Kept> mLeaves;
     std::vector<openvdb::Coord> mInside;
+    struct Uniform {
+        openvdb::Coord origin;
+        float value;
+        Vec3f color;
+    };
+    std::vector<Uniform> mUniform;
 };
 
 } // namespace volmorph::detail

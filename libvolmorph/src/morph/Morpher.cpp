@@ -159,7 +159,7 @@ VolumeSet Morpher::run(double t, const CoordBBox& box, bool prune, double tolera
         request.velocityScale = mSource.voxelSize() / mOptions.secondsPerUnitT;
     request.velocityReachSeconds = mOptions.velocityReachSeconds;
     const float tauColor = float(scheduleValue(mBlend.color, t));
-    detail::OutputLeaves leaves(t, mOptions.memoryLimitBytes,
+    detail::OutputLeaves leaves(t, mOptions.memoryLimitBytes, residentBytes(),
                                 kMorphBytesPerLeaf +
                                     detail::ExtraGrids::bytesPerLeaf(mSource, mTarget) +
                                     (request.velocityScale > 0.0 ? kVelocityBytesPerLeaf : 0),

@@ -143,13 +143,20 @@ Vec3SGrid::Ptr colorFromIndex(const Mesh& mesh, const Int32Grid* index, const Fl
     color->setName(kColorGridName);
     color->setGridClass(openvdb::GRID_UNKNOWN);
     color->setVectorType(openvdb::VEC_INVARIANT);
+    const bool interpolate = !constant && mesh.hasColors() && index;
+    if (!interpolate) {
+        // One colour everywhere: active tiles over the band's blocks, no voxels (a 1000-across
+        // sphere's band would hold 0.4 GB of equal colours as leaves).
+        for (auto leaf = sdf.tree().cbeginLeaf(); leaf; ++leaf)
+            color->tree().addTile(1, leaf->origin(), mean, true);
+        return color;
+    }
     color->tree().topologyUnion(sdf.tree());
     using ColorTree = Vec3SGrid::TreeType;
     openvdb::tree::LeafManager<ColorTree> leaves(color->tree());
-    const bool interpolate = !constant && mesh.hasColors() && index;
     const openvdb::math::Transform& xform = sdf.transform();
     leaves.foreach ([&](ColorTree::LeafNodeType& leaf, size_t) {
-        const auto* indexLeaf = interpolate ? index->tree().probeConstLeaf(leaf.origin()) : nullptr;
+        const auto* indexLeaf = index->tree().probeConstLeaf(leaf.origin());
         for (auto it = leaf.beginValueOn(); it; ++it) {
             Vec3f c = mean;
             if (indexLeaf) {

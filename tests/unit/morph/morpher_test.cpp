@@ -162,3 +162,42 @@ TEST(Morph, SdfFramesWithoutPairsMatchTheDenseReference)
     morpher.frame(0.5, &again);
     EXPECT_LT(again.blendSamples, firstSamples / 4);
 }
+
+TEST(Morph, DensityInteriorsAreTilesOfTheValuesSamplingGives)
+{
+    // Density mode keeps a leaf whose points all warp into blocks of one value on both sides as a
+    // tile (UniformBlocks.h). The same morph of sides whose tiles were made voxels samples every
+    // point: the frames agree voxel for voxel, bit for bit.
+    const OnePairMorph sphere = doublingSphere(0.02); // radius 25 voxels: interior blocks
+    auto voxelized = [](const VolumeSet& v) {
+        VolumeSet out = v;
+        out.density = v.density->deepCopy();
+        out.density->tree().voxelizeActiveTiles();
+        out.color = v.color->deepCopy();
+        out.color->tree().voxelizeActiveTiles();
+        return out;
+    };
+    BlendSpec blend;
+    blend.mode = BlendMode::Density;
+    const Morpher tiled(sphere.source, sphere.target, {sphere.pair}, WarpSpec{}, blend);
+    const Morpher sampled(voxelized(sphere.source), voxelized(sphere.target), {sphere.pair},
+                          WarpSpec{}, blend);
+    for (double t : {0.3, 0.7}) {
+        MorphStats a, b;
+        const VolumeSet x = tiled.frame(t, &a), y = sampled.frame(t, &b);
+        // The interior's blocks (50 at t = 0.3, 128 at t = 0.7) became tiles, not leaves.
+        EXPECT_GE(b.outputLeaves, a.outputLeaves + 40) << "t " << t;
+        EXPECT_EQ(a.activeVoxels, b.activeVoxels) << "t " << t;
+        auto xd = x.density->getConstAccessor();
+        auto xc = x.color->getConstAccessor();
+        auto yc = y.color->getConstAccessor();
+        size_t differ = 0;
+        for (auto it = y.density->cbeginValueOn(); it; ++it) {
+            const openvdb::Coord c =
+                it.getBoundingBox().min(); // a tile's first voxel stands for it
+            differ +=
+                !(xd.isValueOn(c) && xd.getValue(c) == *it && xc.getValue(c) == yc.getValue(c));
+        }
+        EXPECT_EQ(differ, 0u) << "t " << t;
+    }
+}

@@ -12,4 +12,9 @@ uint64_t defaultMemoryLimitBytes();
 /// A limit given in GiB (as the --memory-limit flags take it) in bytes; 0 means the default.
 uint64_t memoryLimitBytes(double gib);
 
+/// The process's resident memory now, after handing the allocator's free pages back to the system
+/// (memory it would reuse is not counted); 0 when it cannot be read. For guards that add what a
+/// stage will allocate to what is already held.
+uint64_t residentBytes();
+
 } // namespace volmorph
