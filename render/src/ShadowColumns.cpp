@@ -28,12 +28,14 @@ ShadowColumns::ShadowColumns(const MarchInputs& in, size_t count, const RayOf& r
                           [&](const tbb::blocked_range<size_t>& range) {
                               Intersector inter(master);
                               DensityReader acc(in.density.tree(), in.padded);
+                              std::vector<float> steps;
                               for (size_t c = range.begin(); c != range.end(); ++c) {
                                   if (in.interrupter && in.interrupter->wasInterrupted()) return;
                                   Vec3d start, direction;
                                   rayOf(first + c, start, direction);
                                   march(inter, acc, in, start, direction, length, spacing,
-                                        columns[c]);
+                                        columns[c], steps);
+                                  compress(steps, columns[c]);
                               }
                           });
         pack(columns);
@@ -42,20 +44,21 @@ ShadowColumns::ShadowColumns(const MarchInputs& in, size_t count, const RayOf& r
 
 void ShadowColumns::pack(std::vector<Column>& columns)
 {
-    size_t total = mData.size();
-    for (const Column& c : columns) total += c.values.size();
-    if (total > mData.capacity()) mData.reserve(std::max(total, mData.capacity() * 3 / 2));
+    size_t total = mKnots.size();
+    for (const Column& c : columns) total += c.knots.size();
+    if (total > mKnots.capacity()) mKnots.reserve(std::max(total, mKnots.capacity() * 3 / 2));
     for (Column& col : columns) {
-        mSpans.push_back(Span{col.first, int(col.values.size()), col.last, mData.size()});
-        mData.insert(mData.end(), col.values.begin(), col.values.end());
-        std::vector<uint16_t>().swap(col.values);
+        mSpans.push_back(Span{col.first, int(col.knots.size()), col.last, mKnots.size()});
+        mKnots.insert(mKnots.end(), col.knots.begin(), col.knots.end());
+        std::vector<Knot>().swap(col.knots);
     }
 }
 
 void ShadowColumns::march(Intersector& inter, DensityReader& acc, const MarchInputs& in,
                           const Vec3d& start, const Vec3d& direction, double length, double spacing,
-                          Column& column)
+                          Column& column, std::vector<float>& steps)
 {
+    steps.clear();
     if (!inter.setWorldRay(VdbRay(start, direction, 0.0, length))) return;
     const Medium1D ray{inter.getIndexPos(0.0), inter.getIndexPos(1.0) - inter.getIndexPos(0.0),
                        in.levelSet};
@@ -64,7 +67,7 @@ void ShadowColumns::march(Intersector& inter, DensityReader& acc, const MarchInp
     double tau = 0.0, t0 = 0.0, t1 = 0.0;
     int k = -1; // the last step index stored
     auto push = [&] {
-        column.values.push_back(uint16_t(std::lround(std::exp(-tau) * 65535.0)));
+        steps.push_back(float(std::exp(-tau)));
         ++k;
     };
     bool going = true;
@@ -88,6 +91,36 @@ void ShadowColumns::march(Intersector& inter, DensityReader& acc, const MarchInp
         while ((k + 1) * h <= t1) push();
     }
     column.last = float(std::exp(-tau));
+}
+
+void ShadowColumns::compress(const std::vector<float>& steps, Column& column)
+{
+    const int n = int(std::min<size_t>(steps.size(), 65535));
+    if (n == 0) return;
+    auto keep = [&](int i) {
+        column.knots.push_back(
+            Knot{uint16_t(i), uint16_t(std::lround(double(steps[size_t(i)]) * 65535.0))});
+    };
+    // A segment from knot i0 may end at step j while its slope lies within the cone of every
+    // step between (the slopes that pass within kTolerance of it).
+    keep(0);
+    int i0 = 0;
+    double lo = -1e30, hi = 1e30;
+    for (int j = 1; j < n; ++j) {
+        const double slope =
+            (double(steps[size_t(j)]) - double(steps[size_t(i0)])) / double(j - i0);
+        if (slope < lo || slope > hi) {
+            keep(j - 1);
+            i0 = j - 1;
+            lo = -1e30;
+            hi = 1e30;
+        }
+        const double d = double(j - i0), v = double(steps[size_t(j)]) - double(steps[size_t(i0)]);
+        lo = std::max(lo, (v - kTolerance) / d);
+        hi = std::min(hi, (v + kTolerance) / d);
+    }
+    if (n > 1) keep(n - 1);
+    if (int(steps.size()) > n) column.last = steps[size_t(n - 1)];
 }
 
 } // namespace volmorph::render

@@ -1,14 +1,19 @@
-// Rays marched once each through the volume, keeping the transmittance at even steps along them:
-// the storage both deep shadow maps share (Lokovic and Veach 2000). ShadowMap's rays are parallel
-// (a directional light), PointShadowMap's leave a point light. A ray stores only the span from
-// where it first meets the occupied region to where the volume has absorbed it, packed into one
-// array.
+// Rays marched once each through the volume, keeping the transmittance along them: the storage
+// both deep shadow maps share (Lokovic and Veach 2000). ShadowMap's rays are parallel (a
+// directional light), PointShadowMap's leave a point light. A ray is marched from where it first
+// meets the occupied region to where the volume has absorbed it, its transmittance taken every
+// step, and stored as Lokovic and Veach store a visibility function: the fewest knots whose
+// piecewise-linear interpolation stays within kTolerance of every step's value (a greedy cone of
+// feasible slopes). Transmittance decays smoothly inside a medium, so a ray needs a few dozen knots
+// at any voxel size, where every step would be some hundreds at 1000 voxels across: the maps grow
+// with the region's cross-section, not its volume.
 #pragma once
 
 #include "GridReaders.h"
 
 #include <openvdb/util/NullInterrupter.h>
 
+#include <algorithm>
 #include <cstdint>
 #include <functional>
 #include <vector>
@@ -29,54 +34,70 @@ class ShadowColumns {
 public:
     /// Ray c of `count` starts at world point `start` and goes along unit `direction`; rayOf(c,
     /// start, direction) says where. Each is marched for `length` world units, its transmittance
-    /// kept every `spacing` world units from its start; in parallel, deterministically. Rays are
+    /// taken every `spacing` world units from its start; in parallel, deterministically. Rays are
     /// skipped once the interrupter asks to stop (the caller checks it and discards the result).
     using RayOf = std::function<void(size_t c, Vec3d& start, Vec3d& direction)>;
     ShadowColumns(const MarchInputs& in, size_t count, const RayOf& rayOf, double length,
                   double spacing);
 
-    /// The transmittance of ray c at its k-th step (k spacings from its start): 1 before its
-    /// stored span, its final transmittance after it.
-    double at(size_t c, int k) const
-    {
-        const Span& span = mSpans[c];
-        const int i = k - span.first;
-        return i < 0            ? 1.0
-               : i < span.count ? double(mData[span.offset + size_t(i)]) * kUnit
-                                : double(span.last);
-    }
-
-    /// Linear interpolation along ray c at fractional step k + w.
+    /// The transmittance of ray c at fractional step k + w (k + w spacings from its start): 1
+    /// before its stored span, its final transmittance after it, linear between knots.
     double along(size_t c, int k, double w) const
     {
-        return (1.0 - w) * at(c, k) + w * at(c, k + 1);
+        const Span& span = mSpans[c];
+        const double x = double(k - span.first) + w; // steps from the span's first
+        if (x <= -1.0) return 1.0;
+        if (span.count == 0) return x >= 0.0 ? double(span.last) : lerp(1.0, span.last, x + 1.0);
+        const Knot* knots = mKnots.data() + span.offset;
+        if (x < 0.0) return lerp(1.0, value(knots[0]), x + 1.0);
+        const Knot& end = knots[span.count - 1];
+        if (x >= double(end.step))
+            return x >= double(end.step) + 1.0 ? double(span.last)
+                                               : lerp(value(end), span.last, x - double(end.step));
+        const Knot* hi =
+            std::upper_bound(knots, knots + span.count, x,
+                             [](double v, const Knot& k) { return v < double(k.step); });
+        const Knot* lo = hi - 1;
+        return lerp(value(*lo), value(*hi), (x - double(lo->step)) / double(hi->step - lo->step));
     }
 
-    size_t bytes() const { return mSpans.size() * sizeof(Span) + mData.size() * sizeof(uint16_t); }
+    size_t bytes() const { return mSpans.size() * sizeof(Span) + mKnots.size() * sizeof(Knot); }
+
+    /// The largest error of the knots' interpolation against the steps' transmittance.
+    static constexpr double kTolerance = 2.5e-4;
 
 private:
-    static constexpr double kUnit = 1.0 / 65535.0; ///< the transmittance of one stored step
+    struct Knot {
+        uint16_t step;  ///< steps from the span's first
+        uint16_t value; ///< transmittance, 16-bit fixed point
+    };
+    static double value(const Knot& k) { return double(k.value) * (1.0 / 65535.0); }
+    static double lerp(double a, double b, double w) { return a + (b - a) * w; }
 
     struct Column {
-        int first = 0;     ///< step index of values[0]
+        int first = 0;     ///< step index of the first knot
         float last = 1.0f; ///< the transmittance past the stored span
-        std::vector<uint16_t> values;
+        std::vector<Knot> knots;
     };
-    struct Span {         ///< a column in mData
-        int first, count; ///< step index of its first value, and how many
-        float last;       ///< the transmittance past its last value
+    struct Span {         ///< a column in mKnots
+        int first, count; ///< step index of its first knot, and how many knots
+        float last;       ///< the transmittance past its last knot
         uint64_t offset;
     };
 
-    /// One ray: the transmittance at each step from `start` along `direction` for `length`.
+    /// One ray: the transmittance at each step from `start` along `direction` for `length`, into
+    /// `steps` (from column.first on).
     static void march(Intersector& inter, DensityReader& acc, const MarchInputs& in,
                       const Vec3d& start, const Vec3d& direction, double length, double spacing,
-                      Column& column);
+                      Column& column, std::vector<float>& steps);
+    /// The knots of `steps` (at most 65535 steps are kept: a ray longer than that inside the
+    /// region, past some 37,000 voxels across, keeps its value there).
+    static void compress(const std::vector<float>& steps, Column& column);
     /// Appends a batch of marched columns to the packed array (and frees theirs).
     void pack(std::vector<Column>& columns);
 
     std::vector<Span> mSpans;
-    std::vector<uint16_t> mData;
+    std::vector<Knot> mKnots;
 };
 
 } // namespace volmorph::render
