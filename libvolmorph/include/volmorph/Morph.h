@@ -29,8 +29,8 @@ struct MorphOptions {
     Sampling sampling = Sampling::Trilinear;
     /// A frame stops with a UserError once the process would hold more than this many bytes: what
     /// it holds when the frame starts (the inputs, the setup, residentBytes()) plus its output,
-    /// kMorphBytesPerLeaf and the carried grids' bytes per kept 8^3 leaf; 0 = half the machine's
-    /// memory.
+    /// kMorphBytesPerLeaf (kDensityBytesPerLeaf in density mode) and the carried grids' bytes per
+    /// kept 8^3 leaf; 0 = half the machine's memory.
     uint64_t memoryLimitBytes = 0;
     /// The `vel` grid's time unit: the seconds one unit of t lasts ((last - first) / fps for a
     /// frame range). 0: no velocity grid.
@@ -44,9 +44,12 @@ struct MorphOptions {
     Interrupter* setupInterrupter = nullptr;
 };
 
-/// What one kept output leaf costs while a frame is made: density, colour and, in sdf mode, the
-/// distance field and its fog, with the tools' temporaries (an upper estimate).
+/// What one kept output leaf costs while an sdf-mode frame is made: density, colour, the distance
+/// field and its fog, with the tools' temporaries (an upper estimate).
 inline constexpr uint64_t kMorphBytesPerLeaf = 24 * 1024;
+/// The same in density mode: a density and a colour leaf with their masks and bookkeeping (8.6 KiB
+/// a kept block measured at 1000 voxels across, BENCHMARKS.md), with a margin.
+inline constexpr uint64_t kDensityBytesPerLeaf = 12 * 1024;
 /// What the velocity adds per kept leaf: its values and mask, and both sides' velocities while
 /// the leaf is filled; in sdf mode also each side's distance and the normal correction (an upper
 /// estimate for both modes).

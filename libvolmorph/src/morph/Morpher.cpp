@@ -159,11 +159,12 @@ VolumeSet Morpher::run(double t, const CoordBBox& box, bool prune, double tolera
         request.velocityScale = mSource.voxelSize() / mOptions.secondsPerUnitT;
     request.velocityReachSeconds = mOptions.velocityReachSeconds;
     const float tauColor = float(scheduleValue(mBlend.color, t));
-    detail::OutputLeaves leaves(t, mOptions.memoryLimitBytes, residentBytes(),
-                                kMorphBytesPerLeaf +
-                                    detail::ExtraGrids::bytesPerLeaf(mSource, mTarget) +
-                                    (request.velocityScale > 0.0 ? kVelocityBytesPerLeaf : 0),
-                                detail::blendedColorBackground(mSource, mTarget, tauColor));
+    detail::OutputLeaves leaves(
+        t, mOptions.memoryLimitBytes, residentBytes(),
+        (mBlend.mode == BlendMode::Density ? kDensityBytesPerLeaf : kMorphBytesPerLeaf) +
+            detail::ExtraGrids::bytesPerLeaf(mSource, mTarget) +
+            (request.velocityScale > 0.0 ? kVelocityBytesPerLeaf : 0),
+        detail::blendedColorBackground(mSource, mTarget, tauColor));
     detail::BlendedFrame frame = mMethod->frame(request, leaves);
     finish(frame.grids, mSource.density->transform(), stats, frame);
     return std::move(frame.grids);
