@@ -60,14 +60,11 @@ double PointShadowMap::placeFaces(const openvdb::BoolGrid& mask)
     mAxes[0] =
         (std::abs(mAxes[2].x()) < 0.9 ? Vec3d(1, 0, 0) : Vec3d(0, 1, 0)).cross(mAxes[2]).unit();
     mAxes[1] = mAxes[2].cross(mAxes[0]);
-    std::array<Vec3d, 8> corners;
+    std::array<Vec3d, 8> corners = occupiedCorners(mDensity, mask);
     double reach = 0.0;
-    for (int c = 0; c < 8; ++c) {
-        const Vec3d corner((c & 1) ? box.max().x() + 1.0 : box.min().x() - 1.0,
-                           (c & 2) ? box.max().y() + 1.0 : box.min().y() - 1.0,
-                           (c & 4) ? box.max().z() + 1.0 : box.min().z() - 1.0);
-        const Vec3d w = mDensity.indexToWorld(corner) - mLight;
-        corners[size_t(c)] = Vec3d(w.dot(mAxes[0]), w.dot(mAxes[1]), w.dot(mAxes[2]));
+    for (Vec3d& corner : corners) {
+        const Vec3d w = corner - mLight;
+        corner = Vec3d(w.dot(mAxes[0]), w.dot(mAxes[1]), w.dot(mAxes[2]));
         reach = std::max(reach, w.length());
     }
     // The region's directions from the light project onto the front face's square (a convex

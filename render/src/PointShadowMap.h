@@ -32,18 +32,8 @@ public:
         if (!(major > 0.0)) return 1.0; // the light itself
         const Face& f = mFaces[2 * axis + (d[axis] < 0.0 ? 1 : 0)];
         const double a = (d[(axis + 1) % 3] / major + 1.0) * mHalf - f.i0,
-                     b = (d[(axis + 2) % 3] / major + 1.0) * mHalf - f.j0,
-                     r = dw.length() / mSpacing;
-        const double fa = std::floor(a), fb = std::floor(b), fr = std::floor(r);
-        const int i = int(fa), j = int(fb), k = int(fr);
-        const double u = a - fa, v = b - fb, w = r - fr;
-        auto ray = [&](int ci, int cj) __attribute__((always_inline))
-        {
-            if (ci < 0 || cj < 0 || ci >= f.width || cj >= f.height) return 1.0;
-            return mColumns->along(f.first + size_t(cj) * size_t(f.width) + size_t(ci), k, w);
-        };
-        return (1.0 - v) * ((1.0 - u) * ray(i, j) + u * ray(i + 1, j)) +
-               v * ((1.0 - u) * ray(i, j + 1) + u * ray(i + 1, j + 1));
+                     b = (d[(axis + 2) % 3] / major + 1.0) * mHalf - f.j0;
+        return mColumns->across(f.first, f.width, f.height, a, b, dw.length() / mSpacing);
     }
 
     /// Lattice points along a face's edge (the face has (resolution + 1)^2).

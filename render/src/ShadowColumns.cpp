@@ -15,6 +15,19 @@ namespace {
 constexpr size_t kBatch = size_t(1) << 16;
 } // namespace
 
+std::array<Vec3d, 8> occupiedCorners(const openvdb::FloatGrid& density,
+                                     const openvdb::BoolGrid& mask)
+{
+    const openvdb::CoordBBox box = mask.evalActiveVoxelBoundingBox();
+    std::array<Vec3d, 8> corners;
+    for (int c = 0; c < 8; ++c)
+        corners[size_t(c)] =
+            density.indexToWorld(Vec3d((c & 1) ? box.max().x() + 1.0 : box.min().x() - 1.0,
+                                       (c & 2) ? box.max().y() + 1.0 : box.min().y() - 1.0,
+                                       (c & 4) ? box.max().z() + 1.0 : box.min().z() - 1.0));
+    return corners;
+}
+
 ShadowColumns::ShadowColumns(const MarchInputs& in, size_t count, const RayOf& rayOf, double length,
                              double spacing)
 {
@@ -44,9 +57,6 @@ ShadowColumns::ShadowColumns(const MarchInputs& in, size_t count, const RayOf& r
 
 void ShadowColumns::pack(std::vector<Column>& columns)
 {
-    size_t total = mKnots.size();
-    for (const Column& c : columns) total += c.knots.size();
-    if (total > mKnots.capacity()) mKnots.reserve(std::max(total, mKnots.capacity() * 3 / 2));
     for (Column& col : columns) {
         mSpans.push_back(Span{col.first, int(col.knots.size()), col.last, mKnots.size()});
         mKnots.insert(mKnots.end(), col.knots.begin(), col.knots.end());

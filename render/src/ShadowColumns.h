@@ -14,6 +14,8 @@
 #include <openvdb/util/NullInterrupter.h>
 
 #include <algorithm>
+#include <array>
+#include <cmath>
 #include <cstdint>
 #include <functional>
 #include <vector>
@@ -30,6 +32,11 @@ struct MarchInputs {
     openvdb::util::NullInterrupter* interrupter;
 };
 
+/// The occupied region's box (the mask's active voxels), one voxel wider, as its 8 corners in world
+/// space: what a shadow map's rays must cover.
+std::array<Vec3d, 8> occupiedCorners(const openvdb::FloatGrid& density,
+                                     const openvdb::BoolGrid& mask);
+
 class ShadowColumns {
 public:
     /// Ray c of `count` starts at world point `start` and goes along unit `direction`; rayOf(c,
@@ -40,12 +47,12 @@ public:
     ShadowColumns(const MarchInputs& in, size_t count, const RayOf& rayOf, double length,
                   double spacing);
 
-    /// The transmittance of ray c at fractional step k + w (k + w spacings from its start): 1
-    /// before its stored span, its final transmittance after it, linear between knots.
-    double along(size_t c, int k, double w) const
+    /// The transmittance of ray c at `steps` spacings from its start: 1 before its stored span,
+    /// its final transmittance after it, linear between knots.
+    double along(size_t c, double steps) const
     {
         const Span& span = mSpans[c];
-        const double x = double(k - span.first) + w; // steps from the span's first
+        const double x = steps - double(span.first); // steps from the span's first
         if (x <= -1.0) return 1.0;
         if (span.count == 0) return x >= 0.0 ? double(span.last) : lerp(1.0, span.last, x + 1.0);
         const Knot* knots = mKnots.data() + span.offset;
@@ -59,6 +66,22 @@ public:
                              [](double v, const Knot& k) { return v < double(k.step); });
         const Knot* lo = hi - 1;
         return lerp(value(*lo), value(*hi), (x - double(lo->step)) / double(hi->step - lo->step));
+    }
+
+    /// Bilinear across a lattice of rays (ray first + j width + i for 0 <= i < width and 0 <= j <
+    /// height; beyond it the transmittance is 1) at lattice coordinates (a, b), `steps` along.
+    double across(size_t first, int width, int height, double a, double b, double steps) const
+    {
+        const double fa = std::floor(a), fb = std::floor(b);
+        const int i = int(fa), j = int(fb);
+        const double u = a - fa, v = b - fb;
+        auto ray = [&](int ci, int cj) __attribute__((always_inline))
+        {
+            if (ci < 0 || cj < 0 || ci >= width || cj >= height) return 1.0;
+            return along(first + size_t(cj) * size_t(width) + size_t(ci), steps);
+        };
+        return (1.0 - v) * ((1.0 - u) * ray(i, j) + u * ray(i + 1, j)) +
+               v * ((1.0 - u) * ray(i, j + 1) + u * ray(i + 1, j + 1));
     }
 
     size_t bytes() const { return mSpans.size() * sizeof(Span) + mKnots.size() * sizeof(Knot); }

@@ -8,7 +8,6 @@
 
 namespace volmorph::render {
 
-using openvdb::CoordBBox;
 using openvdb::FloatGrid;
 
 /// Optical depth (index units times sigma) from world point p along `direction` for up to
@@ -50,13 +49,8 @@ double ShadowMap::placeLattice(const FloatGrid& density, const openvdb::BoolGrid
     mW = travel.unit();
     mU = (std::abs(mW.x()) < 0.9 ? Vec3d(1, 0, 0) : Vec3d(0, 1, 0)).cross(mW).unit();
     mV = mW.cross(mU);
-    const CoordBBox box = mask.evalActiveVoxelBoundingBox();
     Vec3d lo(std::numeric_limits<double>::max()), hi(-std::numeric_limits<double>::max());
-    for (int i = 0; i < 8; ++i) {
-        const Vec3d corner((i & 1) ? box.max().x() + 1.0 : box.min().x() - 1.0,
-                           (i & 2) ? box.max().y() + 1.0 : box.min().y() - 1.0,
-                           (i & 4) ? box.max().z() + 1.0 : box.min().z() - 1.0);
-        const Vec3d w = density.indexToWorld(corner);
+    for (const Vec3d& w : occupiedCorners(density, mask)) {
         const Vec3d l(w.dot(mU), w.dot(mV), w.dot(mW));
         lo = openvdb::math::minComponent(lo, l);
         hi = openvdb::math::maxComponent(hi, l);

@@ -46,16 +46,7 @@ public:
             b = (p.dot(mV) - mOrigin.y()) / mSpacing;
             c = (p.dot(mW) - mOrigin.z()) / mSpacing;
         }
-        const double fa = std::floor(a), fb = std::floor(b), fc = std::floor(c);
-        const int i = int(fa), j = int(fb), k = int(fc);
-        const double u = a - fa, v = b - fb, w = c - fc;
-        auto column = [&](int ci, int cj) __attribute__((always_inline))
-        {
-            if (ci < 0 || cj < 0 || ci >= mCount[0] || cj >= mCount[1]) return 1.0;
-            return mColumns->along(size_t(cj) * size_t(mCount[0]) + size_t(ci), k, w);
-        };
-        return (1.0 - v) * ((1.0 - u) * column(i, j) + u * column(i + 1, j)) +
-               v * ((1.0 - u) * column(i, j + 1) + u * column(i + 1, j + 1));
+        return mColumns->across(0, mCount[0], mCount[1], a, b, c);
     }
 
 private:
