@@ -13,6 +13,7 @@ find_package(OpenImageIO CONFIG REQUIRED)
 find_package(assimp CONFIG REQUIRED)
 find_package(tomlplusplus CONFIG REQUIRED)
 find_package(CLI11 CONFIG REQUIRED)
+find_package(Eigen3 3.3 REQUIRED NO_MODULE)
 
 # libnifti2 (NIfTI volumes). Debian 12's NIFTIConfig.cmake points at /usr/lib/libnifti2.so.2.1.0,
 # which the package installs under /usr/lib/<arch>/: find the library and headers directly.

@@ -25,6 +25,20 @@ struct VoxelizeArgs {
     bool quiet = false;
 };
 
+/// How the inside was decided, for the log and the file's metadata.
+const char* signName(VoxelizeStats::SignPath path)
+{
+    switch (path) {
+    case VoxelizeStats::SignPath::FloodFill:
+        return "flood fill (watertight, one shell)";
+    case VoxelizeStats::SignPath::ClosedShells:
+        return "closed shells (winding-number rule)";
+    case VoxelizeStats::SignPath::WindingNumber:
+        return "winding number";
+    }
+    return "";
+}
+
 int runVoxelize(const VoxelizeArgs& args)
 {
     // Signals are caught from the start: one arriving while the mesh is read (Assimp cannot be
@@ -59,15 +73,16 @@ int runVoxelize(const VoxelizeArgs& args)
     VdbWriteOptions write;
     write.metadata = {{"volmorph_source", std::filesystem::absolute(args.mesh).string()},
                       {"volmorph_voxel_size", voxel.str()},
-                      {"volmorph_sign", stats.usedWindingNumber ? "winding number" : "flood fill"},
+                      {"volmorph_sign", signName(stats.signPath)},
                       {"volmorph_version", versionString()}};
     writeVolumeSet(volumes, output, write);
     if (!args.quiet) {
         std::printf("%s: %zu triangles, %s\n", args.mesh.c_str(), mesh.triangles.size(),
                     describeTopology(mesh.report).c_str());
-        std::printf("voxel size %s world units; inside/outside by %s\n", voxel.str().c_str(),
-                    stats.usedWindingNumber ? "winding number"
-                                            : "flood fill (watertight, one shell)");
+        std::printf("voxel size %s world units; inside/outside by %s", voxel.str().c_str(),
+                    signName(stats.signPath));
+        if (stats.holesFilled) std::printf(", %zu holes filled", stats.holesFilled);
+        std::printf("\n");
         std::printf("sdf %llu active voxels, density %llu active voxels, %.2f s\n",
                     (unsigned long long)stats.sdfActiveVoxels,
                     (unsigned long long)stats.densityActiveVoxels, seconds);

@@ -69,7 +69,8 @@ void volmorphVoxelize(benchmark::State& state)
     }
     state.counters["density_active"] = double(stats.densityActiveVoxels);
     state.counters["sdf_active"] = double(stats.sdfActiveVoxels);
-    state.counters["winding"] = stats.usedWindingNumber ? 1 : 0;
+    state.counters["sign_path"] = double(int(stats.signPath));
+    state.counters["holes"] = double(stats.holesFilled);
     state.SetLabel(kMeshes[size_t(state.range(0))]);
 }
 

@@ -6,6 +6,8 @@
 // process with a time limit (see readIsolated).
 #include <volmorph/Mesh.h>
 
+#include "mesh/DisjointSets.h"
+
 #include <assimp/Importer.hpp>
 #include <assimp/postprocess.h>
 #include <assimp/scene.h>
@@ -54,18 +56,6 @@ std::string prefix(const std::filesystem::path& file, const SourceLocation& wher
     return where.file.empty() ? std::string() : "mesh '" + file.string() + "': ";
 }
 
-/// Union-find over vertices, for counting connected shells.
-struct DisjointSets {
-    std::vector<uint32_t> parent;
-    explicit DisjointSets(size_t n) : parent(n) { std::iota(parent.begin(), parent.end(), 0u); }
-    uint32_t find(uint32_t x)
-    {
-        while (parent[x] != x) x = parent[x] = parent[parent[x]];
-        return x;
-    }
-    void unite(uint32_t a, uint32_t b) { parent[find(a)] = find(b); }
-};
-
 } // namespace
 
 std::pair<Vec3d, Vec3d> Mesh::bounds() const
@@ -92,7 +82,7 @@ void analyzeTopology(Mesh& mesh)
     };
     std::unordered_map<uint64_t, EdgeUse> edges;
     edges.reserve(mesh.triangles.size() * 2);
-    DisjointSets sets(mesh.points.size());
+    detail::DisjointSets sets(mesh.points.size());
     for (const Vec3I& tri : mesh.triangles) {
         for (int k = 0; k < 3; ++k) {
             const uint32_t a = tri[k], b = tri[(k + 1) % 3];

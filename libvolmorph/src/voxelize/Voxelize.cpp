@@ -1,18 +1,15 @@
-// Mesh -> VolumeSet. See Voxelize.h for how inside and outside are decided.
-//
-// This is one of the few translation units that include OpenVDB's tools headers; keep it so.
+// Mesh -> VolumeSet. See Voxelize.h for how inside and outside are decided. OpenVDB's
+// meshToVolume is instantiated once, in voxelize/MeshBand.cpp.
 #include <volmorph/Voxelize.h>
 
+#include "mesh/HoleFill.h"
 #include "mesh/Orientation.h"
-#include "mesh/WindingNumber.h"
+#include "voxelize/MeshBand.h"
+#include "voxelize/WindingSign.h"
 
 #include <openvdb/math/Proximity.h>
-#include <openvdb/tools/MeshToVolume.h>
 #include <openvdb/tools/Prune.h>
-#include <openvdb/tools/SignedFloodFill.h>
 #include <openvdb/tree/LeafManager.h>
-
-#include <unistd.h>
 
 #include <algorithm>
 #include <cmath>
@@ -21,7 +18,6 @@
 namespace volmorph {
 namespace {
 
-using openvdb::Coord;
 using openvdb::FloatGrid;
 using openvdb::FloatTree;
 using openvdb::Int32Grid;
@@ -31,99 +27,12 @@ using openvdb::Vec3SGrid;
 /// (4 + 4 + 4 + 12), meshToVolume's temporaries (about 16), doubled for partly filled leaves.
 constexpr double kBytesPerBandVoxel = 80.0;
 
-void checkInterrupt(Interrupter* interrupter, int percent)
-{
-    if (interrupter && interrupter->wasInterrupted(percent)) throw Interrupted();
-}
-
 std::string gib(uint64_t bytes)
 {
     std::ostringstream s;
     s.precision(3);
     s << double(bytes) / double(1ull << 30) << " GiB";
     return s.str();
-}
-
-/// OpenVDB's unsigned mode leaves some voxels near the band's edge up to 0.6 voxel too far (its
-/// band expansion measures to a neighbour's triangle); the signed mode is exact. Each voxel here
-/// takes the nearest of the closest triangles of its 27-neighbourhood, which restores the exact
-/// distance (measured: worst 0.585 -> 0.14 voxel on a sphere at 128 across).
-void refineUnsignedDistance(FloatGrid& grid, const Int32Grid& index, const Mesh& mesh)
-{
-    const openvdb::math::Transform& xform = grid.transform();
-    openvdb::tree::LeafManager<FloatTree> leaves(grid.tree());
-    leaves.foreach ([&](FloatTree::LeafNodeType& leaf, size_t) {
-        auto indices = index.getConstAccessor();
-        int32_t candidates[27];
-        for (auto it = leaf.beginValueOn(); it; ++it) {
-            const Coord ijk = it.getCoord();
-            int count = 0;
-            for (int dx = -1; dx <= 1; ++dx)
-                for (int dy = -1; dy <= 1; ++dy)
-                    for (int dz = -1; dz <= 1; ++dz) {
-                        const int32_t t = indices.getValue(ijk.offsetBy(dx, dy, dz));
-                        if (t < 0 || size_t(t) >= mesh.triangles.size()) continue;
-                        if (std::find(candidates, candidates + count, t) == candidates + count)
-                            candidates[count++] = t;
-                    }
-            const Vec3d p = xform.indexToWorld(ijk);
-            double best = std::abs(*it);
-            for (int c = 0; c < count; ++c) {
-                const Vec3I& tri = mesh.triangles[size_t(candidates[c])];
-                Vec3d uvw;
-                const Vec3d q = openvdb::math::closestPointOnTriangleToPoint(
-                    Vec3d(mesh.points[tri[0]]), Vec3d(mesh.points[tri[1]]),
-                    Vec3d(mesh.points[tri[2]]), p, uvw);
-                best = std::min(best, (q - p).length());
-            }
-            it.setValue(float(best));
-        }
-    });
-}
-
-/// Gives each active voxel of an unsigned band its sign from the winding number, then fills the
-/// rest with OpenVDB's signedFloodFill and checks its work against the winding number: every tile
-/// at its centre, and every band leaf at its corners (a leaf whose check fails is evaluated voxel
-/// by voxel; this happens beside holes, where flood fill has no surface to stop at).
-void signByWindingNumber(FloatGrid& grid, const Mesh& mesh, Interrupter* interrupter)
-{
-    const detail::WindingNumber winding(mesh.points, mesh.triangles);
-    const openvdb::math::Transform& xform = grid.transform();
-    auto inside = [&](const Coord& ijk) { return winding(xform.indexToWorld(ijk)) > 0.5; };
-
-    openvdb::tree::LeafManager<FloatTree> leaves(grid.tree());
-    leaves.foreach ([&](FloatTree::LeafNodeType& leaf, size_t) {
-        for (auto it = leaf.beginValueOn(); it; ++it)
-            if (inside(it.getCoord())) it.setValue(-std::abs(*it));
-    });
-    checkInterrupt(interrupter, 70);
-
-    openvdb::tools::signedFloodFill(grid.tree());
-    checkInterrupt(interrupter, 75);
-
-    const float background = grid.background();
-    leaves.foreach ([&](FloatTree::LeafNodeType& leaf, size_t) {
-        bool agrees = true;
-        const Coord o = leaf.origin();
-        for (int c = 0; c < 8 && agrees; ++c) {
-            const Coord ijk = o.offsetBy((c & 1) ? 7 : 0, (c & 2) ? 7 : 0, (c & 4) ? 7 : 0);
-            if (!leaf.isValueOn(ijk)) agrees = inside(ijk) == (leaf.getValue(ijk) < 0.0f);
-        }
-        if (agrees) return;
-        for (auto it = leaf.beginValueOff(); it; ++it)
-            it.setValue(inside(it.getCoord()) ? -background : background);
-    });
-    checkInterrupt(interrupter, 80);
-
-    // A tile holds no band voxel, so no surface passes through it: one query at its centre decides
-    // it.
-    for (auto it = grid.tree().beginValueOff(); it; ++it) {
-        if (it.isVoxelValue()) continue;
-        const openvdb::CoordBBox box = it.getBoundingBox();
-        const Vec3d centre = xform.indexToWorld(0.5 * (box.min().asVec3d() + box.max().asVec3d()));
-        it.setValue(winding(centre) > 0.5 ? -background : background);
-    }
-    grid.setGridClass(openvdb::GRID_LEVEL_SET);
 }
 
 /// Colour on the band: vertex colours interpolated at the closest point of the closest triangle.
@@ -201,19 +110,23 @@ uint64_t checkBudget(const Mesh& input, const VoxelizeOptions& options, double v
     return estimate;
 }
 
-/// The sign from the winding number (else OpenVDB's flood fill): asked for, or, by default, for
-/// every mesh but a closed single shell.
-bool usesWindingNumber(const Mesh& input, const VoxelizeOptions& options)
+/// How `input` gets its sign (Voxelize.h): `prepared` is what is voxelized, the input itself or,
+/// unless it is a closed single shell, a copy with its orientation repaired and its holes filled.
+VoxelizeStats::SignPath prepareMesh(const Mesh& input, const VoxelizeOptions& options,
+                                    double voxelSize, Mesh& prepared, size_t& holesFilled)
 {
-    switch (options.sign) {
-    case VoxelizeOptions::Sign::FloodFill:
-        return false;
-    case VoxelizeOptions::Sign::WindingNumber:
-        return true;
-    case VoxelizeOptions::Sign::Auto:
-        break;
-    }
-    return !(input.report.watertight() && input.report.components == 1);
+    using Path = VoxelizeStats::SignPath;
+    const bool closedShell = input.report.watertight() && input.report.components == 1;
+    if (options.sign == VoxelizeOptions::Sign::FloodFill ||
+        (options.sign == VoxelizeOptions::Sign::Auto && closedShell))
+        return Path::FloodFill;
+    prepared = input;
+    detail::repairOrientation(prepared);
+    if (prepared.report.boundaryEdges > 0)
+        holesFilled = detail::fillHoles(prepared, voxelSize).holes;
+    if (options.sign == VoxelizeOptions::Sign::Auto && prepared.report.watertight())
+        return Path::ClosedShells;
+    return Path::WindingNumber;
 }
 
 } // namespace
@@ -282,34 +195,33 @@ VolumeSet voxelize(const Mesh& input, const VoxelizeOptions& options, Interrupte
     const uint64_t estimate = checkBudget(input, options, voxelSize, halfWidth, where);
 
     if (interrupter) interrupter->start("voxelize");
-    const bool useWinding = usesWindingNumber(input, options);
-    Mesh repaired;
-    if (useWinding) {
-        repaired = input;
-        detail::repairOrientation(repaired);
-    }
-    const Mesh& mesh = useWinding ? repaired : input;
+    Mesh prepared;
+    size_t holesFilled = 0;
+    const VoxelizeStats::SignPath path =
+        prepareMesh(input, options, voxelSize, prepared, holesFilled);
+    const Mesh& mesh = path == VoxelizeStats::SignPath::FloodFill ? input : prepared;
 
     const openvdb::math::Transform::Ptr xform =
         openvdb::math::Transform::createLinearTransform(voxelSize);
     std::vector<Vec3f> indexPoints(mesh.points.size());
     for (size_t i = 0; i < mesh.points.size(); ++i)
         indexPoints[i] = Vec3f(xform->worldToIndex(Vec3d(mesh.points[i])));
-    const openvdb::tools::QuadAndTriangleDataAdapter<Vec3f, Vec3I> adapter(indexPoints,
-                                                                           mesh.triangles);
 
     // The winding-number path refines OpenVDB's unsigned distances with the closest triangles.
-    const bool needIndex = useWinding || (!options.color && mesh.hasColors());
+    const bool winding = path == VoxelizeStats::SignPath::WindingNumber;
+    const bool needIndex = winding || (!options.color && mesh.hasColors());
     Int32Grid::Ptr index = needIndex ? Int32Grid::create(-1) : nullptr;
     openvdb::util::NullInterrupter none;
     openvdb::util::NullInterrupter& hook = interrupter ? *interrupter : none;
-    const int flags = useWinding ? openvdb::tools::UNSIGNED_DISTANCE_FIELD : 0;
-    FloatGrid::Ptr sdf = openvdb::tools::meshToVolume<FloatGrid>(hook, adapter, *xform, halfWidth,
-                                                                 halfWidth, flags, index.get());
-    checkInterrupt(interrupter, 60);
-    if (useWinding) {
-        refineUnsignedDistance(*sdf, *index, mesh);
-        signByWindingNumber(*sdf, mesh, interrupter);
+    FloatGrid::Ptr sdf =
+        path == VoxelizeStats::SignPath::ClosedShells
+            ? detail::closedShellsLevelSet(mesh, indexPoints, *xform, halfWidth, index.get(), hook)
+            : detail::meshBand(indexPoints, mesh.triangles, *xform, halfWidth, winding, index.get(),
+                               hook);
+    throwIfInterrupted(interrupter, 60);
+    if (winding) {
+        detail::refineUnsignedDistance(*sdf, *index, mesh);
+        detail::signByWindingNumber(*sdf, mesh, interrupter);
     }
     sdf->setName(kSdfGridName);
     sdf->setGridClass(openvdb::GRID_LEVEL_SET);
@@ -317,14 +229,15 @@ VolumeSet voxelize(const Mesh& input, const VoxelizeOptions& options, Interrupte
     VolumeSet out;
     out.sdf = sdf;
     out.density = fogFromLevelSet(*sdf, options.densityRampVoxels * float(voxelSize));
-    checkInterrupt(interrupter, 90);
+    throwIfInterrupted(interrupter, 90);
     out.color = colorFromIndex(mesh, index.get(), *sdf, options.color);
-    checkInterrupt(interrupter, 100);
+    throwIfInterrupted(interrupter, 100);
     if (interrupter) interrupter->end();
 
     if (stats) {
         stats->voxelSize = voxelSize;
-        stats->usedWindingNumber = useWinding;
+        stats->signPath = path;
+        stats->holesFilled = holesFilled;
         stats->estimatedBytes = estimate;
         stats->sdfActiveVoxels = out.sdf->activeVoxelCount();
         stats->densityActiveVoxels = out.density->activeVoxelCount();

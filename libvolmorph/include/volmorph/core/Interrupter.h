@@ -42,4 +42,10 @@ struct Interrupted : std::exception {
     const char* what() const noexcept override { return "interrupted"; }
 };
 
+/// Throws Interrupted when `interrupter` (may be null) asks to stop; `percent` is the progress.
+inline void throwIfInterrupted(Interrupter* interrupter, int percent = -1)
+{
+    if (interrupter && interrupter->wasInterrupted(percent)) throw Interrupted();
+}
+
 } // namespace volmorph
