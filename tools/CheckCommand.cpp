@@ -238,6 +238,21 @@ void printFrames(const Scene& scene)
     }
 }
 
+/// Each [[prop]]: its mesh read (so that a bad one is refused here, at its key), its role.
+void printProps(const Scene& scene)
+{
+    for (size_t i = 0; i < scene.props.size(); ++i) {
+        const PropSpec& prop = scene.props[i];
+        const Mesh mesh = importMesh(prop.mesh, prop.transform, prop.where);
+        std::printf("prop %zu  %s: %zu triangles, %s, colour %g %g %g\n", i + 1,
+                    prop.mesh.filename().string().c_str(), mesh.triangles.size(),
+                    prop.holdout         ? "holdout"
+                    : prop.shadowCatcher ? "shadow catcher"
+                                         : "diffuse",
+                    prop.color.x(), prop.color.y(), prop.color.z());
+    }
+}
+
 int runCheck(const std::string& scenePath)
 {
     const Scene scene = loadScene(scenePath);
@@ -258,6 +273,7 @@ int runCheck(const std::string& scenePath)
     printPairs(scene);
     printSettings(scene);
     printView(scene.render);
+    printProps(scene);
     printFrames(scene);
     std::fflush(stdout);
     warnFarFeatures(scene, source, target);

@@ -2,6 +2,8 @@
 
 #include "KeyframeTrack.h"
 
+#include <volmorph/Mesh.h>
+
 #include <algorithm>
 #include <cmath>
 
@@ -20,6 +22,25 @@ render::Camera sceneCamera(const CameraSpec& c, const RenderSpec& r, int width)
                           c.eye, c.lookat, c.up, c.fovDegrees, c.orthoWidth, w, h);
 }
 
+/// The scene's [[prop]] meshes, imported and placed, for Embree.
+std::shared_ptr<const render::Props> sceneProps(const Scene& scene)
+{
+    std::vector<render::PropMesh> meshes;
+    for (const PropSpec& spec : scene.props) {
+        const Mesh mesh = importMesh(spec.mesh, spec.transform, spec.where);
+        render::PropMesh prop;
+        prop.points = mesh.points;
+        prop.triangles = mesh.triangles;
+        prop.color = spec.color;
+        prop.role = spec.holdout         ? render::PropMesh::Role::Holdout
+                    : spec.shadowCatcher ? render::PropMesh::Role::ShadowCatcher
+                                         : render::PropMesh::Role::Diffuse;
+        meshes.push_back(std::move(prop));
+    }
+    if (meshes.empty()) return nullptr;
+    return std::make_shared<const render::Props>(std::move(meshes));
+}
+
 } // namespace
 
 SceneRender::SceneRender(const Scene& scene, int threads, int width)
@@ -36,6 +57,8 @@ SceneRender::SceneRender(const Scene& scene, int threads, int width)
     settings.bounces = r.bounces;
     settings.seed = r.seed;
     settings.threads = threads;
+    mProps = sceneProps(scene);
+    settings.props = mProps.get();
 }
 
 render::Camera SceneRender::camera(double frame) const

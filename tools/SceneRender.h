@@ -4,8 +4,10 @@
 #include <volmorph/Scene.h>
 #include <volmorph/VolumeSet.h>
 #include <volmorph/render/Camera.h>
+#include <volmorph/render/Props.h>
 #include <volmorph/render/Renderer.h>
 
+#include <memory>
 #include <vector>
 
 namespace volmorph::cli {
@@ -15,6 +17,7 @@ struct SceneRender {
     render::RenderSettings settings; ///< frame left 0: set it per frame
 
     /// `width` overrides the scene's image width in pixels (the height follows the aspect ratio).
+    /// Imports the scene's props (UserError at their `mesh` key when one cannot be read).
     SceneRender(const Scene& scene, int threads, int width = 0);
 
     /// The camera and lights at `frame` (their keys interpolated; fractional within a shutter).
@@ -31,6 +34,7 @@ struct SceneRender {
 
 private:
     RenderSpec mSpec;
+    std::shared_ptr<const render::Props> mProps; ///< settings.props points here
     double mFps;
     int mWidth;
 };

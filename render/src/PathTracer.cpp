@@ -3,12 +3,26 @@
 #include "Cell.h"
 #include "CellWalk.h"
 #include "Majorants.h"
+#include "PropShading.h"
+#include "Shadows.h"
 
 #include <algorithm>
 #include <cmath>
 
 namespace volmorph::render {
 namespace {
+
+/// The unit direction at polar angle acos(cosTheta) and azimuth phi around unit d, in an
+/// orthonormal frame around d (Duff et al. 2017).
+Vec3d directionAround(const Vec3d& d, double cosTheta, double phi)
+{
+    const double sinTheta = std::sqrt(std::max(0.0, 1.0 - cosTheta * cosTheta));
+    const double sign = std::copysign(1.0, d.z()), a = -1.0 / (sign + d.z()), b = d.x() * d.y() * a;
+    const Vec3d e1(1.0 + sign * d.x() * d.x() * a, sign * b, -sign * d.x());
+    const Vec3d e2(b, sign + d.y() * d.y() * a, -d.y());
+    return (e1 * (sinTheta * std::cos(phi)) + e2 * (sinTheta * std::sin(phi)) + d * cosTheta)
+        .unit();
+}
 
 /// A direction drawn from the Henyey-Greenstein phase function around the travel direction `d`
 /// (unit): cos(d, result) has density proportional to HG(g), by inverting its distribution.
@@ -21,14 +35,13 @@ Vec3d sampleHenyeyGreenstein(const Vec3d& d, double g, double u1, double u2)
         const double s = (1.0 - g * g) / (1.0 - g + 2.0 * g * u1);
         cosTheta = std::clamp((1.0 + g * g - s * s) / (2.0 * g), -1.0, 1.0);
     }
-    const double sinTheta = std::sqrt(std::max(0.0, 1.0 - cosTheta * cosTheta));
-    const double phi = 2.0 * M_PI * u2;
-    // An orthonormal frame around d (Duff et al. 2017).
-    const double sign = std::copysign(1.0, d.z()), a = -1.0 / (sign + d.z()), b = d.x() * d.y() * a;
-    const Vec3d e1(1.0 + sign * d.x() * d.x() * a, sign * b, -sign * d.x());
-    const Vec3d e2(b, sign + d.y() * d.y() * a, -d.y());
-    return (e1 * (sinTheta * std::cos(phi)) + e2 * (sinTheta * std::sin(phi)) + d * cosTheta)
-        .unit();
+    return directionAround(d, cosTheta, 2.0 * M_PI * u2);
+}
+
+/// A direction drawn around unit normal n with density cos(theta) / pi (a diffuse surface's).
+Vec3d cosineDirection(const Vec3d& n, double u1, double u2)
+{
+    return directionAround(n, std::sqrt(1.0 - u1), 2.0 * M_PI * u2);
 }
 
 /// The camera ray's walk, piece by piece, with the optical depth before each piece, until the ray
@@ -81,20 +94,24 @@ class Path {
 public:
     Path(ThreadReaders& readers, Random& random) : mR(readers), mIn(readers.in), mRandom(random) {}
 
-    /// The radiance of the path that collides first at index point ip, travelling along `dir`.
-    Vec3d trace(Vec3d ip, Vec3d dir)
+    /// Where a path is: a collision in the medium (index point ip, arrived along the unit index
+    /// direction `dir`), or a point on a prop (world point x nudged off it, unit normal n facing
+    /// the arrival, arrived along the unit world direction `dir`).
+    struct Vertex {
+        bool surface = false;
+        Vec3d ip{0.0}, x{0.0}, n{0.0}, dir{0.0};
+        size_t prop = 0;
+    };
+
+    /// The radiance of the path from vertex `v` on (Cycles' bounces count every vertex).
+    Vec3d trace(Vertex v)
     {
         Vec3d L(0.0), beta(1.0);
         for (int vertex = 0;; ++vertex) {
-            L += beta * mIn.medium.emission;
-            beta = beta * albedoAt(ip);
-            if (beta.x() <= 0.0 && beta.y() <= 0.0 && beta.z() <= 0.0) break;
-            L += beta * directLight(ip, dir);
+            if (!scatter(v, L, beta)) break;
             if (vertex == mIn.bounces && mIn.environment == Vec3d(0.0)) break;
             if (vertex >= 2 && !survives(beta)) break;
-            dir =
-                sampleHenyeyGreenstein(dir, mIn.medium.anisotropy, mRandom.next(), mRandom.next());
-            if (!track(ip, dir)) {
+            if (!next(v)) {
                 L += beta * mIn.environment;
                 break;
             }
@@ -103,7 +120,100 @@ public:
         return L;
     }
 
+    /// The radiance leaving a diffuse prop's point x (normal n) toward -dir.
+    Vec3d onSurface(const Vec3d& x, const Vec3d& n, const Vec3d& dir, size_t prop)
+    {
+        return trace(Vertex{true, Vec3d(0.0), x, n, dir, prop});
+    }
+
+    /// A shadow catcher's matte at x (normal n): from the direct light on it, and the environment
+    /// along one cosine-weighted direction, with and without the props and the volume.
+    double catcherMatte(const Vec3d& x, const Vec3d& n)
+    {
+        Vec3d unoccluded;
+        Vec3d received = directIrradiance(mR, x, n, unoccluded);
+        if (mIn.environment != Vec3d(0.0)) {
+            const double u1 = mRandom.next(), u2 = mRandom.next();
+            const Vec3d w = cosineDirection(n, u1, u2);
+            const Vec3d E = mIn.environment * M_PI; // a uniform sky's irradiance
+            unoccluded += E;
+            if (!mIn.props->occluded(x, w, 0.0, kNoProp))
+                received +=
+                    E * std::exp(-opticalDepth(mR.shadowInter, mIn.levelSet, mR.shadowDensity, x, w,
+                                               kNoProp, mIn.sigmaPerVoxel));
+        }
+        return shadowMatte(received, unoccluded);
+    }
+
+    /// A collision at index point ip, travelling along `dir` (index space).
+    Vec3d trace(const Vec3d& ip, const Vec3d& dir)
+    {
+        Vertex v;
+        v.ip = ip;
+        v.dir = dir;
+        return trace(v);
+    }
+
 private:
+    /// The vertex's emission and direct light into L, its albedo or reflectance into beta; false
+    /// when nothing more can come back.
+    bool scatter(const Vertex& v, Vec3d& L, Vec3d& beta)
+    {
+        if (!v.surface) {
+            L += beta * mIn.medium.emission;
+            beta = beta * albedoAt(v.ip);
+        } else {
+            beta = beta * mIn.props->mesh(v.prop).color;
+        }
+        if (beta.x() <= 0.0 && beta.y() <= 0.0 && beta.z() <= 0.0) return false;
+        if (!v.surface) {
+            L += beta * directLight(v.ip, v.dir);
+        } else {
+            Vec3d unoccluded;
+            L += diffuseRadiance(beta, directIrradiance(mR, v.x, v.n, unoccluded));
+        }
+        return true;
+    }
+
+    /// The next vertex from `v`: a new direction (the phase function's in the medium, cosine
+    /// weighted on a diffuse prop, both sampled exactly), then the first collision or prop along
+    /// it. False when the path leaves everything.
+    bool next(Vertex& v)
+    {
+        if (!v.surface) {
+            const Vec3d dir = sampleHenyeyGreenstein(v.dir, mIn.medium.anisotropy, mRandom.next(),
+                                                     mRandom.next());
+            if (!mIn.props) { // the medium alone, in index space
+                v.dir = dir;
+                return track(v.ip, dir, kNoProp);
+            }
+            const Vec3d x = mIn.density.indexToWorld(v.ip);
+            return go(x, (mIn.density.indexToWorld(v.ip + dir) - x).unit(), v);
+        }
+        const double u1 = mRandom.next(), u2 = mRandom.next();
+        return go(v.x, cosineDirection(v.n, u1, u2), v);
+    }
+
+    /// From world point x along unit world direction w: the first collision before the first prop
+    /// (into `v`), else the prop; false when neither.
+    bool go(const Vec3d& x, const Vec3d& w, Vertex& v)
+    {
+        PropHit hit;
+        const bool onProp = mIn.props->intersect(x, w, 0.0, kNoProp, hit);
+        const Vec3d ip = mIn.density.worldToIndex(x);
+        Vec3d dir = mIn.density.worldToIndex(x + w) - ip;
+        const double scale = dir.length(); // voxels per world unit
+        dir /= scale;
+        Vec3d at = ip;
+        if (track(at, dir, onProp ? hit.distance * scale : kNoProp)) {
+            v = Vertex{false, at, Vec3d(0.0), Vec3d(0.0), dir, 0};
+            return true;
+        }
+        if (!onProp) return false;
+        v = Vertex{true, Vec3d(0.0), surfacePoint(Ray{x, w}, hit), hit.normal, w, hit.prop};
+        return true;
+    }
+
     Vec3d albedoAt(const Vec3d& ip)
     {
         if (mR.colors) return mR.colors->at(ip) * mIn.medium.albedo;
@@ -134,6 +244,7 @@ private:
         const Vec3d p = mIn.density.indexToWorld(ip);
         double distance; // world units
         const Vec3d toward = towardLight(light, p, distance);
+        if (mIn.props && mIn.props->occluded(p, toward, 0.0, distance)) return 0.0;
         Vec3d dir = mIn.density.worldToIndex(p + toward) - ip; // index units per world unit
         const double scale = dir.length();
         dir /= scale;
@@ -171,19 +282,20 @@ private:
         return true;
     }
 
-    /// Delta tracking from ip along dir (index space, unit): true with ip at the first real
-    /// collision, false if the path leaves the volume.
-    bool track(Vec3d& ip, const Vec3d& dir)
+    /// Delta tracking from ip along dir (index space, unit) up to ray time tMax (voxels): true with
+    /// ip at the first real collision, false if the path leaves the volume before.
+    bool track(Vec3d& ip, const Vec3d& dir, double tMax)
     {
         MajorantWalk walk(*mIn.majorants, *mR.majorants, ip, dir, 0.0);
         double t0, t1;
         float majorant;
-        while (walk.next(t0, t1, majorant)) {
+        while (walk.next(t0, t1, majorant) && t0 < tMax) {
             if (majorant <= 0.0f) continue;
-            const double sigmaMajorant = mIn.sigmaPerVoxel * double(majorant);
+            const double sigmaMajorant = mIn.sigmaPerVoxel * double(majorant),
+                         end = std::min(t1, tMax);
             for (double t = t0;;) {
                 t -= std::log1p(-mRandom.next()) / sigmaMajorant;
-                if (t >= t1) break;
+                if (t >= end) break;
                 const Vec3d p = ip + dir * t;
                 const double sigma = mIn.sigmaPerVoxel * densityAt(mR.density, p, mIn.levelSet);
                 if (mRandom.next() * sigmaMajorant < sigma) {
@@ -204,19 +316,37 @@ private:
 
 RaySample tracePath(ThreadReaders& readers, const Ray& ray, Random& random)
 {
-    if (!readers.inter.setWorldRay(VdbRay(ray.origin, ray.direction))) return RaySample{};
-    const Vec3d eye = readers.inter.getIndexPos(0.0);
-    const Medium1D line{eye, readers.inter.getIndexPos(1.0) - eye, readers.in.levelSet};
-    const double tau = walkPrimary(readers, line);
+    const FrameInputs& in = readers.in;
+    PropHit hit;
+    const bool onProp =
+        in.props && in.props->intersect(ray.origin, ray.direction, 0.0, kNoProp, hit);
     RaySample out;
-    out.T = std::exp(-tau);
-    if (tau <= 0.0) return out;
-    // The first collision, given one: optical depth -ln(1 - u (1 - T)), weight 1 - T.
-    const double target = -std::log1p(-random.next() * (1.0 - out.T));
-    const double t = invertPrimary(readers, line, std::min(target, tau));
     Path path(readers, random);
-    // The weight applies outside the path, so that roulette sees the path's own attenuation.
-    out.L = path.trace(line.eye + line.dir * t, line.dir) * (1.0 - out.T);
+    if (readers.inter.setWorldRay(VdbRay(ray.origin, ray.direction,
+                                         openvdb::math::Delta<double>::value(),
+                                         onProp ? hit.distance : kNoProp))) {
+        const Vec3d eye = readers.inter.getIndexPos(0.0);
+        const Medium1D line{eye, readers.inter.getIndexPos(1.0) - eye, in.levelSet};
+        const double tau = walkPrimary(readers, line);
+        out.T = std::exp(-tau);
+        if (tau > 0.0) {
+            // The first collision, given one: optical depth -ln(1 - u (1 - T)), weight 1 - T.
+            const double target = -std::log1p(-random.next() * (1.0 - out.T));
+            const double t = invertPrimary(readers, line, std::min(target, tau));
+            // The weight applies outside the path, so that roulette sees the path's own
+            // attenuation.
+            out.L = path.trace(line.eye + line.dir * t, line.dir) * (1.0 - out.T);
+        }
+    }
+    if (!onProp || out.T <= kMinTransmittance) return out;
+    const PropMesh& prop = in.props->mesh(hit.prop);
+    Vec3d surface(0.0);
+    double matte = 0.0;
+    if (prop.role == PropMesh::Role::Diffuse)
+        surface = path.onSurface(surfacePoint(ray, hit), hit.normal, ray.direction, hit.prop);
+    else if (prop.role == PropMesh::Role::ShadowCatcher)
+        matte = path.catcherMatte(surfacePoint(ray, hit), hit.normal);
+    finishOnProp(prop, surface, matte, out);
     return out;
 }
 

@@ -47,7 +47,7 @@ PointShadowMap::PointShadowMap(const MarchInputs& in, const Vec3d& light, double
             start = mLight;
             dir = direction(c);
         },
-        length, spacing);
+        length, spacing, 0.0);
 }
 
 double PointShadowMap::placeFaces(const openvdb::BoolGrid& mask)

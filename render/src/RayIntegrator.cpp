@@ -2,6 +2,7 @@
 
 #include "Cell.h"
 #include "CellWalk.h"
+#include "PropShading.h"
 #include "Sampling.h"
 
 #include <openvdb/tools/Interpolation.h>
@@ -35,13 +36,14 @@ Vec3d towardLight(const Light& light, const Vec3d& p, double& distance)
 namespace {
 
 /// The exact transmittance from index point ip toward `light` (no shadow map or cache: the march
-/// through every cell on the way).
+/// through every cell on the way), 0 behind a prop.
 double exactTransmittance(ThreadReaders& readers, const Light& light, const Vec3d& ip)
 {
     const FrameInputs& in = readers.in;
     const Vec3d p = in.density.indexToWorld(ip);
     double distance;
     const Vec3d toward = towardLight(light, p, distance);
+    if (in.props && in.props->occluded(p, toward, 0.0, distance)) return 0.0;
     return std::exp(-opticalDepth(readers.shadowInter, in.levelSet, readers.shadowDensity, p,
                                   toward, distance, in.sigmaPerVoxel));
 }
@@ -199,11 +201,12 @@ private:
     Vec3d mKnotSource{0.0};
 };
 
-} // namespace
-
-RaySample integrateRay(ThreadReaders& readers, const Ray& ray)
+/// The volume's part of a camera ray, up to `tEnd` world units (a prop there, or none).
+RaySample integrateVolume(ThreadReaders& readers, const Ray& ray, double tEnd)
 {
-    if (!readers.inter.setWorldRay(VdbRay(ray.origin, ray.direction))) return RaySample{};
+    if (!readers.inter.setWorldRay(
+            VdbRay(ray.origin, ray.direction, openvdb::math::Delta<double>::value(), tEnd)))
+        return RaySample{};
     const FrameInputs& in = readers.in;
     // A directional light's phase and colour are constant along a ray.
     for (size_t l = 0; l < in.lights.size(); ++l) {
@@ -218,6 +221,29 @@ RaySample integrateRay(ThreadReaders& readers, const Ray& ray)
                         in.levelSet};
     RayIntegrator integrator(readers, ray, line);
     return integrator.run();
+}
+
+} // namespace
+
+RaySample integrateRay(ThreadReaders& readers, const Ray& ray)
+{
+    const FrameInputs& in = readers.in;
+    PropHit hit;
+    const bool onProp =
+        in.props && in.props->intersect(ray.origin, ray.direction, 0.0, kNoProp, hit);
+    RaySample out = integrateVolume(readers, ray, onProp ? hit.distance : kNoProp);
+    if (!onProp || out.T <= kMinTransmittance) return out;
+    const PropMesh& prop = in.props->mesh(hit.prop);
+    Vec3d surface(0.0), unoccluded(0.0);
+    double matte = 0.0;
+    if (prop.role != PropMesh::Role::Holdout) {
+        const Vec3d received =
+            directIrradiance(readers, surfacePoint(ray, hit), hit.normal, unoccluded);
+        surface = diffuseRadiance(prop.color, received);
+        matte = shadowMatte(received, unoccluded);
+    }
+    finishOnProp(prop, surface, matte, out);
+    return out;
 }
 
 } // namespace volmorph::render

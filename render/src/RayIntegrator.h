@@ -6,6 +6,7 @@
 #pragma once
 
 #include <volmorph/render/Camera.h>
+#include <volmorph/render/Props.h>
 #include <volmorph/render/Renderer.h>
 
 #include "Cell.h"
@@ -13,6 +14,7 @@
 #include "Majorants.h"
 #include "Shadows.h"
 
+#include <limits>
 #include <memory>
 #include <vector>
 
@@ -34,7 +36,11 @@ struct FrameInputs {
     const Majorants* majorants; ///< null unless paths are traced
     int bounces;                ///< scattering events after the first (RenderSettings::bounces)
     Vec3d environment;          ///< the environment lights' radiance, summed
+    const Props* props;         ///< may be null: none
 };
+
+/// The far end of a ray that meets no prop (world units).
+inline constexpr double kNoProp = std::numeric_limits<double>::max();
 
 /// A piece of a camera ray inside one cell (or constant run), with the optical depth before it.
 struct TracedPiece {
@@ -78,7 +84,8 @@ struct RaySample {
     double T = 1.0;
 };
 
-/// Integrates one world-space camera ray through the frame's volume.
+/// Integrates one world-space camera ray through the frame's volume, up to the first prop, and
+/// what that prop adds (PropShading.h).
 RaySample integrateRay(ThreadReaders& readers, const Ray& ray);
 
 } // namespace volmorph::render

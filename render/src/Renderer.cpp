@@ -107,7 +107,8 @@ void renderFrame(const openvdb::FloatGrid& density, const openvdb::Vec3SGrid* co
     } else {
         stage(settings.interrupter, "render: shadows");
         shadows =
-            buildShadows({density, padded, *mask, levelSet, sigmaPerVoxel, settings.interrupter},
+            buildShadows({density, padded, *mask, levelSet, sigmaPerVoxel, settings.interrupter,
+                          settings.props && !settings.props->empty() ? settings.props : nullptr},
                          lights, settings.shadowCacheVoxels);
     }
     if (interrupted(settings.interrupter)) throw Interrupted();
@@ -124,7 +125,8 @@ void renderFrame(const openvdb::FloatGrid& density, const openvdb::Vec3SGrid* co
                             shadows,
                             majorants.get(),
                             std::max(0, settings.bounces),
-                            environment};
+                            environment,
+                            settings.props && !settings.props->empty() ? settings.props : nullptr};
     stage(settings.interrupter, "render: pixels");
     renderTiles(frame, camera, settings, image);
     stage(settings.interrupter, nullptr);
@@ -141,8 +143,18 @@ Image renderVolume(const openvdb::FloatGrid& density, const openvdb::Vec3SGrid* 
     image.width = camera.width();
     image.height = camera.height();
     image.pixels.assign(size_t(image.width) * size_t(image.height) * 4, 0.0f);
-    if (density.tree().activeVoxelCount() == 0) return image;
-    auto body = [&] { renderFrame(density, color, camera, lights, medium, settings, image); };
+    const bool props = settings.props && !settings.props->empty();
+    const bool empty = density.tree().activeVoxelCount() == 0;
+    if (empty && !props) return image;
+    // Props with no volume: the same machinery over one active voxel of the background's value,
+    // which adds exactly nothing (its ray-marching structures need an active voxel).
+    openvdb::FloatGrid::Ptr nothing;
+    if (empty) {
+        nothing = density.deepCopy();
+        nothing->tree().setValueOn(openvdb::Coord(0), density.background());
+    }
+    const openvdb::FloatGrid& volume = empty ? *nothing : density;
+    auto body = [&] { renderFrame(volume, color, camera, lights, medium, settings, image); };
     if (settings.threads > 0)
         tbb::task_arena(settings.threads).execute(body);
     else

@@ -13,6 +13,20 @@ namespace volmorph::render {
 namespace {
 /// Rays marched before their values are packed: bounds the unpacked copies held at once.
 constexpr size_t kBatch = size_t(1) << 16;
+
+/// Steps (of `spacing` world units) from a ray's start to its first prop: -inf when one lies
+/// between the light (`lightBehind` behind the start) and the start, +inf when none does before
+/// `length`.
+float darkFrom(const Props& props, const Vec3d& start, const Vec3d& direction, double length,
+               double spacing, double lightBehind)
+{
+    if (lightBehind > 0.0 && props.occluded(start, -direction, 0.0, lightBehind))
+        return -std::numeric_limits<float>::infinity();
+    PropHit hit;
+    if (!props.intersect(start, direction, 0.0, length, hit))
+        return std::numeric_limits<float>::infinity();
+    return float(hit.distance / spacing);
+}
 } // namespace
 
 std::array<Vec3d, 8> occupiedCorners(const openvdb::FloatGrid& density,
@@ -29,7 +43,7 @@ std::array<Vec3d, 8> occupiedCorners(const openvdb::FloatGrid& density,
 }
 
 ShadowColumns::ShadowColumns(const MarchInputs& in, size_t count, const RayOf& rayOf, double length,
-                             double spacing)
+                             double spacing, double lightBehind)
 {
     mSpans.reserve(count);
     const Intersector master(in.mask);
@@ -37,20 +51,23 @@ ShadowColumns::ShadowColumns(const MarchInputs& in, size_t count, const RayOf& r
     for (size_t first = 0; first < count; first += kBatch) {
         if (in.interrupter && in.interrupter->wasInterrupted()) return;
         columns.assign(std::min(kBatch, count - first), Column());
-        tbb::parallel_for(tbb::blocked_range<size_t>(0, columns.size(), 64),
-                          [&](const tbb::blocked_range<size_t>& range) {
-                              Intersector inter(master);
-                              DensityReader acc(in.density.tree(), in.padded);
-                              std::vector<float> steps;
-                              for (size_t c = range.begin(); c != range.end(); ++c) {
-                                  if (in.interrupter && in.interrupter->wasInterrupted()) return;
-                                  Vec3d start, direction;
-                                  rayOf(first + c, start, direction);
-                                  march(inter, acc, in, start, direction, length, spacing,
-                                        columns[c], steps);
-                                  compress(steps, columns[c]);
-                              }
-                          });
+        tbb::parallel_for(
+            tbb::blocked_range<size_t>(0, columns.size(), 64),
+            [&](const tbb::blocked_range<size_t>& range) {
+                Intersector inter(master);
+                DensityReader acc(in.density.tree(), in.padded);
+                std::vector<float> steps;
+                for (size_t c = range.begin(); c != range.end(); ++c) {
+                    if (in.interrupter && in.interrupter->wasInterrupted()) return;
+                    Vec3d start, direction;
+                    rayOf(first + c, start, direction);
+                    march(inter, acc, in, start, direction, length, spacing, columns[c], steps);
+                    compress(steps, columns[c]);
+                    if (in.props)
+                        columns[c].dark =
+                            darkFrom(*in.props, start, direction, length, spacing, lightBehind);
+                }
+            });
         pack(columns);
     }
 }
@@ -58,7 +75,7 @@ ShadowColumns::ShadowColumns(const MarchInputs& in, size_t count, const RayOf& r
 void ShadowColumns::pack(std::vector<Column>& columns)
 {
     for (Column& col : columns) {
-        mSpans.push_back(Span{col.first, int(col.knots.size()), col.last, mKnots.size()});
+        mSpans.push_back(Span{col.first, int(col.knots.size()), col.last, col.dark, mKnots.size()});
         mKnots.insert(mKnots.end(), col.knots.begin(), col.knots.end());
         std::vector<Knot>().swap(col.knots);
     }

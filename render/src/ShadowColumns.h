@@ -11,6 +11,8 @@
 
 #include "GridReaders.h"
 
+#include <volmorph/render/Props.h>
+
 #include <openvdb/util/NullInterrupter.h>
 
 #include <algorithm>
@@ -18,6 +20,7 @@
 #include <cmath>
 #include <cstdint>
 #include <functional>
+#include <limits>
 #include <vector>
 
 namespace volmorph::render {
@@ -30,6 +33,8 @@ struct MarchInputs {
     bool levelSet;
     double sigmaPerVoxel; ///< extinction per index unit at density 1
     openvdb::util::NullInterrupter* interrupter;
+    const Props* props =
+        nullptr; ///< occluders of the rays (their shadows on the volume); may be null
 };
 
 /// The occupied region's box (the mask's active voxels), one voxel wider, as its 8 corners in world
@@ -43,15 +48,18 @@ public:
     /// start, direction) says where. Each is marched for `length` world units, its transmittance
     /// taken every `spacing` world units from its start; in parallel, deterministically. Rays are
     /// skipped once the interrupter asks to stop (the caller checks it and discards the result).
+    /// With props, a ray is dark from its first prop on, looked for from the light: `lightBehind`
+    /// world units behind each ray's start (infinity for a directional light).
     using RayOf = std::function<void(size_t c, Vec3d& start, Vec3d& direction)>;
     ShadowColumns(const MarchInputs& in, size_t count, const RayOf& rayOf, double length,
-                  double spacing);
+                  double spacing, double lightBehind);
 
     /// The transmittance of ray c at `steps` spacings from its start: 1 before its stored span,
-    /// its final transmittance after it, linear between knots.
+    /// its final transmittance after it, linear between knots; 0 from its first prop on.
     double along(size_t c, double steps) const
     {
         const Span& span = mSpans[c];
+        if (steps >= double(span.dark)) return 0.0;
         const double x = steps - double(span.first); // steps from the span's first
         if (x <= -1.0) return 1.0;
         if (span.count == 0) return x >= 0.0 ? double(span.last) : lerp(1.0, span.last, x + 1.0);
@@ -100,11 +108,13 @@ private:
     struct Column {
         int first = 0;     ///< step index of the first knot
         float last = 1.0f; ///< the transmittance past the stored span
+        float dark = std::numeric_limits<float>::infinity(); ///< steps to its first prop
         std::vector<Knot> knots;
     };
     struct Span {         ///< a column in mKnots
         int first, count; ///< step index of its first knot, and how many knots
         float last;       ///< the transmittance past its last knot
+        float dark;       ///< steps from the start to its first prop (-inf: before the start)
         uint64_t offset;
     };
 

@@ -40,7 +40,7 @@ ShadowMap::ShadowMap(const MarchInputs& in, const Vec3d& travel, double spacing)
                     mW * mOrigin.z();
             direction = mW;
         },
-        length, spacing);
+        length, spacing, std::numeric_limits<double>::infinity());
 }
 
 double ShadowMap::placeLattice(const FloatGrid& density, const openvdb::BoolGrid& mask,

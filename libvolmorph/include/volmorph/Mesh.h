@@ -14,8 +14,6 @@
 
 namespace volmorph {
 
-using Vec3I = openvdb::math::Vec3<uint32_t>;
-
 /// What import found and repaired. Nothing here is fatal: open and non-manifold meshes are common
 /// in the wild and the voxelizer handles them.
 struct MeshReport {

@@ -67,6 +67,16 @@ struct ObjectSpec {
     std::filesystem::path volumeAt(int frame) const;
 };
 
+/// A [[prop]]: a mesh in the shot beside the morph, seen and lit by the renderer only.
+struct PropSpec {
+    std::filesystem::path mesh; ///< resolved against the scene file's folder
+    SourceLocation where;       ///< where `mesh` was written, for errors on reading
+    ObjectTransform transform;
+    Vec3d color{0.8, 0.8, 0.8}; ///< diffuse reflectance, linear RGB in [0, 1]
+    bool holdout = false;       ///< cuts the volume's alpha behind it, renders nothing
+    bool shadowCatcher = false; ///< shows only the shadow it receives, as a matte
+};
+
 /// Voxel grid settings: exactly one of voxelSize and resolution is set by the file.
 struct VolumeSpec {
     std::optional<double> voxelSize; ///< world units
@@ -220,6 +230,7 @@ struct Scene {
     WarpSpec warp;
     BlendSpec blend;
     RenderSpec render;
+    std::vector<PropSpec> props;
     FramesSpec frames;
 };
 

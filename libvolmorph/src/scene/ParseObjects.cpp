@@ -1,4 +1,4 @@
-// [source], [target] (mesh or volume, grids, transform, colour) and [volume].
+// [source], [target] (mesh or volume, grids, transform, colour), [[prop]] and [volume].
 #include "TableParsers.h"
 
 #include <volmorph/Frames.h>
@@ -13,6 +13,8 @@ const std::vector<std::string> kObjectKeys = {"mesh",      "volume", "grids",
 const std::vector<std::string> kGridKeys = {"density", "sdf", "color"};
 const std::vector<std::string> kTransformKeys = {"translate", "rotate", "scale"};
 const std::vector<std::string> kVolumeKeys = {"voxel_size", "resolution"};
+const std::vector<std::string> kPropKeys = {"mesh", "transform", "color", "holdout",
+                                            "shadow_catcher"};
 
 void parseTransform(Reader& r, const toml::node& node, const std::string& path, ObjectTransform& xf)
 {
@@ -102,6 +104,34 @@ void parseWindow(Reader& r, const toml::node& n, const std::string& path, Object
         object.window = *w;
 }
 
+/// One [[prop]] table.
+PropSpec parseProp(Reader& r, const toml::table& t, const std::string& path,
+                   const std::filesystem::path& folder)
+{
+    r.checkKeys(t, path, kPropKeys);
+    PropSpec prop;
+    if (const toml::node* n = t.get("mesh"))
+        parseFile(r, *n, path + ".mesh", folder, prop.mesh, prop.where);
+    else
+        r.missing(t, path + ".mesh", "a mesh file name, relative to the scene file");
+    if (const toml::node* n = t.get("transform"))
+        parseTransform(r, *n, path + ".transform", prop.transform);
+    if (const toml::node* n = t.get("color"))
+        if (auto c = r.nonNegativeVec3(*n, path + ".color")) {
+            if (c->x() > 1.0 || c->y() > 1.0 || c->z() > 1.0)
+                r.error(r.at(*n), path + ".color: a reflectance, each channel from 0 to 1");
+            prop.color = *c;
+        }
+    for (auto [key, flag] :
+         {std::pair{"holdout", &prop.holdout}, std::pair{"shadow_catcher", &prop.shadowCatcher}})
+        if (const toml::node* n = t.get(key))
+            if (auto b = r.boolean(*n, path + "." + key)) *flag = *b;
+    if (prop.holdout && prop.shadowCatcher)
+        r.error(r.at(*t.get("shadow_catcher")),
+                path + ": a prop is a holdout or a shadow catcher, not both");
+    return prop;
+}
+
 } // namespace
 
 void parseObject(Reader& r, const toml::node& node, const std::string& path,
@@ -133,6 +163,14 @@ void parseObject(Reader& r, const toml::node& node, const std::string& path,
         parseTransform(r, *n, path + ".transform", object.transform);
     if (const toml::node* n = t->get("color"))
         if (auto c = r.nonNegativeVec3(*n, path + ".color")) object.color = *c;
+}
+
+void parseProps(Reader& r, const toml::node& node, const std::filesystem::path& folder,
+                std::vector<PropSpec>& props)
+{
+    r.eachTable(node, "prop", [&](const toml::table& t, const std::string& path) {
+        props.push_back(parseProp(r, t, path, folder));
+    });
 }
 
 void parseVolume(Reader& r, const toml::node& node, VolumeSpec& volume)

@@ -115,15 +115,9 @@ void parsePair(Reader& r, const toml::table& t, const std::string& path,
 
 void parsePairs(Reader& r, const toml::node& node, std::vector<FeaturePairSpec>& pairs)
 {
-    const toml::array* tables = node.as_array();
-    if (!tables) {
-        r.error(r.at(node), "pair: expected [[pair]] tables, got " + std::string(typeName(node)));
-        return;
-    }
-    for (size_t i = 0; i < tables->size(); ++i) {
-        const std::string path = "pair[" + std::to_string(i + 1) + "]";
-        if (const toml::table* t = r.table(*tables->get(i), path)) parsePair(r, *t, path, pairs);
-    }
+    r.eachTable(node, "pair", [&](const toml::table& t, const std::string& path) {
+        parsePair(r, t, path, pairs);
+    });
 }
 
 } // namespace volmorph::detail

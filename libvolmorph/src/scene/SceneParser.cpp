@@ -27,8 +27,8 @@ using detail::typeName;
 
 // Keys allowed at the root and in [frames]; each table group's are in its unit. Anything else is
 // reported with a "did you mean" for near misses.
-const std::vector<std::string> kRootKeys = {"source", "target", "volume", "pair",
-                                            "warp",   "blend",  "render", "frames"};
+const std::vector<std::string> kRootKeys = {"source", "target", "volume", "pair",  "warp",
+                                            "blend",  "render", "prop",   "frames"};
 const std::vector<std::string> kFramesKeys = {"range", "output", "fps"};
 
 class SceneParser {
@@ -58,6 +58,8 @@ public:
         if (const toml::node* n = root.get("warp")) detail::parseWarp(r, *n, mScene.warp);
         if (const toml::node* n = root.get("blend")) detail::parseBlend(r, *n, mScene.blend);
         if (const toml::node* n = root.get("render")) detail::parseRender(r, *n, mScene.render);
+        if (const toml::node* n = root.get("prop"))
+            detail::parseProps(r, *n, mScene.folder, mScene.props);
         if (mScene.render.lights.empty()) {
             // Default: a white key light from above, front-left.
             LightSpec key;

@@ -19,6 +19,9 @@ inline constexpr double kDegreesToRadians = 3.14159265358979323846 / 180.0;
 /// [source] and [target]: mesh (resolved against `folder`), transform, color.
 void parseObject(Reader& r, const toml::node& node, const std::string& path,
                  const std::filesystem::path& folder, ObjectSpec& object);
+/// [[prop]]: meshes in the shot (mesh, transform, color, holdout, shadow_catcher).
+void parseProps(Reader& r, const toml::node& node, const std::filesystem::path& folder,
+                std::vector<PropSpec>& props);
 /// [volume]: voxel_size or resolution.
 void parseVolume(Reader& r, const toml::node& node, VolumeSpec& volume);
 /// [[pair]]: appends every pair that is complete.

@@ -134,6 +134,29 @@ public:
         return i->get();
     }
 
+    /// Calls f(table, path) for each table of the array of tables [[name]] at `node`, path being
+    /// "name[i]" (from 1).
+    template <typename F>
+    void eachTable(const toml::node& node, const std::string& name, F&& f)
+    {
+        const toml::array* tables = node.as_array();
+        if (!tables) {
+            error(at(node), name + ": expected [[" + name + "]] tables, got " + typeName(node));
+            return;
+        }
+        for (size_t i = 0; i < tables->size(); ++i) {
+            const std::string path = name + "[" + std::to_string(i + 1) + "]";
+            if (const toml::table* t = table(*tables->get(i), path)) f(*t, path);
+        }
+    }
+
+    std::optional<bool> boolean(const toml::node& n, const std::string& path)
+    {
+        if (const auto* b = n.as_boolean()) return b->get();
+        error(at(n), path + ": expected true or false, got " + typeName(n));
+        return std::nullopt;
+    }
+
     std::optional<std::string> string(const toml::node& n, const std::string& path)
     {
         if (const auto* s = n.as_string()) return s->get();

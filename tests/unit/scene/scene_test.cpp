@@ -541,3 +541,46 @@ TEST(Scene, ShadowCacheSpacing)
     expectError(base + "shadow_cache = 17\n", 9, 16, "render.shadow_cache");
     expectError(base + "shadow_cache = 1.5\n", 9, 16, "render.shadow_cache");
 }
+
+TEST(Scene, PropsAreRead)
+{
+    const Scene s = parse(std::string(kMinimal) + R"(
+[[prop]]
+mesh = "meshes/cube.obj"
+transform = { translate = [0, -1, 0], scale = [4, 0.1, 4] }
+color = [0.2, 0.3, 0.4]
+[[prop]]
+mesh = "meshes/tetra.off"
+shadow_catcher = true
+[[prop]]
+mesh = "meshes/tetra.off"
+holdout = true
+)");
+    ASSERT_EQ(s.props.size(), 3u);
+    EXPECT_EQ(s.props[0].mesh, kInline.parent_path() / "meshes/cube.obj");
+    EXPECT_EQ(s.props[0].transform.translate, Vec3d(0, -1, 0));
+    EXPECT_EQ(s.props[0].color, Vec3d(0.2, 0.3, 0.4));
+    EXPECT_FALSE(s.props[0].holdout || s.props[0].shadowCatcher);
+    EXPECT_EQ(s.props[1].color, Vec3d(0.8)); // the documented default
+    EXPECT_TRUE(s.props[1].shadowCatcher);
+    EXPECT_TRUE(s.props[2].holdout);
+    EXPECT_EQ(s.props[1].where.line, 14);
+}
+
+TEST(SceneErrors, PropMistakes)
+{
+    expectAddedError("[[prop]]\ncolor = [0.5, 0.5, 0.5]\n", 8, 1, "missing prop[1].mesh");
+    expectAddedError("[[prop]]\nmesh = \"meshes/cube.obj\"\nholdout = 1\n", 10, 11,
+                     "prop[1].holdout: expected true or false");
+    // Every problem of every prop at once.
+    const std::vector<Diagnostic> both =
+        errors(std::string(kMinimal) +
+               "[[prop]]\nmesh = \"meshes/cube.obj\"\nshadow_catcher = true\nholdout = true\n"
+               "[[prop]]\nmesh = \"meshes/none.obj\"\n");
+    ASSERT_EQ(both.size(), 2u);
+    EXPECT_NE(both[0].message.find("a holdout or a shadow catcher, not both"), std::string::npos);
+    EXPECT_NE(both[1].message.find("prop[2].mesh: file not found"), std::string::npos);
+    expectAddedError("[prop]\nmesh = \"meshes/cube.obj\"\n", 8, 1, "expected [[prop]] tables");
+    expectAddedError("[[prop]]\nmesh = \"meshes/cube.obj\"\nshade = 1\n", 10, 1,
+                     "unknown key 'shade' in [prop[1]]");
+}

@@ -5,10 +5,13 @@
 #include <openvdb/math/Mat4.h>
 #include <openvdb/math/Vec3.h>
 
+#include <cstdint>
+
 namespace volmorph {
 
 using Vec3d = openvdb::math::Vec3d;
 using Vec3f = openvdb::math::Vec3s;
 using Mat4d = openvdb::math::Mat4d;
+using Vec3I = openvdb::math::Vec3<uint32_t>; ///< a triangle's vertex indices
 
 } // namespace volmorph

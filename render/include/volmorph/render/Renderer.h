@@ -35,6 +35,7 @@
 #pragma once
 
 #include <volmorph/render/Camera.h>
+#include <volmorph/render/Props.h>
 
 #include <openvdb/openvdb.h>
 #include <openvdb/util/NullInterrupter.h>
@@ -91,6 +92,8 @@ struct RenderSettings {
     /// pixel, as each shutter time's one sample is).
     bool centreSingleSample = true;
     int threads = 0; ///< 0 = all cores
+    /// Meshes in the shot (Props.h), built once for a sequence; null: none.
+    const Props* props = nullptr;
     /// Asked between pixels and between the shadow maps' columns (OpenVDB's interrupter interface);
     /// when it answers true, renderVolume throws volmorph::Interrupted. May be null.
     openvdb::util::NullInterrupter* interrupter = nullptr;

@@ -1,0 +1,62 @@
+#include "PropShading.h"
+
+#include "Shadows.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace volmorph::render {
+
+Vec3d directIrradiance(ThreadReaders& readers, const Vec3d& x, const Vec3d& n, Vec3d& unoccluded)
+{
+    const FrameInputs& in = readers.in;
+    Vec3d received(0.0);
+    unoccluded = Vec3d(0.0);
+    for (const Light& light : in.lights) {
+        if (light.type == Light::Type::Environment) continue;
+        double distance;
+        const Vec3d toward = towardLight(light, x, distance);
+        const double cosine = n.dot(toward);
+        if (cosine <= 0.0) continue;
+        const double falloff = light.type == Light::Type::Point ? 1.0 / (distance * distance) : 1.0;
+        const Vec3d E = light.color * (light.intensity * falloff * cosine);
+        unoccluded += E;
+        if (in.props && in.props->occluded(x, toward, 0.0, distance)) continue;
+        const double tau = opticalDepth(readers.shadowInter, in.levelSet, readers.shadowDensity, x,
+                                        toward, distance, in.sigmaPerVoxel);
+        received += E * std::exp(-tau);
+    }
+    return received;
+}
+
+double shadowMatte(const Vec3d& received, const Vec3d& unoccluded)
+{
+    const double reference = unoccluded.x() + unoccluded.y() + unoccluded.z();
+    if (reference <= 0.0) return 0.0;
+    const double seen = received.x() + received.y() + received.z();
+    return std::clamp(1.0 - seen / reference, 0.0, 1.0);
+}
+
+void finishOnProp(const PropMesh& prop, const Vec3d& surface, double matte, RaySample& out)
+{
+    switch (prop.role) {
+    case PropMesh::Role::Diffuse:
+        out.L += surface * out.T;
+        out.T = 0.0;
+        break;
+    case PropMesh::Role::Holdout:
+        break;
+    case PropMesh::Role::ShadowCatcher:
+        out.T *= 1.0 - matte;
+        break;
+    }
+}
+
+Vec3d surfacePoint(const Ray& ray, const PropHit& hit)
+{
+    const Vec3d x = ray.origin + ray.direction * hit.distance;
+    const double scale = std::max({1.0, std::abs(x.x()), std::abs(x.y()), std::abs(x.z())});
+    return x + hit.normal * (1e-5 * scale);
+}
+
+} // namespace volmorph::render

@@ -1,0 +1,218 @@
+// Props (render/Props.h) against closed forms: a Lambertian floor under a sun, the shadow of a slab
+// of known optical depth on it (Beer-Lambert), a shadow catcher's matte, a holdout's alpha, and a
+// prop's shadow on the volume against the exact march and the path tracer.
+#include <volmorph/render/Props.h>
+#include <volmorph/render/Renderer.h>
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+using namespace volmorph;
+using render::Camera;
+using render::PropMesh;
+
+namespace {
+
+constexpr double kVoxel = 0.02;
+
+/// An axis-aligned quad at height y over [x0, x1] x [z0, z1], facing up.
+PropMesh floorQuad(double y, double x0, double x1, double z0, double z1,
+                   PropMesh::Role role = PropMesh::Role::Diffuse)
+{
+    PropMesh m;
+    m.points = {Vec3f(float(x0), float(y), float(z0)), Vec3f(float(x1), float(y), float(z0)),
+                Vec3f(float(x1), float(y), float(z1)), Vec3f(float(x0), float(y), float(z1))};
+    m.triangles = {Vec3I(0, 2, 1), Vec3I(0, 3, 2)};
+    m.color = Vec3d(0.5, 0.6, 0.7);
+    m.role = role;
+    return m;
+}
+
+/// Density 1 at the voxels whose centres lie in [x0, x1] x [y0, y1] x [z0, z1] (world units).
+openvdb::FloatGrid::Ptr slab(Vec3d lo, Vec3d hi)
+{
+    auto grid = openvdb::FloatGrid::create(0.0f);
+    grid->setTransform(openvdb::math::Transform::createLinearTransform(kVoxel));
+    const openvdb::CoordBBox box(openvdb::Coord::round(lo / kVoxel),
+                                 openvdb::Coord::round(hi / kVoxel));
+    grid->tree().denseFill(box, 1.0f, true);
+    grid->setGridClass(openvdb::GRID_FOG_VOLUME);
+    return grid;
+}
+
+/// Looking straight down at the floor from above: 64 pixels over 2 world units, centred at x.
+Camera downAt(double x)
+{
+    return Camera(Camera::Projection::Orthographic, Vec3d(x, 5, 0), Vec3d(x, 0, 0), Vec3d(0, 0, -1),
+                  40.0, 2.0, 64, 64);
+}
+
+render::Light sun(const Vec3d& travel, double intensity)
+{
+    render::Light light;
+    light.direction = travel.unit();
+    light.intensity = intensity;
+    return light;
+}
+
+/// The pixel of row 32 whose ray passes nearest world x (an orthographic camera).
+const float* atX(const render::Image& image, const Camera& camera, double x)
+{
+    int best = 0;
+    for (int px = 1; px < image.width; ++px)
+        if (std::abs(camera.ray(px + 0.5, 32.5).origin.x() - x) <
+            std::abs(camera.ray(best + 0.5, 32.5).origin.x() - x))
+            best = px;
+    return image.at(best, 32);
+}
+
+struct Shot {
+    openvdb::FloatGrid::Ptr density;
+    render::Medium medium;
+    render::RenderSettings settings;
+    std::vector<render::Light> lights;
+};
+
+/// A slab 0.1 thick at heights 0.5 to 0.6 over x in [-1, -0.5], a sun travelling down at 45
+/// degrees toward +x: its shadow falls on the floor over x in about [-0.5, 0], where the sun's
+/// ray crosses the slab for 0.1 sqrt(2).
+Shot slabShot()
+{
+    Shot s;
+    // Voxel centres from 0.5 to 0.58: with the trilinear ramps, 0.1 of optical thickness across.
+    s.density = slab(Vec3d(-1.0, 0.5, -1.0), Vec3d(-0.5, 0.58, 1.0));
+    s.medium.extinction = 10.0;
+    s.medium.albedo = 0.0;
+    s.settings.samples = 1;
+    s.lights = {sun(Vec3d(1, -1, 0), 3.0)};
+    return s;
+}
+
+} // namespace
+
+TEST(Props, ASunOnAFloorAndTheSlabsShadowAreLambertAndBeerLambert)
+{
+    Shot s = slabShot();
+    const render::Props props({floorQuad(0.0, -3, 3, -3, 3)});
+    s.settings.props = &props;
+    const double cosine = 1.0 / std::sqrt(2.0);
+    const Vec3d lit = Vec3d(0.5, 0.6, 0.7) / M_PI * 3.0 * cosine;
+    const double T = std::exp(-10.0 * 0.1 * std::sqrt(2.0));
+    for (const bool paths : {false, true}) {
+        s.settings.tracePaths = paths;
+        const render::Image image =
+            render::renderVolume(*s.density, nullptr, downAt(0.0), s.lights, s.medium, s.settings);
+        const float* open = atX(image, downAt(0.0), 0.5);
+        const float* shadow = atX(image, downAt(0.0), -0.25);
+        for (int c = 0; c < 3; ++c) {
+            EXPECT_NEAR(open[c], lit[c], 1e-5 * lit[c]) << "paths " << paths;
+            EXPECT_NEAR(shadow[c], lit[c] * T, 1e-4 * lit[c]) << "paths " << paths;
+        }
+        EXPECT_EQ(open[3], 1.0f);
+        EXPECT_EQ(shadow[3], 1.0f);
+    }
+}
+
+TEST(Props, AShadowCatchersMatteIsTheShadowsDepth)
+{
+    Shot s = slabShot();
+    const render::Props props({floorQuad(0.0, -3, 3, -3, 3, PropMesh::Role::ShadowCatcher)});
+    s.settings.props = &props;
+    const double T = std::exp(-10.0 * 0.1 * std::sqrt(2.0));
+    const render::Image image =
+        render::renderVolume(*s.density, nullptr, downAt(0.0), s.lights, s.medium, s.settings);
+    const float* open = atX(image, downAt(0.0), 0.5);
+    const float* shadow = atX(image, downAt(0.0), -0.25);
+    for (int c = 0; c < 3; ++c) {
+        EXPECT_EQ(open[c], 0.0f);
+        EXPECT_EQ(shadow[c], 0.0f);
+    }
+    EXPECT_EQ(open[3], 0.0f);
+    EXPECT_NEAR(shadow[3], 1.0 - T, 1e-4);
+}
+
+TEST(Props, AHoldoutInFrontOfTheVolumeZeroesItsAlpha)
+{
+    Shot s = slabShot();
+    s.medium.albedo = 0.8;
+    s.lights = {sun(Vec3d(0, -1, 0), 3.0)}; // overhead: the holdout's shadow falls under it
+    // A holdout above the slab's left half, between it and the camera.
+    const render::Props props({floorQuad(1.0, -1.2, -0.75, -3, 3, PropMesh::Role::Holdout)});
+    const render::Image plain =
+        render::renderVolume(*s.density, nullptr, downAt(-0.75), s.lights, s.medium, s.settings);
+    s.settings.props = &props;
+    const render::Image cut =
+        render::renderVolume(*s.density, nullptr, downAt(-0.75), s.lights, s.medium, s.settings);
+    const float* behind = atX(cut, downAt(-0.75), -0.9);
+    for (int c = 0; c < 4; ++c) EXPECT_EQ(behind[c], 0.0f);
+    EXPECT_GT(atX(plain, downAt(-0.75), -0.9)[3], 0.5f);
+    // Beside the holdout the volume is as it was.
+    const float* beside = atX(cut, downAt(-0.75), -0.6);
+    for (int c = 0; c < 4; ++c) EXPECT_EQ(beside[c], atX(plain, downAt(-0.75), -0.6)[c]);
+}
+
+TEST(Props, APropsShadowDarkensTheVolume)
+{
+    // An opaque quad above the slab's left part, between it and a sun overhead: there the slab
+    // receives no direct light, and its single scattering is 0 (no emission); beside it, the same
+    // as without the quad, to the bit. Seen from below, by the shadow map, the exact march and the
+    // path tracer (bounces 0).
+    Shot s = slabShot();
+    s.medium.albedo = 0.8;
+    s.lights = {sun(Vec3d(0, -1, 0), 3.0)};
+    const render::Props props({floorQuad(1.0, -1.5, -0.75, -3, 3)});
+    const Camera up(Camera::Projection::Orthographic, Vec3d(-0.75, -5, 0), Vec3d(-0.75, 0, 0),
+                    Vec3d(0, 0, 1), 40.0, 2.0, 64, 64);
+    for (const int method : {0, 1, 2}) {
+        s.settings.shadowCacheVoxels = method == 0 ? 1 : 0;
+        s.settings.tracePaths = method == 2;
+        s.settings.samples = method == 2 ? 16 : 1;
+        s.settings.props = nullptr; // the reference: the same method without the quad
+        const render::Image plain =
+            render::renderVolume(*s.density, nullptr, up, s.lights, s.medium, s.settings);
+        s.settings.props = &props;
+        const render::Image image =
+            render::renderVolume(*s.density, nullptr, up, s.lights, s.medium, s.settings);
+        int dark = 0, lit = 0;
+        for (int px = 0; px < 64; ++px) {
+            const double x = up.ray(px + 0.5, 32.5).origin.x();
+            const float* p = image.at(px, 32);
+            const float* q = plain.at(px, 32);
+            if (x > -0.97 && x < -0.8) { // under the quad
+                ++dark;
+                EXPECT_GT(q[0], 0.04f);
+                for (int c = 0; c < 3; ++c) EXPECT_LT(p[c], 1e-6f) << "method " << method;
+            } else if (x > -0.7 && x < -0.53) { // beside it
+                ++lit;
+                for (int c = 0; c < 3; ++c) EXPECT_EQ(p[c], q[c]) << "method " << method;
+            }
+        }
+        EXPECT_GT(dark, 4);
+        EXPECT_GT(lit, 4);
+    }
+}
+
+TEST(Props, AFloorUnderAUniformSkyReflectsItsColourTimesTheSky)
+{
+    // A white furnace for surfaces: a diffuse floor under a sky of radiance L from every direction
+    // (and nothing else, the volume empty) sends back color x L exactly, at any sample count.
+    const auto empty = openvdb::FloatGrid::create(0.0f);
+    empty->setTransform(openvdb::math::Transform::createLinearTransform(kVoxel));
+    const render::Props props({floorQuad(0.0, -3, 3, -3, 3)});
+    render::Light sky;
+    sky.type = render::Light::Type::Environment;
+    sky.intensity = 0.5;
+    render::Medium medium;
+    render::RenderSettings settings;
+    settings.samples = 4;
+    settings.props = &props;
+    const render::Image image =
+        render::renderVolume(*empty, nullptr, downAt(0.0), {sky}, medium, settings);
+    const Vec3d expected = Vec3d(0.5, 0.6, 0.7) * 0.5;
+    for (const double x : {-0.5, 0.0, 0.7}) {
+        const float* p = atX(image, downAt(0.0), x);
+        for (int c = 0; c < 3; ++c) EXPECT_NEAR(p[c], expected[c], 1e-6);
+        EXPECT_EQ(p[3], 1.0f);
+    }
+}
