@@ -79,6 +79,7 @@ std::vector<render::Light> SceneRender::lights(double frame) const
         light.position = l.position;
         light.color = l.color;
         light.intensity = l.intensity;
+        light.angle = l.angleRadians;
         lights.push_back(light);
     }
     return lights;

@@ -12,18 +12,6 @@
 namespace volmorph::render {
 namespace {
 
-/// The unit direction at polar angle acos(cosTheta) and azimuth phi around unit d, in an
-/// orthonormal frame around d (Duff et al. 2017).
-Vec3d directionAround(const Vec3d& d, double cosTheta, double phi)
-{
-    const double sinTheta = std::sqrt(std::max(0.0, 1.0 - cosTheta * cosTheta));
-    const double sign = std::copysign(1.0, d.z()), a = -1.0 / (sign + d.z()), b = d.x() * d.y() * a;
-    const Vec3d e1(1.0 + sign * d.x() * d.x() * a, sign * b, -sign * d.x());
-    const Vec3d e2(b, sign + d.y() * d.y() * a, -d.y());
-    return (e1 * (sinTheta * std::cos(phi)) + e2 * (sinTheta * std::sin(phi)) + d * cosTheta)
-        .unit();
-}
-
 /// A direction drawn from the Henyey-Greenstein phase function around the travel direction `d`
 /// (unit): cos(d, result) has density proportional to HG(g), by inverting its distribution.
 Vec3d sampleHenyeyGreenstein(const Vec3d& d, double g, double u1, double u2)
@@ -131,7 +119,7 @@ public:
     double catcherMatte(const Vec3d& x, const Vec3d& n)
     {
         Vec3d unoccluded;
-        Vec3d received = directIrradiance(mR, x, n, unoccluded);
+        Vec3d received = directIrradiance(mR, x, n, unoccluded, &mRandom);
         if (mIn.environment != Vec3d(0.0)) {
             const double u1 = mRandom.next(), u2 = mRandom.next();
             const Vec3d w = cosineDirection(n, u1, u2);
@@ -170,7 +158,7 @@ private:
             L += beta * directLight(v.ip, v.dir);
         } else {
             Vec3d unoccluded;
-            L += diffuseRadiance(beta, directIrradiance(mR, v.x, v.n, unoccluded));
+            L += diffuseRadiance(beta, directIrradiance(mR, v.x, v.n, unoccluded, &mRandom));
         }
         return true;
     }
@@ -243,7 +231,7 @@ private:
     {
         const Vec3d p = mIn.density.indexToWorld(ip);
         double distance; // world units
-        const Vec3d toward = towardLight(light, p, distance);
+        const Vec3d toward = sampleLight(light, towardLight(light, p, distance), &mRandom);
         if (mIn.props && mIn.props->occluded(p, toward, 0.0, distance)) return 0.0;
         Vec3d dir = mIn.density.worldToIndex(p + toward) - ip; // index units per world unit
         const double scale = dir.length();

@@ -7,7 +7,8 @@
 
 namespace volmorph::render {
 
-Vec3d directIrradiance(ThreadReaders& readers, const Vec3d& x, const Vec3d& n, Vec3d& unoccluded)
+Vec3d directIrradiance(ThreadReaders& readers, const Vec3d& x, const Vec3d& n, Vec3d& unoccluded,
+                       Random* random)
 {
     const FrameInputs& in = readers.in;
     Vec3d received(0.0);
@@ -15,7 +16,7 @@ Vec3d directIrradiance(ThreadReaders& readers, const Vec3d& x, const Vec3d& n, V
     for (const Light& light : in.lights) {
         if (light.type == Light::Type::Environment) continue;
         double distance;
-        const Vec3d toward = towardLight(light, x, distance);
+        const Vec3d toward = sampleLight(light, towardLight(light, x, distance), random);
         const double cosine = n.dot(toward);
         if (cosine <= 0.0) continue;
         const double falloff = light.type == Light::Type::Point ? 1.0 / (distance * distance) : 1.0;

@@ -6,6 +6,7 @@
 #include <volmorph/render/Props.h>
 
 #include "RayIntegrator.h"
+#include "Sampling.h"
 
 namespace volmorph::render {
 
@@ -13,8 +14,10 @@ namespace volmorph::render {
 /// from every directional and point light: sum of E cos(theta) times the props' visibility times
 /// the volume's transmittance (exact, cell by cell), where E is the light's irradiance on a
 /// surface facing it. `unoccluded` gets the same sum without visibility and transmittance (a
-/// shadow catcher's reference).
-Vec3d directIrradiance(ThreadReaders& readers, const Vec3d& x, const Vec3d& n, Vec3d& unoccluded);
+/// shadow catcher's reference). A soft sun's direction is drawn over its disc with `random` (its
+/// centre without).
+Vec3d directIrradiance(ThreadReaders& readers, const Vec3d& x, const Vec3d& n, Vec3d& unoccluded,
+                       Random* random);
 
 /// The radiance a diffuse surface of reflectance `color` sends back under `irradiance`: color / pi
 /// times it.

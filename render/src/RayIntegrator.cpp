@@ -225,7 +225,7 @@ RaySample integrateVolume(ThreadReaders& readers, const Ray& ray, double tEnd)
 
 } // namespace
 
-RaySample integrateRay(ThreadReaders& readers, const Ray& ray)
+RaySample integrateRay(ThreadReaders& readers, const Ray& ray, Random* random)
 {
     const FrameInputs& in = readers.in;
     PropHit hit;
@@ -238,7 +238,7 @@ RaySample integrateRay(ThreadReaders& readers, const Ray& ray)
     double matte = 0.0;
     if (prop.role != PropMesh::Role::Holdout) {
         const Vec3d received =
-            directIrradiance(readers, surfacePoint(ray, hit), hit.normal, unoccluded);
+            directIrradiance(readers, surfacePoint(ray, hit), hit.normal, unoccluded, random);
         surface = diffuseRadiance(prop.color, received);
         matte = shadowMatte(received, unoccluded);
     }

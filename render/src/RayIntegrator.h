@@ -12,6 +12,7 @@
 #include "Cell.h"
 #include "GridReaders.h"
 #include "Majorants.h"
+#include "Sampling.h"
 #include "Shadows.h"
 
 #include <limits>
@@ -85,7 +86,7 @@ struct RaySample {
 };
 
 /// Integrates one world-space camera ray through the frame's volume, up to the first prop, and
-/// what that prop adds (PropShading.h).
-RaySample integrateRay(ThreadReaders& readers, const Ray& ray);
+/// what that prop adds (PropShading.h); `random` (may be null) draws soft suns' directions there.
+RaySample integrateRay(ThreadReaders& readers, const Ray& ray, Random* random = nullptr);
 
 } // namespace volmorph::render

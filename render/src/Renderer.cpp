@@ -51,8 +51,8 @@ void renderPixel(ThreadReaders& readers, const Camera& camera, const RenderSetti
         const double sx = centre ? 0.5 : ((s % strata) + jx) / strata;
         const double sy = centre ? 0.5 : ((s / strata) % strata + jy) / strata;
         const Ray ray = camera.ray(x + sx, y + sy);
-        const RaySample sample =
-            readers.in.majorants ? tracePath(readers, ray, random) : integrateRay(readers, ray);
+        const RaySample sample = readers.in.majorants ? tracePath(readers, ray, random)
+                                                      : integrateRay(readers, ray, &random);
         r += sample.L.x();
         g += sample.L.y();
         b += sample.L.z();

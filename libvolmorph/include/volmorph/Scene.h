@@ -179,6 +179,7 @@ struct LightSpec {
     Vec3d position{0.0, 0.0, 0.0};   ///< point: world units
     Vec3d color{1.0, 1.0, 1.0};
     double intensity = 1.0;
+    double angleRadians = 0.0; ///< directional: angular diameter (a soft sun); the file has degrees
     std::vector<LightKey> keys; ///< animation, by increasing frame; empty: still (the CLI's
                                 ///< KeyframeTrack interpolates them)
 };

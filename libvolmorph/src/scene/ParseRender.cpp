@@ -15,8 +15,8 @@ const std::vector<std::string> kRenderKeys = {
 const std::vector<std::string> kCameraKeys = {"projection", "eye",   "lookat", "up",
                                               "fov",        "width", "keys"};
 const std::vector<std::string> kCameraKeyKeys = {"frame", "eye", "lookat", "up", "fov", "width"};
-const std::vector<std::string> kLightKeys = {"type",  "direction", "position",
-                                             "color", "intensity", "keys"};
+const std::vector<std::string> kLightKeys = {"type",      "direction", "position", "color",
+                                             "intensity", "angle",     "keys"};
 const std::vector<std::string> kLightKeyKeys = {"frame", "direction", "position", "color",
                                                 "intensity"};
 
@@ -189,6 +189,13 @@ void parseLight(Reader& r, const toml::node& node, const std::string& path,
         if (auto v = r.numberIn(*n, path + ".intensity", 0.0, true,
                                 std::numeric_limits<double>::max(), "an intensity >= 0"))
             light.intensity = *v;
+    if (const toml::node* n = t->get("angle")) {
+        if (light.type != LightType::Directional)
+            r.error(r.at(*n), path + ".angle: only a directional light has an angular diameter");
+        else if (auto v = r.numberIn(*n, path + ".angle", 0.0, true, 180.0,
+                                     "an angular diameter in degrees, from 0 to 180"))
+            light.angleRadians = *v * kDegreesToRadians;
+    }
     if (const toml::node* n = t->get("keys")) {
         forEachKey(
             r, *n, path + ".keys",

@@ -5,12 +5,16 @@
 #include <volmorph/render/Renderer.h>
 
 #include <gtest/gtest.h>
+#include <openvdb/tools/LevelSetSphere.h>
 
+#include <algorithm>
 #include <cmath>
+#include <cstdio>
 
 using namespace volmorph;
 using render::Camera;
 using render::PropMesh;
+using render::Ray;
 
 namespace {
 
@@ -215,4 +219,55 @@ TEST(Props, AFloorUnderAUniformSkyReflectsItsColourTimesTheSky)
         for (int c = 0; c < 3; ++c) EXPECT_NEAR(p[c], expected[c], 1e-6);
         EXPECT_EQ(p[3], 1.0f);
     }
+}
+
+TEST(Props, ASoftSunsPenumbraIsHeightTimesAngle)
+{
+    // An opaque sphere (a level set of constant density) of radius 0.5 centred 1 above a floor,
+    // under a sun overhead of angular diameter a: its shadow's edge on the floor is a penumbra of
+    // full width h a (h = 1, the silhouette's height). Seen from a camera under the sphere, along
+    // one row across the edge; the 10-90% width of a disc's straight-edge penumbra is 0.687 of
+    // its full width.
+    const double a = 6.0 * M_PI / 180.0;
+    const auto ball = openvdb::tools::createLevelSetSphere<openvdb::FloatGrid>(
+        0.5f, openvdb::Vec3f(0, 1, 0), 0.01f, 3.0f);
+    const render::Props props({floorQuad(0.0, -3, 3, -3, 3)});
+    render::Light light = sun(Vec3d(0, -1, 0), 1.0);
+    light.angle = a;
+    render::Medium medium;
+    medium.kind = render::Medium::Kind::LevelSet;
+    medium.extinction = 400.0;
+    render::RenderSettings settings;
+    settings.samples = 1024;
+    settings.props = &props;
+    // Beside the sphere, below it, looking down at the edge on the x axis: the row runs along x.
+    const Camera camera(Camera::Projection::Perspective, Vec3d(0.5, 0.3, -0.35), Vec3d(0.5, 0, 0),
+                        Vec3d(0, 1, 0), 30.0, 0.0, 256, 1);
+    const render::Image image =
+        render::renderVolume(*ball, nullptr, camera, {light}, medium, settings);
+    // Visible fraction of the sun against floor x, outward across the edge.
+    const double lit = 0.6 / M_PI; // the floor's red reflectance / pi, irradiance 1
+    std::vector<std::pair<double, double>> profile;
+    for (int px = 0; px < 256; ++px) {
+        const Ray ray = camera.ray(px + 0.5, 0.5);
+        const double t = -ray.origin.y() / ray.direction.y();
+        const Vec3d floor = ray.origin + ray.direction * t;
+        profile.emplace_back(std::hypot(floor.x(), floor.z()), image.at(px, 0)[1] / lit);
+    }
+    std::sort(profile.begin(), profile.end());
+    auto crossing = [&](double level) { // the first x where the fraction reaches `level`
+        for (size_t i = 1; i < profile.size(); ++i)
+            if (profile[i].second >= level && profile[i - 1].second < level) {
+                const auto& [x0, f0] = profile[i - 1];
+                const auto& [x1, f1] = profile[i];
+                return x0 + (level - f0) / (f1 - f0) * (x1 - x0);
+            }
+        return 0.0;
+    };
+    const double width = (crossing(0.9) - crossing(0.1)) / 0.687;
+    std::printf("penumbra: %.4f world units wide, h a = %.4f\n", width, a);
+    EXPECT_NEAR(width, a, 0.1 * a);
+    EXPECT_NEAR(0.5 * (crossing(0.9) + crossing(0.1)), 0.5, 0.01); // centred on the silhouette
+    EXPECT_NEAR(profile.front().second, 0.0, 1e-6);                // the umbra
+    EXPECT_NEAR(profile.back().second, 1.0, 1e-3);                 // full sun
 }

@@ -55,6 +55,10 @@ struct Light {
     Vec3d position{0, 0, 0};   ///< point: world units; irradiance falls off with distance squared
     Vec3d color{1, 1, 1};      ///< linear RGB, times intensity
     double intensity = 1.0;
+    /// Directional: the angular diameter of the disc it comes from (radians; 0: a point at
+    /// infinity). Its irradiance stays color x intensity. Surfaces and paths sample the disc; the
+    /// single-scattering estimator's shadow map inside the volume keeps its centre direction.
+    double angle = 0.0;
 };
 
 struct Medium {
