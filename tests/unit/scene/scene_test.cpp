@@ -448,6 +448,8 @@ TEST(Scene, CommentedExampleInScenesReadmeParses)
     EXPECT_EQ(s.pairs.size(), 2u);
     EXPECT_NEAR(s.source.transform.rotateRadians.y(), M_PI / 2, 1e-12);
     EXPECT_EQ(s.render.lights.size(), 2u);
+    ASSERT_EQ(s.props.size(), 1u);
+    EXPECT_EQ(s.props[0].color, Vec3d(0.6));
     EXPECT_EQ(s.frames.count(), 24);
 }
 
