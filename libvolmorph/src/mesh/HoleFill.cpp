@@ -25,6 +25,20 @@ uint64_t edgeKey(uint32_t a, uint32_t b)
     return (uint64_t(std::min(a, b)) << 32) | std::max(a, b);
 }
 
+/// The part of `loop` from place k (a vertex the walk has come back to) on is a closed loop: moved
+/// to `loops` (or counted as unclosed when shorter than 3), leaving `loop` ending at that vertex.
+void splitOff(Loop& loop, std::unordered_map<uint32_t, size_t>& at, size_t k,
+              std::vector<Loop>& loops, size_t& unclosed)
+{
+    Loop part(loop.begin() + std::ptrdiff_t(k), loop.end());
+    for (size_t i = k + 1; i < loop.size(); ++i) at.erase(loop[i]);
+    loop.resize(k + 1);
+    if (part.size() >= 3)
+        loops.push_back(std::move(part));
+    else
+        ++unclosed;
+}
+
 /// The holes' loops. A triangle's boundary edge a -> b is walked b -> a, so each loop runs the way
 /// a patch triangle on it must traverse it to agree with the mesh's orientation.
 std::vector<Loop> boundaryLoops(const Mesh& mesh, size_t& unclosed)
@@ -49,10 +63,18 @@ std::vector<Loop> boundaryLoops(const Mesh& mesh, size_t& unclosed)
         std::vector<uint32_t>& first = next[start];
         if (first.empty()) continue;
         Loop loop{start};
+        std::unordered_map<uint32_t, size_t> at{{start, 0}}; // each vertex's place in `loop`
         uint32_t v = first.back();
         first.pop_back();
         while (v != start && loop.size() <= edges) {
-            loop.push_back(v);
+            if (auto seen = at.find(v); seen != at.end()) {
+                // A pinch: the walk came back to v, closing a loop of its own. Each is patched
+                // apart (one patch across both would reuse the pinch's edges).
+                splitOff(loop, at, seen->second, loops, unclosed);
+            } else {
+                at[v] = loop.size();
+                loop.push_back(v);
+            }
             std::vector<uint32_t>& out = next[v];
             if (out.empty()) break;
             v = out.back();

@@ -17,7 +17,8 @@ struct HoleFillStats {
     size_t patchTriangles = 0; ///< triangles added
 };
 
-/// Closes every boundary loop of `mesh` (consistently oriented, as repairOrientation leaves it)
+/// Closes every boundary loop of `mesh` (consistently oriented, as repairOrientation leaves it; a
+/// boundary walk that passes a vertex twice is split there into loops patched apart)
 /// with a faired patch whose edges are about `spacing` world units long, or the loop's own mean
 /// edge length when that is longer. New vertices take colours faired like their positions. The
 /// topology report is refreshed.

@@ -76,3 +76,34 @@ TEST(HoleFill, ColoursAreFairedToo)
         EXPECT_GT(open.colors[i][0], 0.5f + 0.375f - 0.01f); // above the rim's red, as z is
     }
 }
+
+TEST(HoleFill, HolesMeetingAtAVertexArePatchedApart)
+{
+    // Two triangles around one vertex that share no edge: their removal leaves one boundary walk
+    // through that vertex twice (a pinch). Patched as one loop, the patch would reuse the pinch's
+    // edges; as two, the mesh closes into a manifold.
+    Mesh mesh = sphereMesh();
+    std::vector<size_t> around;
+    for (size_t t = 0; t < mesh.triangles.size(); ++t)
+        for (int k = 0; k < 3; ++k)
+            if (mesh.triangles[t][k] == 0) around.push_back(t);
+    auto shareEdge = [&](size_t a, size_t b) {
+        int common = 0;
+        for (int i = 0; i < 3; ++i)
+            for (int j = 0; j < 3; ++j) common += mesh.triangles[a][i] == mesh.triangles[b][j];
+        return common >= 2;
+    };
+    size_t second = 1;
+    while (second < around.size() && shareEdge(around[0], around[second])) ++second;
+    ASSERT_LT(second, around.size());
+    mesh.triangles.erase(mesh.triangles.begin() +
+                         std::ptrdiff_t(std::max(around[0], around[second])));
+    mesh.triangles.erase(mesh.triangles.begin() +
+                         std::ptrdiff_t(std::min(around[0], around[second])));
+    analyzeTopology(mesh);
+    ASSERT_EQ(mesh.report.boundaryEdges, 6u);
+    const detail::HoleFillStats stats = detail::fillHoles(mesh, 0.0);
+    EXPECT_EQ(stats.holes, 2u);
+    EXPECT_TRUE(mesh.report.watertight()); // no boundary and no non-manifold edge
+    EXPECT_TRUE(mesh.report.consistentlyOriented());
+}
