@@ -88,6 +88,7 @@ void renderFrame(const openvdb::FloatGrid& density, const openvdb::Vec3SGrid* co
                  const RenderSettings& settings, Image& image)
 {
     const bool levelSet = medium.kind == Medium::Kind::LevelSet;
+    const Props* props = settings.props && !settings.props->empty() ? settings.props : nullptr;
     const double sigmaPerVoxel = medium.extinction * density.voxelSize()[0]; // per index unit
     stage(settings.interrupter, "render: empty-space mask");
     const openvdb::BoolGrid::Ptr mask = rayMask(density, levelSet);
@@ -106,10 +107,9 @@ void renderFrame(const openvdb::FloatGrid& density, const openvdb::Vec3SGrid* co
         majorants = std::make_unique<const Majorants>(density, padded, levelSet);
     } else {
         stage(settings.interrupter, "render: shadows");
-        shadows =
-            buildShadows({density, padded, *mask, levelSet, sigmaPerVoxel, settings.interrupter,
-                          settings.props && !settings.props->empty() ? settings.props : nullptr},
-                         lights, settings.shadowCacheVoxels);
+        shadows = buildShadows(
+            {density, padded, *mask, levelSet, sigmaPerVoxel, settings.interrupter, props}, lights,
+            settings.shadowCacheVoxels);
     }
     if (interrupted(settings.interrupter)) throw Interrupted();
     const Intersector master(*mask);
@@ -126,7 +126,7 @@ void renderFrame(const openvdb::FloatGrid& density, const openvdb::Vec3SGrid* co
                             majorants.get(),
                             std::max(0, settings.bounces),
                             environment,
-                            settings.props && !settings.props->empty() ? settings.props : nullptr};
+                            props};
     stage(settings.interrupter, "render: pixels");
     renderTiles(frame, camera, settings, image);
     stage(settings.interrupter, nullptr);

@@ -76,9 +76,9 @@ void combineLeaf(FloatTree::LeafNodeType& leaf, const std::vector<Shell>& shells
 {
     constexpr openvdb::Index kSize = FloatTree::LeafNodeType::SIZE;
     std::array<float, kSize> best;
-    std::array<int32_t, kSize> closest, count;
+    std::array<int32_t, kSize> triangle, count; // the closest triangle (in the mesh), -1: none
     best.fill(std::numeric_limits<float>::max());
-    closest.fill(-1);
+    triangle.fill(-1);
     count.fill(0);
     const CoordBBox box = leaf.getNodeBoundingBox();
     for (size_t s = 0; s < bands.size(); ++s) {
@@ -86,13 +86,16 @@ void combineLeaf(FloatTree::LeafNodeType& leaf, const std::vector<Shell>& shells
         ShellBlock block;
         block.leaf = bands[s].sdf->tree().probeConstLeaf(leaf.origin());
         if (!block.leaf) block.tile = bands[s].sdf->tree().getValue(leaf.origin());
+        const auto* indexLeaf =
+            index && block.leaf ? bands[s].index->tree().probeConstLeaf(leaf.origin()) : nullptr;
         for (auto it = leaf.beginValueOn(); it; ++it) {
             const openvdb::Index i = it.pos();
             const float d = block.value(i);
             if (d < 0.0f) count[i] += shells[s].orientation;
             if (block.inBand(i) && std::abs(d) < best[i]) {
                 best[i] = std::abs(d);
-                closest[i] = int32_t(s);
+                const int32_t local = indexLeaf ? indexLeaf->getValue(i) : -1;
+                triangle[i] = local < 0 ? -1 : shells[s].meshTriangle[size_t(local)];
             }
         }
     }
@@ -100,10 +103,7 @@ void combineLeaf(FloatTree::LeafNodeType& leaf, const std::vector<Shell>& shells
     for (auto it = leaf.beginValueOn(); it; ++it) {
         const openvdb::Index i = it.pos();
         it.setValue(count[i] >= 1 ? -best[i] : best[i]);
-        if (!indexLeaf) continue;
-        const size_t s = size_t(closest[i]);
-        const int32_t local = bands[s].index->tree().getValue(it.getCoord());
-        indexLeaf->setValueOn(i, local < 0 ? -1 : shells[s].meshTriangle[size_t(local)]);
+        if (indexLeaf) indexLeaf->setValueOn(i, triangle[i]);
     }
 }
 

@@ -76,7 +76,7 @@ constexpr openvdb::Index kLeafSize = Leaf::SIZE;
 /// The active voxels of `leaf` joined to `seed` across faces whose two voxels lie d(u) + d(v) >
 /// `voxel` from the surface (unsigned world distances): no surface passes between such voxels (a
 /// crossing c on the segment would give d(u) + d(v) <= |uc| + |cv| = one voxel), so they share w's
-/// side. `piece` marks the voxels taken.
+/// side. `taken` marks the voxels already in a piece.
 std::vector<openvdb::Index> pieceOf(const Leaf& leaf, openvdb::Index seed, float voxel,
                                     std::array<bool, kLeafSize>& taken)
 {
@@ -204,9 +204,9 @@ std::vector<char> tileSides(const std::vector<CoordBBox>& boxes, const std::vect
 
 /// Gives each active voxel of an unsigned band its sign from the winding number (signLeaf), then
 /// fills the rest with OpenVDB's signedFloodFill and checks its work against the winding number:
-/// every tile at its centre, and every band leaf at its corners (a leaf whose check fails is
-/// evaluated voxel by voxel; this happens beside holes, where flood fill has no surface to stop
-/// at).
+/// every band leaf at its corners (a leaf whose check fails is evaluated voxel by voxel; this
+/// happens beside holes, where flood fill has no surface to stop at), and the tiles by pieces
+/// (tileSides).
 void signByWindingNumber(FloatGrid& grid, const Mesh& mesh, Interrupter* interrupter)
 {
     const detail::WindingNumber winding(mesh.points, mesh.triangles);
