@@ -166,8 +166,8 @@ Progress::~Progress()
 
 void checkFilmMemory(int width, int height, double limitGiB)
 {
-    constexpr double kBytesPerPixel =
-        48.0; // the float RGBA film, and a float and a half copy to write it
+    // The float film of RGBA and the 15 layers' floats, and a float and a half copy to write it.
+    constexpr double kBytesPerPixel = 19 * (4.0 + 4.0 + 2.0);
     const double bytes = kBytesPerPixel * double(width) * double(height);
     const double limit = double(memoryLimitBytes(limitGiB));
     if (bytes <= limit) return;

@@ -118,6 +118,7 @@ int runPreview(const PreviewArgs& args)
     SceneRender view(scene, args.threads, width);
     view.settings.interrupter = &interrupter;
     if (args.samples) view.settings.samples = *args.samples;
+    view.settings.layers = false; // a preview is RGBA alone
     if (args.from.empty())
         morph.emplace(scene, args.cache, interrupter, MorphOptions{}, args.quiet);
     else if (const std::string why = checkFramePattern(args.from); !why.empty())

@@ -46,7 +46,7 @@ struct RenderVdbArgs {
     double memoryLimitGiB = 0.0;
     std::vector<double> shutter; ///< open, close in frames: motion blur along the vel grid
     double fps = 24.0;
-    bool floatExr = false, verbose = false;
+    bool floatExr = false, noLayers = false, verbose = false;
 };
 
 void parseResolution(const std::string& text, int& width, int& height)
@@ -183,6 +183,7 @@ int runRenderVdb(const RenderVdbArgs& args)
     settings.stepVoxels = args.step;
     settings.shadowCacheVoxels = args.shadowCache;
     settings.bounces = args.bounces;
+    settings.layers = !args.noLayers;
     settings.threads = args.threads;
     settings.interrupter = &interrupter;
     const auto start = std::chrono::steady_clock::now();
@@ -364,6 +365,9 @@ Command addRenderVdbCommand(CLI::App& app)
                     "refuse a film above this, in GiB (default: half the machine's memory)")
         ->check(CLI::PositiveNumber);
     sub->add_flag("--float", a->floatExr, "float EXR instead of half");
+    sub->add_flag("--no-layers", a->noLayers,
+                  "RGBA alone, without the layers for compositing (volume, direct, indirect, "
+                  "emission, shadow, depth.Z)");
     sub->add_flag("-v,--verbose", a->verbose,
                   "print each stage as it starts, with the time since the start (stderr)");
     return {sub, [a] { return runRenderVdb(*a); }};

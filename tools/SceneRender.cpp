@@ -55,6 +55,7 @@ SceneRender::SceneRender(const Scene& scene, int threads, int width)
     settings.stepVoxels = r.stepVoxels;
     settings.shadowCacheVoxels = r.shadowCacheVoxels;
     settings.bounces = r.bounces;
+    settings.layers = r.layers;
     settings.seed = r.seed;
     settings.threads = threads;
     mProps = sceneProps(scene);

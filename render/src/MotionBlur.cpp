@@ -101,9 +101,15 @@ Image renderMotionBlurred(const openvdb::FloatGrid& density, const openvdb::Vec3
             sum = image;
         } else {
             for (size_t i = 0; i < sum.pixels.size(); ++i) sum.pixels[i] += image.pixels[i];
+            for (size_t i = 0; i < sum.layers.size(); ++i)
+                sum.layers[i] = i % layer::kFloats == layer::kDepth
+                                    ? std::min(sum.layers[i], image.layers[i])
+                                    : sum.layers[i] + image.layers[i];
         }
     }
     for (float& v : sum.pixels) v /= float(times.size());
+    for (size_t i = 0; i < sum.layers.size(); ++i)
+        if (i % layer::kFloats != layer::kDepth) sum.layers[i] /= float(times.size());
     return sum;
 }
 

@@ -12,6 +12,12 @@
 namespace volmorph::render {
 namespace {
 
+/// The layers' channel names (Renderer.h, layer::), as Nuke reads an EXR's layers.
+constexpr const char* kLayerNames[layer::kFloats] = {
+    "volume.R",   "volume.G",   "volume.B",   "volume.A",   "direct.R",
+    "direct.G",   "direct.B",   "indirect.R", "indirect.G", "indirect.B",
+    "emission.R", "emission.G", "emission.B", "shadow.A",   "depth.Z"};
+
 OIIO::ImageSpec specOf(const Image& image, OIIO::TypeDesc type)
 {
     OIIO::ImageSpec spec(image.width, image.height, 4, type);
@@ -20,15 +26,42 @@ OIIO::ImageSpec specOf(const Image& image, OIIO::TypeDesc type)
     return spec;
 }
 
+/// RGBA, then the layers if the image has them: colours in `type`, depth as float.
+OIIO::ImageSpec exrSpecOf(const Image& image, OIIO::TypeDesc type)
+{
+    OIIO::ImageSpec spec = specOf(image, type);
+    if (image.layers.empty()) return spec;
+    spec.nchannels = 4 + layer::kFloats;
+    spec.channelformats.assign(size_t(spec.nchannels), type);
+    for (const char* name : kLayerNames) spec.channelnames.push_back(name);
+    spec.channelformats[4 + layer::kDepth] = OIIO::TypeDesc::FLOAT;
+    spec.z_channel = 4 + layer::kDepth;
+    return spec;
+}
+
+/// The image's channels interleaved as `spec` lists them (RGBA, then the layers).
+std::vector<float> interleaved(const OIIO::ImageSpec& spec, const Image& image)
+{
+    if (spec.nchannels == 4) return image.pixels;
+    const size_t pixels = size_t(image.width) * size_t(image.height), n = size_t(spec.nchannels);
+    std::vector<float> all(pixels * n);
+    for (size_t p = 0; p < pixels; ++p) {
+        std::copy_n(&image.pixels[4 * p], 4, &all[n * p]);
+        std::copy_n(&image.layers[layer::kFloats * p], layer::kFloats, &all[n * p + 4]);
+    }
+    return all;
+}
+
 void writeWith(const std::filesystem::path& path, const OIIO::ImageSpec& spec, const Image& image)
 {
+    const std::vector<float> all = interleaved(spec, image);
     // Created from the final name (format from its extension), written under a temporary one.
     auto out = OIIO::ImageOutput::create(path.string());
     if (!out)
         throw std::runtime_error("no image writer for " + path.string() + ": " + OIIO::geterror());
     writeAtomically(path, [&](const std::filesystem::path& temporary) {
         bool ok = out->open(temporary.string(), spec);
-        ok = ok && out->write_image(OIIO::TypeDesc::FLOAT, image.pixels.data());
+        ok = ok && out->write_image(OIIO::TypeDesc::FLOAT, all.data());
         ok = out->close() && ok;
         if (!ok) throw std::runtime_error(out->geterror());
     });
@@ -54,7 +87,7 @@ void writeExr(const Image& image, const Camera& camera, const std::filesystem::p
               const ExrOptions& options)
 {
     OIIO::ImageSpec spec =
-        specOf(image, options.halfFloat ? OIIO::TypeDesc::HALF : OIIO::TypeDesc::FLOAT);
+        exrSpecOf(image, options.halfFloat ? OIIO::TypeDesc::HALF : OIIO::TypeDesc::FLOAT);
     spec.attribute("compression", "zip");
     spec.attribute("Software", std::string("volmorph ") + versionString());
     spec.attribute("volmorph:frame", options.frame);
@@ -86,16 +119,29 @@ Image readImage(const std::filesystem::path& path)
     auto in = OIIO::ImageInput::open(path.string());
     if (!in) throw std::runtime_error(OIIO::geterror());
     const OIIO::ImageSpec& spec = in->spec();
+    const size_t pixels = size_t(spec.width) * size_t(spec.height), n = size_t(spec.nchannels);
+    std::vector<float> all(pixels * n);
+    if (!in->read_image(0, 0, 0, spec.nchannels, OIIO::TypeDesc::FLOAT, all.data()))
+        throw std::runtime_error(in->geterror());
     Image image;
     image.width = spec.width;
     image.height = spec.height;
-    image.pixels.assign(size_t(spec.width) * size_t(spec.height) * 4, 0.0f);
-    std::vector<float> all(size_t(spec.width) * size_t(spec.height) * size_t(spec.nchannels));
-    if (!in->read_image(0, 0, 0, spec.nchannels, OIIO::TypeDesc::FLOAT, all.data()))
-        throw std::runtime_error(in->geterror());
-    for (size_t p = 0; p < size_t(spec.width) * size_t(spec.height); ++p)
-        for (int c = 0; c < std::min(4, spec.nchannels); ++c)
-            image.pixels[4 * p + size_t(c)] = all[p * size_t(spec.nchannels) + size_t(c)];
+    // RGBA by name (the first four channels where they are not named so); the layers when all
+    // are there.
+    auto copy = [&](const char* const* names, int count, std::vector<float>& to, bool byPosition) {
+        to.assign(pixels * size_t(count), 0.0f);
+        for (int c = 0; c < count; ++c) {
+            int from = spec.channelindex(names[c]);
+            if (from < 0 && byPosition && c < spec.nchannels) from = c;
+            if (from < 0) continue;
+            for (size_t p = 0; p < pixels; ++p)
+                to[size_t(count) * p + size_t(c)] = all[n * p + size_t(from)];
+        }
+    };
+    const char* const rgba[4] = {"R", "G", "B", "A"};
+    copy(rgba, 4, image.pixels, spec.channelindex("R") < 0);
+    if (spec.channelindex(kLayerNames[0]) >= 0 && spec.channelindex("depth.Z") >= 0)
+        copy(kLayerNames, layer::kFloats, image.layers, false);
     return image;
 }
 

@@ -77,6 +77,16 @@ double invertPrimary(const ThreadReaders& r, const Medium1D& line, double target
     return p.ta + 0.5 * (lo + hi);
 }
 
+constexpr double kLn2 = 0.69314718055994531;
+
+/// The world distance along the camera ray at which its alpha passes 0.5 (its optical depth ln 2),
+/// after walkPrimary found the total above that.
+double halfAlphaDistance(const ThreadReaders& r, const Ray& ray, const Medium1D& line)
+{
+    const Vec3d ip = line.eye + line.dir * invertPrimary(r, line, kLn2);
+    return (r.in.density.indexToWorld(ip) - ray.origin).length();
+}
+
 /// One path from the camera ray's first collision on: its radiance.
 class Path {
 public:
@@ -91,16 +101,19 @@ public:
         size_t prop = 0;
     };
 
-    /// The radiance of the path from vertex `v` on (Cycles' bounces count every vertex).
-    Vec3d trace(Vertex v)
+    /// The radiance of the path from vertex `v` on (Cycles' bounces count every vertex): what
+    /// reaches the first vertex from the lights and the environment is direct, the rest indirect.
+    Radiance trace(Vertex v)
     {
-        Vec3d L(0.0), beta(1.0);
+        Radiance L;
+        Vec3d beta(1.0);
         for (int vertex = 0;; ++vertex) {
-            if (!scatter(v, L, beta)) break;
+            Vec3d& light = vertex == 0 ? L.direct : L.indirect;
+            if (!scatter(v, vertex == 0 ? L.emission : L.indirect, light, beta)) break;
             if (vertex == mIn.bounces && mIn.environment == Vec3d(0.0)) break;
             if (vertex >= 2 && !survives(beta)) break;
             if (!next(v)) {
-                L += beta * mIn.environment;
+                light += beta * mIn.environment;
                 break;
             }
             if (vertex == mIn.bounces) break;
@@ -109,7 +122,7 @@ public:
     }
 
     /// The radiance leaving a diffuse prop's point x (normal n) toward -dir.
-    Vec3d onSurface(const Vec3d& x, const Vec3d& n, const Vec3d& dir, size_t prop)
+    Radiance onSurface(const Vec3d& x, const Vec3d& n, const Vec3d& dir, size_t prop)
     {
         return trace(Vertex{true, Vec3d(0.0), x, n, dir, prop});
     }
@@ -134,7 +147,7 @@ public:
     }
 
     /// A collision at index point ip, travelling along `dir` (index space).
-    Vec3d trace(const Vec3d& ip, const Vec3d& dir)
+    Radiance trace(const Vec3d& ip, const Vec3d& dir)
     {
         Vertex v;
         v.ip = ip;
@@ -143,22 +156,22 @@ public:
     }
 
 private:
-    /// The vertex's emission and direct light into L, its albedo or reflectance into beta; false
-    /// when nothing more can come back.
-    bool scatter(const Vertex& v, Vec3d& L, Vec3d& beta)
+    /// The vertex's emission into `emitted` and the light it scatters from the lights into `lit`,
+    /// its albedo or reflectance into beta; false when nothing more can come back.
+    bool scatter(const Vertex& v, Vec3d& emitted, Vec3d& lit, Vec3d& beta)
     {
         if (!v.surface) {
-            L += beta * mIn.medium.emission;
+            emitted += beta * mIn.medium.emission;
             beta = beta * albedoAt(v.ip);
         } else {
             beta = beta * mIn.props->mesh(v.prop).color;
         }
         if (beta.x() <= 0.0 && beta.y() <= 0.0 && beta.z() <= 0.0) return false;
         if (!v.surface) {
-            L += beta * directLight(v.ip, v.dir);
+            lit += beta * directLight(v.ip, v.dir);
         } else {
             Vec3d unoccluded;
-            L += diffuseRadiance(beta, directIrradiance(mR, v.x, v.n, unoccluded, &mRandom));
+            lit += diffuseRadiance(beta, directIrradiance(mR, v.x, v.n, unoccluded, &mRandom));
         }
         return true;
     }
@@ -323,18 +336,22 @@ RaySample tracePath(ThreadReaders& readers, const Ray& ray, Random& random)
             const double t = invertPrimary(readers, line, std::min(target, tau));
             // The weight applies outside the path, so that roulette sees the path's own
             // attenuation.
-            out.L = path.trace(line.eye + line.dir * t, line.dir) * (1.0 - out.T);
+            out.L = path.trace(line.eye + line.dir * t, line.dir);
+            out.L *= 1.0 - out.T;
         }
+        if (tau > kLn2) out.depth = halfAlphaDistance(readers, ray, line);
     }
+    out.volumeL = out.L.sum();
+    out.volumeT = out.T;
     if (!onProp || out.T <= kMinTransmittance) return out;
     const PropMesh& prop = in.props->mesh(hit.prop);
-    Vec3d surface(0.0);
+    Radiance surface;
     double matte = 0.0;
     if (prop.role == PropMesh::Role::Diffuse)
         surface = path.onSurface(surfacePoint(ray, hit), hit.normal, ray.direction, hit.prop);
     else if (prop.role == PropMesh::Role::ShadowCatcher)
         matte = path.catcherMatte(surfacePoint(ray, hit), hit.normal);
-    finishOnProp(prop, surface, matte, out);
+    finishOnProp(prop, hit.distance, surface, matte, out);
     return out;
 }
 

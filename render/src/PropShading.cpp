@@ -38,16 +38,21 @@ double shadowMatte(const Vec3d& received, const Vec3d& unoccluded)
     return std::clamp(1.0 - seen / reference, 0.0, 1.0);
 }
 
-void finishOnProp(const PropMesh& prop, const Vec3d& surface, double matte, RaySample& out)
+void finishOnProp(const PropMesh& prop, double distance, const Radiance& surface, double matte,
+                  RaySample& out)
 {
+    out.depth = std::min(out.depth, distance);
     switch (prop.role) {
     case PropMesh::Role::Diffuse:
-        out.L += surface * out.T;
+        out.L.direct += surface.direct * out.T;
+        out.L.indirect += surface.indirect * out.T;
+        out.L.emission += surface.emission * out.T;
         out.T = 0.0;
         break;
     case PropMesh::Role::Holdout:
         break;
     case PropMesh::Role::ShadowCatcher:
+        out.shadow = matte * out.T;
         out.T *= 1.0 - matte;
         break;
     }

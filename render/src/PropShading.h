@@ -32,11 +32,13 @@ inline Vec3d diffuseRadiance(const Vec3d& color, const Vec3d& irradiance)
 /// A shadow catcher's matte: 1 - received / unoccluded (per channel's mean), 0 without light.
 double shadowMatte(const Vec3d& received, const Vec3d& unoccluded);
 
-/// A camera ray that reached prop `hit` with `out` the volume in front of it (radiance, and its
-/// transmittance T): a diffuse prop adds T times `surface` (its radiance) and makes the pixel
-/// opaque; a holdout keeps the alpha of the volume in front only; a shadow catcher adds no colour
-/// and `matte` times T to the alpha.
-void finishOnProp(const PropMesh& prop, const Vec3d& surface, double matte, RaySample& out);
+/// A camera ray that reached prop `hit`, `distance` world units along it, with `out` the volume in
+/// front of it (radiance, and its transmittance T): a diffuse prop adds T times `surface` (its
+/// radiance) and makes the pixel opaque; a holdout keeps the alpha of the volume in front only; a
+/// shadow catcher adds no colour and `matte` times T to the alpha (out.shadow). The depth becomes
+/// the prop's unless the volume's alpha passed 0.5 before it.
+void finishOnProp(const PropMesh& prop, double distance, const Radiance& surface, double matte,
+                  RaySample& out);
 
 /// The world point a camera ray meets its prop at, nudged off the surface along its normal.
 Vec3d surfacePoint(const Ray& ray, const PropHit& hit);

@@ -105,14 +105,18 @@ public:
         return mOut;
     }
 
+    /// The ray time (voxels) at which the alpha passed 0.5, negative while it has not.
+    double halfAlpha() const { return mHalf; }
+
 private:
-    /// The source term at ray time t (voxels): emission plus albedo times the light arriving.
+    /// The scattered part of the source term at ray time t (voxels): albedo times the light
+    /// arriving. (The emission, constant, adds emission x (1 - T) over the ray: integrateVolume.)
     Vec3d sourceAt(double t)
     {
         const Vec3d ip = mLine.eye + mLine.dir * t;
         Vec3d albedo(mIn.medium.albedo);
         if (mR.colors) albedo = mR.colors->at(ip) * mIn.medium.albedo;
-        Vec3d source = mIn.medium.emission;
+        Vec3d source(0.0);
         for (size_t l = 0; l < mIn.lights.size(); ++l) {
             Vec3d c;
             const double Tl = lightArriving(mR, l, ip, mRay.direction, &mR.perRay[l], c);
@@ -126,7 +130,7 @@ private:
     {
         const Vec3d next = sourceAt(t);
         if (mA > 0.0)
-            mOut.L +=
+            mOut.L.direct +=
                 mKnotSource * mA + (next - mKnotSource) * (t > mKnot ? mB / (t - mKnot) : 0.0);
         mKnot = t;
         mKnotSource = next;
@@ -158,6 +162,9 @@ private:
                 const double a = mOut.T * (1.0 - transmitted);
                 mA += a;
                 mB += a * (end - 0.5 * dt - mKnot);
+                // Where T reaches 0.5, the step's density taken as uniform.
+                if (mHalf < 0.0 && mOut.T * transmitted <= 0.5)
+                    mHalf = ta + k * dt + dt * std::log(2.0 * mOut.T) / tau;
                 mOut.T *= transmitted;
             }
             if (mOut.T <= kMinTransmittance) {
@@ -197,7 +204,7 @@ private:
     const Medium1D mLine;
     RaySample mOut;
     bool mOpen = false; ///< a knot is placed and steps since it are pending
-    double mKnot = 0.0, mA = 0.0, mB = 0.0, mLastEnd = -1.0;
+    double mKnot = 0.0, mA = 0.0, mB = 0.0, mLastEnd = -1.0, mHalf = -1.0;
     Vec3d mKnotSource{0.0};
 };
 
@@ -220,7 +227,13 @@ RaySample integrateVolume(ThreadReaders& readers, const Ray& ray, double tEnd)
                         readers.inter.getIndexPos(1.0) - readers.inter.getIndexPos(0.0),
                         in.levelSet};
     RayIntegrator integrator(readers, ray, line);
-    return integrator.run();
+    RaySample out = integrator.run();
+    out.L.emission = in.medium.emission * (1.0 - out.T);
+    if (integrator.halfAlpha() >= 0.0)
+        out.depth =
+            (in.density.indexToWorld(line.eye + line.dir * integrator.halfAlpha()) - ray.origin)
+                .length();
+    return out;
 }
 
 } // namespace
@@ -232,17 +245,20 @@ RaySample integrateRay(ThreadReaders& readers, const Ray& ray, Random* random)
     const bool onProp =
         in.props && in.props->intersect(ray.origin, ray.direction, 0.0, kNoProp, hit);
     RaySample out = integrateVolume(readers, ray, onProp ? hit.distance : kNoProp);
+    out.volumeL = out.L.sum();
+    out.volumeT = out.T;
     if (!onProp || out.T <= kMinTransmittance) return out;
     const PropMesh& prop = in.props->mesh(hit.prop);
-    Vec3d surface(0.0), unoccluded(0.0);
+    Radiance surface;
+    Vec3d unoccluded(0.0);
     double matte = 0.0;
     if (prop.role != PropMesh::Role::Holdout) {
         const Vec3d received =
             directIrradiance(readers, surfacePoint(ray, hit), hit.normal, unoccluded, random);
-        surface = diffuseRadiance(prop.color, received);
+        surface.direct = diffuseRadiance(prop.color, received);
         matte = shadowMatte(received, unoccluded);
     }
-    finishOnProp(prop, surface, matte, out);
+    finishOnProp(prop, hit.distance, surface, matte, out);
     return out;
 }
 

@@ -42,6 +42,8 @@ struct FrameInputs {
 
 /// The far end of a ray that meets no prop (world units).
 inline constexpr double kNoProp = std::numeric_limits<double>::max();
+/// RaySample::depth where the ray meets neither a prop nor alpha 0.5.
+inline constexpr double kNoHit = std::numeric_limits<double>::infinity();
 
 /// A piece of a camera ray inside one cell (or constant run), with the optical depth before it.
 struct TracedPiece {
@@ -79,10 +81,28 @@ Vec3d lightPhased(const FrameInputs& in, size_t l, const Vec3d& ip, const Vec3d&
 double lightArriving(ThreadReaders& readers, size_t l, const Vec3d& ip, const Vec3d& direction,
                      const Vec3d* directional, Vec3d& phased);
 
-/// The radiance L (linear RGB, premultiplied) and the transmittance T along one camera ray.
+/// Radiance (linear RGB, premultiplied) split as the layers split it (Renderer.h, layer::).
+struct Radiance {
+    Vec3d direct{0.0}, indirect{0.0}, emission{0.0};
+
+    Vec3d sum() const { return direct + indirect + emission; }
+    Radiance& operator*=(double s)
+    {
+        direct *= s;
+        indirect *= s;
+        emission *= s;
+        return *this;
+    }
+};
+
+/// What one camera ray brings: its radiance and transmittance T, and what the layers take apart.
 struct RaySample {
-    Vec3d L{0.0};
+    Radiance L;
     double T = 1.0;
+    Vec3d volumeL{0.0};    ///< the volume's radiance in front of the first prop
+    double volumeT = 1.0;  ///< the volume's transmittance in front of the first prop
+    double shadow = 0.0;   ///< a shadow catcher's matte times volumeT
+    double depth = kNoHit; ///< world distance along the ray: alpha passes 0.5, or the prop
 };
 
 /// Integrates one world-space camera ray through the frame's volume, up to the first prop, and

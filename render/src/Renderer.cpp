@@ -34,13 +34,35 @@ void stage(openvdb::util::NullInterrupter* interrupter, const char* name)
     if (name) interrupter->start(name);
 }
 
-/// The pixel (x, y)'s samples averaged: RGB premultiplied, A = 1 - transmittance.
+/// One sample's part of its pixel: RGBA into `rgba`, the layers (layer::) into `layers` when
+/// given, the depth there as the nearest; `viewCosine` is the ray's cosine to the view axis.
+void accumulate(const RaySample& sample, double viewCosine, double* rgba, double* layers)
+{
+    const Vec3d L = sample.L.sum();
+    for (int c = 0; c < 3; ++c) rgba[c] += L[c];
+    rgba[3] += 1.0 - sample.T;
+    if (!layers) return;
+    for (int c = 0; c < 3; ++c) {
+        layers[layer::kVolume + c] += sample.volumeL[c];
+        layers[layer::kDirect + c] += sample.L.direct[c];
+        layers[layer::kIndirect + c] += sample.L.indirect[c];
+        layers[layer::kEmission + c] += sample.L.emission[c];
+    }
+    layers[layer::kVolume + 3] += 1.0 - sample.volumeT;
+    layers[layer::kShadow] += sample.shadow;
+    if (sample.depth != kNoHit)
+        layers[layer::kDepth] = std::min(layers[layer::kDepth], sample.depth * viewCosine);
+}
+
+/// The pixel (x, y)'s samples averaged into px (RGBA: RGB premultiplied, A = 1 - transmittance)
+/// and, when given, `layers` (layer::kFloats).
 void renderPixel(ThreadReaders& readers, const Camera& camera, const RenderSettings& settings,
-                 int x, int y, float* px)
+                 int x, int y, float* px, float* layers)
 {
     const int samples = std::max(1, settings.samples);
     const int strata = int(std::ceil(std::sqrt(double(samples))));
-    double r = 0, g = 0, b = 0, alpha = 0;
+    double rgba[4] = {0, 0, 0, 0}, sums[layer::kFloats] = {};
+    sums[layer::kDepth] = layer::kNoDepth;
     for (int s = 0; s < samples; ++s) {
         Random random(uint64_t(y) * 65536u + uint64_t(x), uint64_t(s),
                       (uint64_t(settings.frame) << 32) ^ settings.seed);
@@ -53,15 +75,12 @@ void renderPixel(ThreadReaders& readers, const Camera& camera, const RenderSetti
         const Ray ray = camera.ray(x + sx, y + sy);
         const RaySample sample = readers.in.majorants ? tracePath(readers, ray, random)
                                                       : integrateRay(readers, ray, &random);
-        r += sample.L.x();
-        g += sample.L.y();
-        b += sample.L.z();
-        alpha += 1.0 - sample.T;
+        accumulate(sample, ray.direction.dot(camera.forward()), rgba, layers ? sums : nullptr);
     }
-    px[0] = float(r / samples);
-    px[1] = float(g / samples);
-    px[2] = float(b / samples);
-    px[3] = float(alpha / samples);
+    for (int c = 0; c < 4; ++c) px[c] = float(rgba[c] / samples);
+    if (!layers) return;
+    for (int c = 0; c < layer::kFloats; ++c)
+        layers[c] = float(c == layer::kDepth ? sums[c] : sums[c] / samples);
 }
 
 /// Every pixel of `image`, tiles in parallel. Pixels are independent and each one's samples are
@@ -76,7 +95,9 @@ void renderTiles(const FrameInputs& frame, const Camera& camera, const RenderSet
                           for (int y = tile.rows().begin(); y != tile.rows().end(); ++y)
                               for (int x = tile.cols().begin(); x != tile.cols().end(); ++x) {
                                   if (interrupted(settings.interrupter)) return;
-                                  renderPixel(readers, camera, settings, x, y, image.at(x, y));
+                                  renderPixel(readers, camera, settings, x, y, image.at(x, y),
+                                              image.layers.empty() ? nullptr
+                                                                   : image.layersAt(x, y));
                               }
                       });
 }
@@ -143,6 +164,11 @@ Image renderVolume(const openvdb::FloatGrid& density, const openvdb::Vec3SGrid* 
     image.width = camera.width();
     image.height = camera.height();
     image.pixels.assign(size_t(image.width) * size_t(image.height) * 4, 0.0f);
+    if (settings.layers) {
+        image.layers.assign(size_t(image.width) * size_t(image.height) * layer::kFloats, 0.0f);
+        for (size_t p = 0; p < image.layers.size(); p += layer::kFloats)
+            image.layers[p + layer::kDepth] = layer::kNoDepth;
+    }
     const bool props = settings.props && !settings.props->empty();
     const bool empty = density.tree().activeVoxelCount() == 0;
     if (empty && !props) return image;

@@ -1,6 +1,6 @@
 #!/bin/sh
-# volmorph render-vdb: an EXR with the metadata of the spec, a PNG preview, and the same pixels
-# bit for bit whatever the thread count.
+# volmorph render-vdb: an EXR with the metadata and layers of the spec (RGBA alone with --no-layers),
+# a PNG preview, and the same pixels bit for bit whatever the thread count.
 # usage: render_vdb.sh VOLMORPH SOURCE_DIR
 set -eu
 volmorph=$1
@@ -17,9 +17,13 @@ idiff -fail 0 -failpercent 0 -hardfail 0 "$out/one.exr" "$out/two.exr" >/dev/nul
     || { echo "--threads 1 and 2 differ"; idiff "$out/one.exr" "$out/two.exr"; exit 1; }
 info=$(oiiotool --info -v "$out/one.exr")
 for field in "half" "compression: \"zip\"" "chromaticities: 0.64, 0.33, 0.3, 0.6, 0.15, 0.06, 0.3127, 0.329" \
-             "worldToCamera" "worldToNDC" "Software: \"volmorph" "volmorph:samples: 3"; do
+             "worldToCamera" "worldToNDC" "Software: \"volmorph" "volmorph:samples: 3" \
+             "19 channel" "depth.Z (float)" "volume.A (half)" "indirect.B (half)" "shadow.A (half)"; do
     echo "$info" | grep -q "$field" || { echo "EXR lacks $field:"; echo "$info"; exit 1; }
 done
+# shellcheck disable=SC2086
+"$volmorph" render-vdb "$out/sphere.vdb" -o "$out/rgba.exr" --no-layers $common >/dev/null
+oiiotool --info "$out/rgba.exr" | grep -q "4 channel" || { echo "--no-layers wrote layers"; exit 1; }
 [ -s "$out/one.png" ] || { echo "no PNG preview"; exit 1; }
 [ "$(ls "$out" | grep -c partial || true)" -eq 0 ] || { echo "temporary files left"; exit 1; }
 echo "render-vdb: deterministic across thread counts, metadata present"

@@ -197,6 +197,9 @@ struct RenderSpec {
     int bounces = 0;
     /// Spacing of the transmittance caches toward lights, in voxels; 0: exact per sample.
     int shadowCacheVoxels = 1;
+    /// The EXR's layers for compositing beside RGBA (volume, direct, indirect, emission, shadow,
+    /// depth.Z).
+    bool layers = true;
     unsigned seed = 0;
     /// Motion blur: the shutter's open and close, in frames around the frame ([-0.25, 0.25]: half a
     /// frame centred on it); open == close (the default) renders the instant.

@@ -11,7 +11,7 @@ namespace {
 
 const std::vector<std::string> kRenderKeys = {
     "resolution", "samples", "step",     "extinction", "albedo",       "anisotropy", "seed",
-    "camera",     "lights",  "emission", "bounces",    "shadow_cache", "shutter"};
+    "camera",     "lights",  "emission", "bounces",    "shadow_cache", "shutter",    "layers"};
 const std::vector<std::string> kCameraKeys = {"projection", "eye",   "lookat", "up",
                                               "fov",        "width", "keys"};
 const std::vector<std::string> kCameraKeyKeys = {"frame", "eye", "lookat", "up", "fov", "width"};
@@ -273,6 +273,8 @@ void parseRender(Reader& r, const toml::node& node, RenderSpec& rs)
         if (auto v = r.integerIn(*n, "render.shadow_cache", 0, 16)) rs.shadowCacheVoxels = int(*v);
     if (const toml::node* n = t->get("emission"))
         if (auto v = r.nonNegativeVec3(*n, "render.emission")) rs.emission = *v;
+    if (const toml::node* n = t->get("layers"))
+        if (auto v = r.boolean(*n, "render.layers")) rs.layers = *v;
     if (const toml::node* n = t->get("shutter"))
         if (auto v = r.interval(*n, "render.shutter",
                                 "the shutter's open and close in frames around the frame", false))

@@ -4,6 +4,8 @@
 #include <volmorph/render/Props.h>
 #include <volmorph/render/Renderer.h>
 
+#include "support/RenderFixtures.h"
+
 #include <gtest/gtest.h>
 #include <openvdb/tools/LevelSetSphere.h>
 
@@ -15,34 +17,15 @@ using namespace volmorph;
 using render::Camera;
 using render::PropMesh;
 using render::Ray;
+using test::floorQuad;
 
 namespace {
 
 constexpr double kVoxel = 0.02;
 
-/// An axis-aligned quad at height y over [x0, x1] x [z0, z1], facing up.
-PropMesh floorQuad(double y, double x0, double x1, double z0, double z1,
-                   PropMesh::Role role = PropMesh::Role::Diffuse)
-{
-    PropMesh m;
-    m.points = {Vec3f(float(x0), float(y), float(z0)), Vec3f(float(x1), float(y), float(z0)),
-                Vec3f(float(x1), float(y), float(z1)), Vec3f(float(x0), float(y), float(z1))};
-    m.triangles = {Vec3I(0, 2, 1), Vec3I(0, 3, 2)};
-    m.color = Vec3d(0.5, 0.6, 0.7);
-    m.role = role;
-    return m;
-}
-
-/// Density 1 at the voxels whose centres lie in [x0, x1] x [y0, y1] x [z0, z1] (world units).
 openvdb::FloatGrid::Ptr slab(Vec3d lo, Vec3d hi)
 {
-    auto grid = openvdb::FloatGrid::create(0.0f);
-    grid->setTransform(openvdb::math::Transform::createLinearTransform(kVoxel));
-    const openvdb::CoordBBox box(openvdb::Coord::round(lo / kVoxel),
-                                 openvdb::Coord::round(hi / kVoxel));
-    grid->tree().denseFill(box, 1.0f, true);
-    grid->setGridClass(openvdb::GRID_FOG_VOLUME);
-    return grid;
+    return test::fogSlab(lo, hi, kVoxel);
 }
 
 /// Looking straight down at the floor from above: 64 pixels over 2 world units, centred at x.
@@ -54,10 +37,7 @@ Camera downAt(double x)
 
 render::Light sun(const Vec3d& travel, double intensity)
 {
-    render::Light light;
-    light.direction = travel.unit();
-    light.intensity = intensity;
-    return light;
+    return test::sunLight(travel, intensity);
 }
 
 /// The pixel of row 32 whose ray passes nearest world x (an orthographic camera).

@@ -28,6 +28,9 @@ public:
     /// OpenEXR's worldToNDC (perspective divide by w), column vectors.
     Mat4d worldToNdc() const;
 
+    /// The unit view direction (world): a ray's depth is its distance times ray.direction .
+    /// forward.
+    const Vec3d& forward() const { return mForward; }
     int width() const { return mWidth; }
     int height() const { return mHeight; }
 

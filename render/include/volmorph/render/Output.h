@@ -11,15 +11,18 @@
 namespace volmorph::render {
 
 struct ExrOptions {
-    bool halfFloat = true;                       ///< half RGBA (default) or float
+    bool halfFloat = true;                       ///< half colours (default) or float
     std::map<std::string, std::string> metadata; ///< extra string attributes
     int frame = 0;
     int samples = 0;
     double renderSeconds = 0.0;
 };
 
-/// Writes `image` as an OpenEXR file: ZIP compression, linear Rec.709 chromaticities, software and
-/// version, frame, worldToCamera and worldToNDC, samples and render time. The file appears at
+/// Writes `image` as an OpenEXR file: RGBA, and its layers when it has them (Renderer.h, layer::),
+/// named as Nuke reads them: volume.R/G/B/A, direct.*, indirect.*, emission.* (R, G, B),
+/// shadow.A and depth.Z, colours in half (or float) and depth always float. ZIP compression,
+/// linear Rec.709 chromaticities, software and version, frame, worldToCamera and worldToNDC,
+/// samples and render time. The file appears at
 /// `path` only when complete (written under a temporary name, then renamed). Throws
 /// std::runtime_error with the reason when it cannot be written.
 void writeExr(const Image& image, const Camera& camera, const std::filesystem::path& path,
@@ -28,7 +31,8 @@ void writeExr(const Image& image, const Camera& camera, const std::filesystem::p
 /// Writes an 8-bit sRGB PNG preview (clamped, over black), atomically like writeExr.
 void writePng(const Image& image, const std::filesystem::path& path);
 
-/// Reads an image's RGBA pixels (tests, diff). Throws std::runtime_error when it cannot.
+/// Reads an image's RGBA pixels (by channel name, else its first four channels), and the layers
+/// when the file has them all (tests, diff). Throws std::runtime_error when it cannot.
 Image readImage(const std::filesystem::path& path);
 
 } // namespace volmorph::render

@@ -98,21 +98,47 @@ struct RenderSettings {
     int threads = 0; ///< 0 = all cores
     /// Meshes in the shot (Props.h), built once for a sequence; null: none.
     const Props* props = nullptr;
+    /// Fill Image::layers (the layers for compositing) besides RGBA.
+    bool layers = false;
     /// Asked between pixels and between the shadow maps' columns (OpenVDB's interrupter interface);
     /// when it answers true, renderVolume throws volmorph::Interrupted. May be null.
     openvdb::util::NullInterrupter* interrupter = nullptr;
 };
 
+/// The layers for compositing beside RGBA (RenderSettings::layers), as floats per pixel at these
+/// offsets:
+/// - Volume (RGBA): the volume alone, in front of the first prop: RGB premultiplied, A = 1 - its
+///   transmittance.
+/// - Direct, Indirect, Emission (RGB each): the beauty's RGB split three ways (they add up to it):
+///   light arriving at the path's first vertex (a collision in the volume, or the prop the camera
+///   sees) from a light or the environment with no scattering between; light that scattered at
+///   least once more; the medium's emission at the first vertex (single scattering: along the ray).
+/// - Shadow (A): a shadow catcher's matte times the volume's transmittance in front of it, its
+/// share
+///   of the alpha: A = volume.A + shadow where a catcher is behind, volume.A elsewhere.
+/// - Depth (Z): camera-space depth (world units along the view axis) of the first point where the
+///   volume's alpha passes 0.5, or of the first prop if it comes before; the nearest over the
+///   pixel's samples; kNoDepth where neither (as Cycles' 1e10).
+namespace layer {
+inline constexpr int kVolume = 0, kDirect = 4, kIndirect = 7, kEmission = 10, kShadow = 13,
+                     kDepth = 14, kFloats = 15;
+inline constexpr float kNoDepth = 1e10f;
+} // namespace layer
+
 /// A float RGBA image, RGB premultiplied, linear; A = 1 - transmittance. Row-major, top row first.
 struct Image {
     int width = 0, height = 0;
     std::vector<float> pixels; ///< 4 floats per pixel
+    std::vector<float> layers; ///< empty, or layer::kFloats floats per pixel (see layer::)
 
-    float* at(int x, int y) { return &pixels[4 * (size_t(y) * size_t(width) + size_t(x))]; }
-    const float* at(int x, int y) const
+    float* at(int x, int y) { return &pixels[4 * index(x, y)]; }
+    const float* at(int x, int y) const { return &pixels[4 * index(x, y)]; }
+    float* layersAt(int x, int y) { return &layers[size_t(layer::kFloats) * index(x, y)]; }
+    const float* layersAt(int x, int y) const
     {
-        return &pixels[4 * (size_t(y) * size_t(width) + size_t(x))];
+        return &layers[size_t(layer::kFloats) * index(x, y)];
     }
+    size_t index(int x, int y) const { return size_t(y) * size_t(width) + size_t(x); }
 };
 
 /// Renders `density` (a fog: any float grid of densities, negative values counting as 0; or a level
