@@ -1,5 +1,6 @@
 // volmorph check SCENE: validate a scene and summarise it.
 #include "Common.h"
+#include "SceneRender.h"
 
 #include <volmorph/Frames.h>
 #include <volmorph/Scene.h>
@@ -7,6 +8,7 @@
 #include <volmorph/Schedule.h>
 #include <volmorph/VolumeInput.h>
 #include <volmorph/Voxelize.h>
+#include <volmorph/render/EnvironmentMap.h>
 
 #include <algorithm>
 #include <cmath>
@@ -193,6 +195,17 @@ void printSettings(const Scene& scene)
         std::printf("; exact transmittance toward lights\n");
 }
 
+/// An environment light, and its sky map's size once read.
+void printEnvironment(const LightSpec& l)
+{
+    std::printf("light   environment, colour %s, intensity %s (radiance)", fmt(l.color).c_str(),
+                fmt(l.intensity).c_str());
+    if (const auto map = readSkyMap(l))
+        std::printf(", times the lat-long map %s (%dx%d)", l.map.filename().string().c_str(),
+                    map->width(), map->height());
+    std::printf("\n");
+}
+
 /// The camera, the emission and the lights (with their animation keys).
 void printView(const RenderSpec& r)
 {
@@ -213,8 +226,7 @@ void printView(const RenderSpec& r)
             std::printf("light   directional, travelling %s, colour %s, intensity %s\n",
                         fmt(l.direction).c_str(), fmt(l.color).c_str(), fmt(l.intensity).c_str());
         else if (l.type == LightType::Environment)
-            std::printf("light   environment, colour %s, intensity %s (radiance)\n",
-                        fmt(l.color).c_str(), fmt(l.intensity).c_str());
+            printEnvironment(l);
         else
             std::printf("light   point at %s, colour %s, intensity %s\n", fmt(l.position).c_str(),
                         fmt(l.color).c_str(), fmt(l.intensity).c_str());

@@ -10,6 +10,7 @@
 #include <volmorph/core/VdbRead.h>
 #include <volmorph/core/Version.h>
 #include <volmorph/Voxelize.h>
+#include <volmorph/render/EnvironmentMap.h>
 #include <volmorph/render/Output.h>
 #include <volmorph/render/Renderer.h>
 
@@ -37,7 +38,7 @@ Vec3d vec3(const std::vector<double>& v)
 /// 0.7). The camera is placed to frame the volume unless --translate places it (vdb_render's
 /// default, the origin, is inside most volumes).
 struct RenderVdbArgs {
-    std::string input, output, png, camera = "persp", grid, resolution = "1920x1080";
+    std::string input, output, png, camera = "persp", grid, resolution = "1920x1080", envMap;
     std::vector<double> translate, lookat, up{0, 1, 0}, light, emission, env;
     double fov = 2.0 * std::atan(41.2136 / 100.0) * 180.0 / M_PI, frameWidth = 0.0,
            extinction = 40.0, albedo = 0.8, step = 1.0;
@@ -118,11 +119,13 @@ render::Camera vdbCamera(const RenderVdbArgs& args, const openvdb::FloatGrid& de
 }
 
 /// The flags' lights: --light (a directional light; by default vdb_render's, toward 0.3,0.3,0 with
-/// colour 0.7) unless --env alone is given, and the environment of --env.
+/// colour 0.7) unless --env or --env-map alone is given, and the environment of --env (a constant
+/// sky) or --env-map (a lat-long map, times --env when given).
 std::vector<render::Light> vdbLights(const RenderVdbArgs& args)
 {
     std::vector<render::Light> lights;
-    if (!args.light.empty() || args.env.empty()) {
+    const bool sky = !args.env.empty() || !args.envMap.empty();
+    if (!args.light.empty() || !sky) {
         const std::vector<double> toward =
             args.light.empty() ? std::vector<double>{0.3, 0.3, 0.0, 0.7, 0.7, 0.7} : args.light;
         render::Light light;
@@ -130,11 +133,19 @@ std::vector<render::Light> vdbLights(const RenderVdbArgs& args)
         if (toward.size() == 6) light.color = Vec3d(toward[3], toward[4], toward[5]);
         lights.push_back(light);
     }
-    if (!args.env.empty()) {
-        render::Light sky;
-        sky.type = render::Light::Type::Environment;
-        sky.color = vec3(args.env);
-        lights.push_back(sky);
+    if (sky) {
+        render::Light environment;
+        environment.type = render::Light::Type::Environment;
+        if (!args.env.empty()) environment.color = vec3(args.env);
+        if (!args.envMap.empty()) {
+            try {
+                environment.map = render::EnvironmentMap::read(args.envMap);
+            } catch (const std::exception& e) {
+                throw UserError(SourceLocation{args.envMap},
+                                std::string("cannot read the sky map (") + e.what() + ")");
+            }
+        }
+        lights.push_back(environment);
     }
     return lights;
 }
@@ -171,9 +182,9 @@ int runRenderVdb(const RenderVdbArgs& args)
     checkFilmMemory(width, height, args.memoryLimitGiB);
     Interrupter interrupter(false, args.verbose);
     StopSignals signals(interrupter);
+    const std::vector<render::Light> lights = vdbLights(args); // the sky map before the volume
     const InputGrids grids = readInputGrids(args);
     const render::Camera camera = vdbCamera(args, *grids.density, width, height);
-    const std::vector<render::Light> lights = vdbLights(args);
     render::Medium medium;
     medium.extinction = args.extinction;
     medium.albedo = args.albedo;
@@ -339,6 +350,10 @@ Command addRenderVdbCommand(CLI::App& app)
         ->delimiter(',')
         ->expected(3)
         ->check(CLI::NonNegativeNumber);
+    sub->add_option("--env-map", a->envMap,
+                    "environment light from a lat-long HDR image (EXR, HDR, ...; its centre looks "
+                    "along +x, y up), importance-sampled; times --env R,G,B when given (alone: no "
+                    "--light unless given)");
     sub->add_option("--bounces", a->bounces,
                     "volume scattering events after the first (0: single scattering; more: "
                     "path tracing)")

@@ -3,6 +3,8 @@
 #include "KeyframeTrack.h"
 
 #include <volmorph/Mesh.h>
+#include <volmorph/core/Diagnostics.h>
+#include <volmorph/render/EnvironmentMap.h>
 
 #include <algorithm>
 #include <cmath>
@@ -43,6 +45,17 @@ std::shared_ptr<const render::Props> sceneProps(const Scene& scene)
 
 } // namespace
 
+std::shared_ptr<const render::EnvironmentMap> readSkyMap(const LightSpec& light)
+{
+    if (light.map.empty()) return nullptr;
+    try {
+        return render::EnvironmentMap::read(light.map);
+    } catch (const std::exception& e) {
+        throw UserError(light.mapWhere,
+                        "cannot read the sky map " + light.map.string() + " (" + e.what() + ")");
+    }
+}
+
 SceneRender::SceneRender(const Scene& scene, int threads, int width)
     : mSpec(scene.render), mFps(scene.frames.fps), mWidth(width)
 {
@@ -60,6 +73,7 @@ SceneRender::SceneRender(const Scene& scene, int threads, int width)
     settings.threads = threads;
     mProps = sceneProps(scene);
     settings.props = mProps.get();
+    for (const LightSpec& light : r.lights) mMaps.push_back(readSkyMap(light));
 }
 
 render::Camera SceneRender::camera(double frame) const
@@ -70,8 +84,8 @@ render::Camera SceneRender::camera(double frame) const
 std::vector<render::Light> SceneRender::lights(double frame) const
 {
     std::vector<render::Light> lights;
-    for (const LightSpec& spec : mSpec.lights) {
-        const LightSpec l = lightAt(spec, frame);
+    for (size_t i = 0; i < mSpec.lights.size(); ++i) {
+        const LightSpec l = lightAt(mSpec.lights[i], frame);
         render::Light light;
         light.type = l.type == LightType::Point         ? render::Light::Type::Point
                      : l.type == LightType::Environment ? render::Light::Type::Environment
@@ -81,6 +95,7 @@ std::vector<render::Light> SceneRender::lights(double frame) const
         light.color = l.color;
         light.intensity = l.intensity;
         light.angle = l.angleRadians;
+        light.map = mMaps[i];
         lights.push_back(light);
     }
     return lights;

@@ -10,14 +10,22 @@
 #include <memory>
 #include <vector>
 
+namespace volmorph::render {
+class EnvironmentMap;
+}
+
 namespace volmorph::cli {
+
+/// The light's sky map read (null without one); UserError at its `map` key when it cannot be.
+std::shared_ptr<const render::EnvironmentMap> readSkyMap(const LightSpec& light);
 
 struct SceneRender {
     render::Medium medium;
     render::RenderSettings settings; ///< frame left 0: set it per frame
 
     /// `width` overrides the scene's image width in pixels (the height follows the aspect ratio).
-    /// Imports the scene's props (UserError at their `mesh` key when one cannot be read).
+    /// Imports the scene's props and reads its sky map (UserError at their `mesh` or `map` key
+    /// when one cannot be read).
     SceneRender(const Scene& scene, int threads, int width = 0);
 
     /// The camera and lights at `frame` (their keys interpolated; fractional within a shutter).
@@ -35,6 +43,8 @@ struct SceneRender {
 private:
     RenderSpec mSpec;
     std::shared_ptr<const render::Props> mProps; ///< settings.props points here
+    /// Per light of the scene: its sky map, read once for the sequence (null: none).
+    std::vector<std::shared_ptr<const render::EnvironmentMap>> mMaps;
     double mFps;
     int mWidth;
 };

@@ -110,10 +110,10 @@ public:
         for (int vertex = 0;; ++vertex) {
             Vec3d& light = vertex == 0 ? L.direct : L.indirect;
             if (!scatter(v, vertex == 0 ? L.emission : L.indirect, light, beta)) break;
-            if (vertex == mIn.bounces && mIn.environment == Vec3d(0.0)) break;
+            if (vertex == mIn.bounces && !mIn.sky.any()) break;
             if (vertex >= 2 && !survives(beta)) break;
             if (!next(v)) {
-                light += beta * mIn.environment;
+                light += beta * escaping();
                 break;
             }
             if (vertex == mIn.bounces) break;
@@ -128,20 +128,30 @@ public:
     }
 
     /// A shadow catcher's matte at x (normal n): from the direct light on it, and the environment
-    /// along one cosine-weighted direction, with and without the props and the volume.
+    /// (a constant sky along one cosine-weighted direction, a map along one drawn from it), with
+    /// and without the props and the volume.
     double catcherMatte(const Vec3d& x, const Vec3d& n)
     {
         Vec3d unoccluded;
         Vec3d received = directIrradiance(mR, x, n, unoccluded, &mRandom);
-        if (mIn.environment != Vec3d(0.0)) {
+        const Sky& sky = mIn.sky;
+        if (sky.constant != Vec3d(0.0)) {
             const double u1 = mRandom.next(), u2 = mRandom.next();
             const Vec3d w = cosineDirection(n, u1, u2);
-            const Vec3d E = mIn.environment * M_PI; // a uniform sky's irradiance
+            const Vec3d E = sky.constant * M_PI; // a uniform sky's irradiance
             unoccluded += E;
-            if (!mIn.props->occluded(x, w, 0.0, kNoProp))
-                received +=
-                    E * std::exp(-opticalDepth(mR.shadowInter, mIn.levelSet, mR.shadowDensity, x, w,
-                                               kNoProp, mIn.sigmaPerVoxel));
+            received += E * visibility(x, w);
+        }
+        if (sky.map) {
+            const double u1 = mRandom.next(), u2 = mRandom.next();
+            double pdf;
+            const Vec3d w = sky.map->sample(u1, u2, pdf);
+            const double cosine = n.dot(w);
+            if (pdf > 0.0 && cosine > 0.0) {
+                const Vec3d E = sky.mapRadiance(w) * (cosine / pdf);
+                unoccluded += E;
+                received += E * visibility(x, w);
+            }
         }
         return shadowMatte(received, unoccluded);
     }
@@ -173,6 +183,7 @@ private:
             Vec3d unoccluded;
             lit += diffuseRadiance(beta, directIrradiance(mR, v.x, v.n, unoccluded, &mRandom));
         }
+        if (mIn.sky.map) lit += beta * skyLight(v);
         return true;
     }
 
@@ -184,15 +195,72 @@ private:
         if (!v.surface) {
             const Vec3d dir = sampleHenyeyGreenstein(v.dir, mIn.medium.anisotropy, mRandom.next(),
                                                      mRandom.next());
+            mPdf = henyeyGreenstein(v.dir.dot(dir), mIn.medium.anisotropy);
             if (!mIn.props) { // the medium alone, in index space
-                v.dir = dir;
-                return track(v.ip, dir, kNoProp);
+                if (track(v.ip, dir, kNoProp)) {
+                    v.dir = dir;
+                    return true;
+                }
+                if (mIn.sky.map) mEscape = worldDirection(v.ip, dir);
+                return false;
             }
-            const Vec3d x = mIn.density.indexToWorld(v.ip);
-            return go(x, (mIn.density.indexToWorld(v.ip + dir) - x).unit(), v);
+            return go(mIn.density.indexToWorld(v.ip), worldDirection(v.ip, dir), v);
         }
         const double u1 = mRandom.next(), u2 = mRandom.next();
-        return go(v.x, cosineDirection(v.n, u1, u2), v);
+        const Vec3d w = cosineDirection(v.n, u1, u2);
+        mPdf = v.n.dot(w) / M_PI;
+        return go(v.x, w, v);
+    }
+
+    /// The unit world direction of unit index direction `dir` at index point ip.
+    Vec3d worldDirection(const Vec3d& ip, const Vec3d& dir) const
+    {
+        return (mIn.density.indexToWorld(ip + dir) - mIn.density.indexToWorld(ip)).unit();
+    }
+
+    /// The environment's radiance along the direction the path left everything by (mEscape,
+    /// drawn with density mPdf): a map's weighted against skyLight's chance of drawing it.
+    Vec3d escaping() const
+    {
+        const Sky& sky = mIn.sky;
+        if (!sky.map) return sky.constant;
+        return sky.constant +
+               sky.mapRadiance(mEscape) * powerHeuristic(mPdf, sky.map->pdf(mEscape));
+    }
+
+    /// Next-event estimation toward the sky map from vertex v: one direction drawn from the map,
+    /// weighted against the phase function's (or a diffuse surface's cosine's) chance of drawing
+    /// it (power heuristic), through the medium's transmittance (ratio tracking from a collision,
+    /// exact from a surface) and the props. Per unit throughput, reflectance already in it.
+    Vec3d skyLight(const Vertex& v)
+    {
+        const Sky& sky = mIn.sky;
+        const double u1 = mRandom.next(), u2 = mRandom.next();
+        double pdf;
+        const Vec3d w = sky.map->sample(u1, u2, pdf);
+        if (pdf <= 0.0) return Vec3d(0.0);
+        double f = 0.0, T = 0.0;
+        if (v.surface) {
+            f = v.n.dot(w) / M_PI;
+            if (f <= 0.0) return Vec3d(0.0);
+            T = visibility(v.x, w);
+        } else {
+            const Vec3d x = mIn.density.indexToWorld(v.ip);
+            const Vec3d dir = (mIn.density.worldToIndex(x + w) - v.ip).unit();
+            f = henyeyGreenstein(v.dir.dot(dir), mIn.medium.anisotropy);
+            T = transmittance(v.ip, w, kNoProp);
+        }
+        if (T <= 0.0) return Vec3d(0.0);
+        return sky.mapRadiance(w) * (f * T / pdf * powerHeuristic(pdf, f));
+    }
+
+    /// What reaches world point x from infinitely far along unit world direction w: 0 behind a
+    /// prop, else the volume's exact transmittance.
+    double visibility(const Vec3d& x, const Vec3d& w)
+    {
+        if (mIn.props && mIn.props->occluded(x, w, 0.0, kNoProp)) return 0.0;
+        return std::exp(-opticalDepth(mR.shadowInter, mIn.levelSet, mR.shadowDensity, x, w, kNoProp,
+                                      mIn.sigmaPerVoxel));
     }
 
     /// From world point x along unit world direction w: the first collision before the first prop
@@ -201,6 +269,7 @@ private:
     {
         PropHit hit;
         const bool onProp = mIn.props->intersect(x, w, 0.0, kNoProp, hit);
+        mEscape = w;
         const Vec3d ip = mIn.density.worldToIndex(x);
         Vec3d dir = mIn.density.worldToIndex(x + w) - ip;
         const double scale = dir.length(); // voxels per world unit
@@ -236,15 +305,24 @@ private:
         return sum;
     }
 
-    /// The transmittance from index point ip toward `light`, unbiased, by ratio tracking against
-    /// the majorants (Novak et al. 2014, as pbrt-v4): tentative collisions at the majorant's rate,
-    /// each multiplying the estimate by the chance that it is null, 1 - sigma_t / sigma_majorant.
-    /// Below 0.1 the estimate plays Russian roulette (survives with chance 1/2, doubled).
+    /// The transmittance from index point ip toward `light` (a soft sun's direction drawn over
+    /// its disc), as transmittance() estimates it.
     double ratioTracking(const Vec3d& ip, const Light& light)
     {
-        const Vec3d p = mIn.density.indexToWorld(ip);
         double distance; // world units
-        const Vec3d toward = sampleLight(light, towardLight(light, p, distance), &mRandom);
+        const Vec3d toward = sampleLight(
+            light, towardLight(light, mIn.density.indexToWorld(ip), distance), &mRandom);
+        return transmittance(ip, toward, distance);
+    }
+
+    /// The transmittance from index point ip along unit world direction `toward` for `distance`
+    /// world units: 0 where a prop blocks the way, else unbiased, by ratio tracking against the
+    /// majorants (Novak et al. 2014, as pbrt-v4): tentative collisions at the majorant's rate,
+    /// each multiplying the estimate by the chance that it is null, 1 - sigma_t / sigma_majorant.
+    /// Below 0.1 the estimate plays Russian roulette (survives with chance 1/2, doubled).
+    double transmittance(const Vec3d& ip, const Vec3d& toward, double distance)
+    {
+        const Vec3d p = mIn.density.indexToWorld(ip);
         if (mIn.props && mIn.props->occluded(p, toward, 0.0, distance)) return 0.0;
         Vec3d dir = mIn.density.worldToIndex(p + toward) - ip; // index units per world unit
         const double scale = dir.length();
@@ -311,6 +389,8 @@ private:
     ThreadReaders& mR;
     const FrameInputs& mIn;
     Random& mRandom;
+    double mPdf = 0.0;  ///< the density (per steradian) of the direction next() drew last
+    Vec3d mEscape{0.0}; ///< the world direction by which the path last left everything
 };
 
 } // namespace

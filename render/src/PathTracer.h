@@ -14,7 +14,11 @@
 // throughput; next-event estimation toward every directional and point light, its transmittance
 // by ratio tracking against the same majorants (unbiased: no shadow map is built); then a new
 // direction from the Henyey-Greenstein phase function (sampled exactly, so its weight is 1). A path
-// that leaves the volume after a collision gathers the environment's radiance. A camera ray that
+// that leaves the volume after a collision gathers the environment's radiance. A sky map (Sky.h) is
+// also sampled at every collision and prop vertex (a direction drawn from the map, its
+// transmittance by ratio tracking), and the two ways of finding its light are weighed by Veach's
+// power heuristic against each other: a small bright disc in the map is found as a sun is, and
+// a broad sky as the phase function finds it. A camera ray that
 // leaves without a collision shows the background, which is transparent (RGB premultiplied, A =
 // 1 - T). Collisions are counted like Cycles' volume bounces: `bounces` N allows N + 1 scattering
 // events, the last of which still sees the lights and the environment. Russian roulette from the

@@ -14,6 +14,7 @@
 #include "Majorants.h"
 #include "Sampling.h"
 #include "Shadows.h"
+#include "Sky.h"
 
 #include <limits>
 #include <memory>
@@ -36,7 +37,7 @@ struct FrameInputs {
     // Path tracing (PathTracer.h); unused by the single-scattering estimator.
     const Majorants* majorants; ///< null unless paths are traced
     int bounces;                ///< scattering events after the first (RenderSettings::bounces)
-    Vec3d environment;          ///< the environment lights' radiance, summed
+    Sky sky;                    ///< the environment lights
     const Props* props;         ///< may be null: none
 };
 

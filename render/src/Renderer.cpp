@@ -115,12 +115,10 @@ void renderFrame(const openvdb::FloatGrid& density, const openvdb::Vec3SGrid* co
     const openvdb::BoolGrid::Ptr mask = rayMask(density, levelSet);
     const PaddedLeaves padded(density.tree());
     if (interrupted(settings.interrupter)) throw Interrupted();
-    Vec3d environment(0.0);
-    for (const Light& light : lights)
-        if (light.type == Light::Type::Environment) environment += light.color * light.intensity;
+    const Sky sky = Sky::of(lights);
     // Paths find their transmittance toward the lights by ratio tracking against the majorants;
     // the single-scattering estimator reads shadow maps.
-    const bool paths = settings.tracePaths || settings.bounces > 0 || environment != Vec3d(0.0);
+    const bool paths = settings.tracePaths || settings.bounces > 0 || sky.any();
     std::vector<Shadow> shadows(lights.size());
     std::unique_ptr<const Majorants> majorants;
     if (paths) {
@@ -146,7 +144,7 @@ void renderFrame(const openvdb::FloatGrid& density, const openvdb::Vec3SGrid* co
                             shadows,
                             majorants.get(),
                             std::max(0, settings.bounces),
-                            environment,
+                            sky,
                             props};
     stage(settings.interrupter, "render: pixels");
     renderTiles(frame, camera, settings, image);

@@ -24,6 +24,12 @@ done
 # shellcheck disable=SC2086
 "$volmorph" render-vdb "$out/sphere.vdb" -o "$out/rgba.exr" --no-layers $common >/dev/null
 oiiotool --info "$out/rgba.exr" | grep -q "4 channel" || { echo "--no-layers wrote layers"; exit 1; }
+# A sky map alone lights the volume (no default light then): some pixels lit, all finite.
+"$volmorph" render-vdb "$out/sphere.vdb" -o "$out/sky.exr" --env-map "$2/scenes/skies/sky.exr" \
+    --res 32x24 --samples 4 --extinction 8 --grid density --no-layers >/dev/null
+stats=$(oiiotool "$out/sky.exr" --printstats)
+echo "$stats" | grep -q "NanCount: 0 0 0 0" || { echo "non-finite pixels under the sky map"; exit 1; }
+echo "$stats" | grep "Stats Max" | awk '{ exit !($3 > 0.05) }' || { echo "the sky map lit nothing: $stats"; exit 1; }
 [ -s "$out/one.png" ] || { echo "no PNG preview"; exit 1; }
 [ "$(ls "$out" | grep -c partial || true)" -eq 0 ] || { echo "temporary files left"; exit 1; }
 echo "render-vdb: deterministic across thread counts, metadata present"

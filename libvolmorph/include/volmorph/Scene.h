@@ -180,6 +180,10 @@ struct LightSpec {
     Vec3d color{1.0, 1.0, 1.0};
     double intensity = 1.0;
     double angleRadians = 0.0; ///< directional: angular diameter (a soft sun); the file has degrees
+    /// Environment: a lat-long HDR image (resolved against the scene file's folder) whose radiance,
+    /// times color x intensity, arrives from each direction; empty: a constant sky.
+    std::filesystem::path map;
+    SourceLocation mapWhere;    ///< where `map` was written, for errors on reading
     std::vector<LightKey> keys; ///< animation, by increasing frame; empty: still (the CLI's
                                 ///< KeyframeTrack interpolates them)
 };

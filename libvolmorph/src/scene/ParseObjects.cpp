@@ -6,6 +6,24 @@
 #include <limits>
 
 namespace volmorph::detail {
+
+void parseFile(Reader& r, const toml::node& n, const std::string& path,
+               const std::filesystem::path& folder, std::filesystem::path& file,
+               SourceLocation& where)
+{
+    const std::optional<std::string> s = r.string(n, path);
+    if (!s) return;
+    where = r.at(n);
+    const std::filesystem::path p(*s);
+    file = p.is_absolute() ? p : folder / p;
+    std::error_code ec;
+    if (s->empty())
+        r.error(r.at(n), path + ": expected a file name");
+    else if (!std::filesystem::is_regular_file(file, ec))
+        r.error(r.at(n),
+                path + ": file not found: '" + *s + "' (looked for " + file.string() + ")");
+}
+
 namespace {
 
 const std::vector<std::string> kObjectKeys = {"mesh",      "volume", "grids",
@@ -34,24 +52,6 @@ void parseTransform(Reader& r, const toml::node& node, const std::string& path, 
             xf.scale = Vec3d(*s);
         }
     }
-}
-
-/// A file name at `n`, resolved against `folder`, that must exist.
-void parseFile(Reader& r, const toml::node& n, const std::string& path,
-               const std::filesystem::path& folder, std::filesystem::path& file,
-               SourceLocation& where)
-{
-    const std::optional<std::string> s = r.string(n, path);
-    if (!s) return;
-    where = r.at(n);
-    const std::filesystem::path p(*s);
-    file = p.is_absolute() ? p : folder / p;
-    std::error_code ec;
-    if (s->empty())
-        r.error(r.at(n), path + ": expected a file name");
-    else if (!std::filesystem::is_regular_file(file, ec))
-        r.error(r.at(n),
-                path + ": file not found: '" + *s + "' (looked for " + file.string() + ")");
 }
 
 /// A volume file, or a sequence "fx.####.vdb" of which at least one frame is on disk.

@@ -1,6 +1,7 @@
 // [render]: image, medium, camera and lights, with the keys that animate them.
 #include "TableParsers.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <limits>
@@ -16,7 +17,7 @@ const std::vector<std::string> kCameraKeys = {"projection", "eye",   "lookat", "
                                               "fov",        "width", "keys"};
 const std::vector<std::string> kCameraKeyKeys = {"frame", "eye", "lookat", "up", "fov", "width"};
 const std::vector<std::string> kLightKeys = {"type",      "direction", "position", "color",
-                                             "intensity", "angle",     "keys"};
+                                             "intensity", "angle",     "map",      "keys"};
 const std::vector<std::string> kLightKeyKeys = {"frame", "direction", "position", "color",
                                                 "intensity"};
 
@@ -176,7 +177,7 @@ void parsePlacement(Reader& r, const toml::table& t, const toml::node& node,
 }
 
 void parseLight(Reader& r, const toml::node& node, const std::string& path,
-                std::vector<LightSpec>& lights)
+                const std::filesystem::path& folder, std::vector<LightSpec>& lights)
 {
     const toml::table* t = r.table(node, path);
     if (!t) return;
@@ -195,6 +196,16 @@ void parseLight(Reader& r, const toml::node& node, const std::string& path,
         else if (auto v = r.numberIn(*n, path + ".angle", 0.0, true, 180.0,
                                      "an angular diameter in degrees, from 0 to 180"))
             light.angleRadians = *v * kDegreesToRadians;
+    }
+    if (const toml::node* n = t->get("map")) {
+        const bool another = std::any_of(lights.begin(), lights.end(),
+                                         [](const LightSpec& l) { return !l.map.empty(); });
+        if (light.type != LightType::Environment)
+            r.error(r.at(*n), path + ".map: only an environment light has a sky map");
+        else if (another)
+            r.error(r.at(*n), path + ".map: only one environment light may have a map");
+        else
+            parseFile(r, *n, path + ".map", folder, light.map, light.mapWhere);
     }
     if (const toml::node* n = t->get("keys")) {
         forEachKey(
@@ -227,7 +238,8 @@ void parseLight(Reader& r, const toml::node& node, const std::string& path,
 
 } // namespace
 
-void parseRender(Reader& r, const toml::node& node, RenderSpec& rs)
+void parseRender(Reader& r, const toml::node& node, const std::filesystem::path& folder,
+                 RenderSpec& rs)
 {
     const toml::table* t = r.table(node, "render");
     if (!t) return;
@@ -283,7 +295,7 @@ void parseRender(Reader& r, const toml::node& node, RenderSpec& rs)
     if (const toml::node* n = t->get("lights")) {
         if (const toml::array* a = n->as_array()) {
             for (size_t i = 0; i < a->size(); ++i)
-                parseLight(r, *a->get(i), "render.lights[" + std::to_string(i + 1) + "]",
+                parseLight(r, *a->get(i), "render.lights[" + std::to_string(i + 1) + "]", folder,
                            rs.lights);
         } else {
             r.error(r.at(*n), "render.lights: expected an array of light tables, got " +

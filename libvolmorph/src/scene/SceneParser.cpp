@@ -57,7 +57,8 @@ public:
         if (const toml::node* n = root.get("pair")) detail::parsePairs(r, *n, mScene.pairs);
         if (const toml::node* n = root.get("warp")) detail::parseWarp(r, *n, mScene.warp);
         if (const toml::node* n = root.get("blend")) detail::parseBlend(r, *n, mScene.blend);
-        if (const toml::node* n = root.get("render")) detail::parseRender(r, *n, mScene.render);
+        if (const toml::node* n = root.get("render"))
+            detail::parseRender(r, *n, mScene.folder, mScene.render);
         if (const toml::node* n = root.get("prop"))
             detail::parseProps(r, *n, mScene.folder, mScene.props);
         if (mScene.render.lights.empty()) {

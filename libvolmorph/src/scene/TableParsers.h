@@ -29,7 +29,13 @@ void parsePairs(Reader& r, const toml::node& node, std::vector<FeaturePairSpec>&
 /// [warp] and [blend] (with its schedules).
 void parseWarp(Reader& r, const toml::node& node, WarpSpec& warp);
 void parseBlend(Reader& r, const toml::node& node, BlendSpec& blend);
-/// [render], its camera and lights (with their keys).
-void parseRender(Reader& r, const toml::node& node, RenderSpec& render);
+/// [render], its camera and lights (with their keys); a sky map's path resolved against `folder`.
+void parseRender(Reader& r, const toml::node& node, const std::filesystem::path& folder,
+                 RenderSpec& render);
+/// A file name at `n`, resolved against `folder`, that must exist: into `file`, and where it was
+/// written into `where`.
+void parseFile(Reader& r, const toml::node& n, const std::string& path,
+               const std::filesystem::path& folder, std::filesystem::path& file,
+               SourceLocation& where);
 
 } // namespace volmorph::detail

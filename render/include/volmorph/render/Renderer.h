@@ -41,9 +41,12 @@
 #include <openvdb/util/NullInterrupter.h>
 
 #include <cstdint>
+#include <memory>
 #include <vector>
 
 namespace volmorph::render {
+
+class EnvironmentMap;
 
 /// Units as Cycles': a directional light's color x intensity is the irradiance on a surface facing
 /// it (sun strength); a point light's is its intensity (irradiance times distance squared); an
@@ -59,6 +62,10 @@ struct Light {
     /// infinity). Its irradiance stays color x intensity. Surfaces and paths sample the disc; the
     /// single-scattering estimator's shadow map inside the volume keeps its centre direction.
     double angle = 0.0;
+    /// Environment: a lat-long HDR map (EnvironmentMap.h) whose radiance, times color x intensity,
+    /// arrives from each direction, importance-sampled; null: color x intensity from every one.
+    /// At most one environment light of an image has a map.
+    std::shared_ptr<const EnvironmentMap> map;
 };
 
 struct Medium {
