@@ -1,6 +1,6 @@
 #include <volmorph/render/EnvironmentMap.h>
 
-#include <OpenImageIO/imageio.h>
+#include <volmorph/render/Output.h>
 
 #include <algorithm>
 #include <cmath>
@@ -53,18 +53,19 @@ EnvironmentMap::EnvironmentMap(int width, int height, std::vector<float> rgb)
 
 std::shared_ptr<const EnvironmentMap> EnvironmentMap::read(const std::filesystem::path& path)
 {
-    auto in = OIIO::ImageInput::open(path.string());
-    if (!in) throw std::runtime_error(OIIO::geterror());
-    const OIIO::ImageSpec& spec = in->spec();
-    const size_t pixels = size_t(spec.width) * size_t(spec.height), n = size_t(spec.nchannels);
-    std::vector<float> all(pixels * n);
-    if (!in->read_image(0, 0, 0, spec.nchannels, OIIO::TypeDesc::FLOAT, all.data()))
-        throw std::runtime_error(in->geterror());
+    const ChannelImage image = readChannels(path);
+    const size_t pixels = size_t(image.width) * size_t(image.height), n = image.names.size();
+    // R, G and B by name, else the first three channels, else the first as grey.
+    size_t from[3];
+    for (size_t c = 0; c < 3; ++c) {
+        const int named = image.channel(std::string(1, "RGB"[c]));
+        from[c] = named >= 0 ? size_t(named) : n >= 3 ? c : 0;
+    }
     std::vector<float> rgb(3 * pixels);
     for (size_t p = 0; p < pixels; ++p)
-        for (size_t c = 0; c < 3; ++c) rgb[3 * p + c] = all[n * p + (n >= 3 ? c : 0)];
+        for (size_t c = 0; c < 3; ++c) rgb[3 * p + c] = image.values[n * p + from[c]];
     try {
-        return std::make_shared<const EnvironmentMap>(spec.width, spec.height, std::move(rgb));
+        return std::make_shared<const EnvironmentMap>(image.width, image.height, std::move(rgb));
     } catch (const std::invalid_argument& e) {
         throw std::runtime_error(e.what());
     }

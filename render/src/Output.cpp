@@ -7,6 +7,7 @@
 #include <OpenImageIO/imagebufalgo.h>
 #include <OpenImageIO/imageio.h>
 
+#include <algorithm>
 #include <stdexcept>
 
 namespace volmorph::render {
@@ -114,33 +115,50 @@ void writePng(const Image& image, const std::filesystem::path& path)
     });
 }
 
-Image readImage(const std::filesystem::path& path)
+int ChannelImage::channel(const std::string& name) const
+{
+    const auto it = std::find(names.begin(), names.end(), name);
+    return it == names.end() ? -1 : int(it - names.begin());
+}
+
+ChannelImage readChannels(const std::filesystem::path& path)
 {
     auto in = OIIO::ImageInput::open(path.string());
     if (!in) throw std::runtime_error(OIIO::geterror());
     const OIIO::ImageSpec& spec = in->spec();
-    const size_t pixels = size_t(spec.width) * size_t(spec.height), n = size_t(spec.nchannels);
-    std::vector<float> all(pixels * n);
-    if (!in->read_image(0, 0, 0, spec.nchannels, OIIO::TypeDesc::FLOAT, all.data()))
-        throw std::runtime_error(in->geterror());
-    Image image;
+    ChannelImage image;
     image.width = spec.width;
     image.height = spec.height;
+    image.names = spec.channelnames;
+    image.names.resize(size_t(spec.nchannels));
+    image.values.resize(size_t(spec.width) * size_t(spec.height) * size_t(spec.nchannels));
+    if (!in->read_image(0, 0, 0, spec.nchannels, OIIO::TypeDesc::FLOAT, image.values.data()))
+        throw std::runtime_error(in->geterror());
+    return image;
+}
+
+Image readImage(const std::filesystem::path& path)
+{
+    const ChannelImage all = readChannels(path);
+    const size_t pixels = size_t(all.width) * size_t(all.height), n = all.names.size();
+    Image image;
+    image.width = all.width;
+    image.height = all.height;
     // RGBA by name (the first four channels where they are not named so); the layers when all
     // are there.
     auto copy = [&](const char* const* names, int count, std::vector<float>& to, bool byPosition) {
         to.assign(pixels * size_t(count), 0.0f);
         for (int c = 0; c < count; ++c) {
-            int from = spec.channelindex(names[c]);
-            if (from < 0 && byPosition && c < spec.nchannels) from = c;
+            int from = all.channel(names[c]);
+            if (from < 0 && byPosition && size_t(c) < n) from = c;
             if (from < 0) continue;
             for (size_t p = 0; p < pixels; ++p)
-                to[size_t(count) * p + size_t(c)] = all[n * p + size_t(from)];
+                to[size_t(count) * p + size_t(c)] = all.values[n * p + size_t(from)];
         }
     };
     const char* const rgba[4] = {"R", "G", "B", "A"};
-    copy(rgba, 4, image.pixels, spec.channelindex("R") < 0);
-    if (spec.channelindex(kLayerNames[0]) >= 0 && spec.channelindex("depth.Z") >= 0)
+    copy(rgba, 4, image.pixels, all.channel("R") < 0);
+    if (all.channel(kLayerNames[0]) >= 0 && all.channel("depth.Z") >= 0)
         copy(kLayerNames, layer::kFloats, image.layers, false);
     return image;
 }

@@ -7,6 +7,7 @@
 #include <filesystem>
 #include <map>
 #include <string>
+#include <vector>
 
 namespace volmorph::render {
 
@@ -30,6 +31,20 @@ void writeExr(const Image& image, const Camera& camera, const std::filesystem::p
 
 /// Writes an 8-bit sRGB PNG preview (clamped, over black), atomically like writeExr.
 void writePng(const Image& image, const std::filesystem::path& path);
+
+/// Every channel of an image file (its first subimage) as floats.
+struct ChannelImage {
+    int width = 0, height = 0;
+    std::vector<std::string> names; ///< the channels' names, in the file's order
+    std::vector<float> values;      ///< names.size() floats per pixel, row-major, top row first
+
+    /// The index of channel `name`, -1 when the file has none.
+    int channel(const std::string& name) const;
+};
+
+/// Reads every channel of an image through OpenImageIO. Throws std::runtime_error with the reason
+/// when it cannot.
+ChannelImage readChannels(const std::filesystem::path& path);
 
 /// Reads an image's RGBA pixels (by channel name, else its first four channels), and the layers
 /// when the file has them all (tests, diff). Throws std::runtime_error when it cannot.
