@@ -164,11 +164,12 @@ Progress::~Progress()
     if (!mQuiet && mTerminal && mBarShown) std::fputs("\n", stdout);
 }
 
-void checkFilmMemory(int width, int height, double limitGiB)
+void checkFilmMemory(int width, int height, double limitGiB, bool layers)
 {
-    // The float film of RGBA and the 15 layers' floats, and a float and a half copy to write it.
-    constexpr double kBytesPerPixel = 19 * (4.0 + 4.0 + 2.0);
-    const double bytes = kBytesPerPixel * double(width) * double(height);
+    // Per channel (RGBA, and the layers' 15): the float film, the float copy interleaved to write
+    // it, and the encoder's buffer.
+    const double bytesPerPixel = (layers ? 19.0 : 4.0) * 12.0;
+    const double bytes = bytesPerPixel * double(width) * double(height);
     const double limit = double(memoryLimitBytes(limitGiB));
     if (bytes <= limit) return;
     char text[300];

@@ -43,8 +43,9 @@ std::string fmt(const Vec3d& v);
 std::string describeTopology(const MeshReport& r);
 
 /// Refuses (UserError) to render a width x height film that would need more than the memory limit
-/// (`limitGiB`, 0 = half the machine's memory): float RGBA plus the copies made to write it.
-void checkFilmMemory(int width, int height, double limitGiB);
+/// (`limitGiB`, 0 = half the machine's memory): float RGBA, and the layers when asked for, plus the
+/// copies made to write them.
+void checkFilmMemory(int width, int height, double limitGiB, bool layers);
 
 /// Wall-clock seconds since `start`.
 double secondsSince(std::chrono::steady_clock::time_point start);

@@ -179,7 +179,7 @@ int runRenderVdb(const RenderVdbArgs& args)
                         "expected OPEN,CLOSE in frames with OPEN <= CLOSE, got " +
                             std::to_string(args.shutter[0]) + "," +
                             std::to_string(args.shutter[1]));
-    checkFilmMemory(width, height, args.memoryLimitGiB);
+    checkFilmMemory(width, height, args.memoryLimitGiB, !args.noLayers);
     Interrupter interrupter(false, args.verbose);
     StopSignals signals(interrupter);
     const std::vector<render::Light> lights = vdbLights(args); // the sky map before the volume
@@ -271,7 +271,8 @@ int runRenderScene(const RenderSceneArgs& args)
 
     Interrupter interrupter(false, args.verbose);
     StopSignals signals(interrupter);
-    checkFilmMemory(scene.render.width, scene.render.height, args.memoryLimitGiB);
+    checkFilmMemory(scene.render.width, scene.render.height, args.memoryLimitGiB,
+                    scene.render.layers);
     SceneRender renderer(scene, args.threads);
     MorphOptions morphOptions;
     morphOptions.memoryLimitBytes = memoryLimitBytes(args.memoryLimitGiB);
