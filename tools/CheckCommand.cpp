@@ -223,8 +223,12 @@ void printView(const RenderSpec& r)
         std::printf("emission %s per unit optical depth\n", fmt(r.emission).c_str());
     for (const LightSpec& l : r.lights) {
         if (l.type == LightType::Directional)
-            std::printf("light   directional, travelling %s, colour %s, intensity %s\n",
-                        fmt(l.direction).c_str(), fmt(l.color).c_str(), fmt(l.intensity).c_str());
+            std::printf(
+                "light   directional, travelling %s, colour %s, intensity %s%s\n",
+                fmt(l.direction).c_str(), fmt(l.color).c_str(), fmt(l.intensity).c_str(),
+                l.angleRadians > 0.0
+                    ? (", " + fmt(l.angleRadians * 180.0 / M_PI) + " degrees across").c_str()
+                    : "");
         else if (l.type == LightType::Environment)
             printEnvironment(l);
         else

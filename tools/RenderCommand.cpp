@@ -39,9 +39,11 @@ Vec3d vec3(const std::vector<double>& v)
 /// default, the origin, is inside most volumes).
 struct RenderVdbArgs {
     std::string input, output, png, camera = "persp", grid, resolution = "1920x1080", envMap;
-    std::vector<double> translate, lookat, up{0, 1, 0}, light, emission, env;
+    std::vector<double> translate, lookat, up{0, 1, 0}, light, emission, env,
+        propColor{0.8, 0.8, 0.8};
+    std::vector<std::string> props; ///< meshes in world units, diffuse, coloured propColor
     double fov = 2.0 * std::atan(41.2136 / 100.0) * 180.0 / M_PI, frameWidth = 0.0,
-           extinction = 40.0, albedo = 0.8, step = 1.0;
+           extinction = 40.0, albedo = 0.8, step = 1.0, lightAngle = 0.0;
     int shadowCache = 1;
     int samples = 1, threads = 0, bounces = 0;
     double memoryLimitGiB = 0.0;
@@ -131,6 +133,7 @@ std::vector<render::Light> vdbLights(const RenderVdbArgs& args)
         render::Light light;
         light.direction = -vec3(toward); // the flag points toward the light, as vdb_render's
         if (toward.size() == 6) light.color = Vec3d(toward[3], toward[4], toward[5]);
+        light.angle = args.lightAngle * M_PI / 180.0; // degrees on the command line
         lights.push_back(light);
     }
     if (sky) {
@@ -148,6 +151,20 @@ std::vector<render::Light> vdbLights(const RenderVdbArgs& args)
         lights.push_back(environment);
     }
     return lights;
+}
+
+/// The --prop meshes, diffuse, coloured --prop-color; UserError naming a mesh that cannot be read.
+std::shared_ptr<const render::Props> vdbProps(const RenderVdbArgs& args)
+{
+    std::vector<PropSpec> specs;
+    for (const std::string& mesh : args.props) {
+        PropSpec spec;
+        spec.mesh = mesh;
+        spec.where = SourceLocation{mesh};
+        spec.color = vec3(args.propColor);
+        specs.push_back(spec);
+    }
+    return importProps(specs);
 }
 
 /// The still image, or with --shutter the image blurred along the file's velocity grid.
@@ -182,7 +199,9 @@ int runRenderVdb(const RenderVdbArgs& args)
     checkFilmMemory(width, height, args.memoryLimitGiB, !args.noLayers);
     Interrupter interrupter(false, args.verbose);
     StopSignals signals(interrupter);
-    const std::vector<render::Light> lights = vdbLights(args); // the sky map before the volume
+    // The sky map and the props before the volume: no work before an error in them.
+    const std::vector<render::Light> lights = vdbLights(args);
+    const std::shared_ptr<const render::Props> props = vdbProps(args);
     const InputGrids grids = readInputGrids(args);
     const render::Camera camera = vdbCamera(args, *grids.density, width, height);
     render::Medium medium;
@@ -197,6 +216,7 @@ int runRenderVdb(const RenderVdbArgs& args)
     settings.layers = !args.noLayers;
     settings.threads = args.threads;
     settings.interrupter = &interrupter;
+    settings.props = props.get();
     const auto start = std::chrono::steady_clock::now();
     const render::Image image = renderVdbImage(args, grids, camera, lights, medium, settings);
     const double seconds = secondsSince(start);
@@ -304,6 +324,36 @@ int runRenderScene(const RenderSceneArgs& args)
     return failed ? kExitUserError : 0;
 }
 
+/// render-vdb's lights and props: --light, --env, --light-angle, --prop, --prop-color, --env-map.
+void addShotOptions(CLI::App* sub, RenderVdbArgs& a)
+{
+    sub->add_option("--light", a.light,
+                    "direction toward the light X,Y,Z[,R,G,B] (as vdb_render; default "
+                    "0.3,0.3,0,0.7,0.7,0.7 unless --env alone)")
+        ->delimiter(',')
+        ->expected(3, 6);
+    sub->add_option("--env", a.env,
+                    "environment light: radiance R,G,B from every direction (alone: no --light "
+                    "unless given)")
+        ->delimiter(',')
+        ->expected(3)
+        ->check(CLI::NonNegativeNumber);
+    sub->add_option("--light-angle", a.lightAngle,
+                    "the --light's angular diameter in degrees (a soft sun; 0: a point)")
+        ->check(CLI::Range(0.0, 180.0));
+    sub->add_option("--prop", a.props,
+                    "a mesh in the shot (world units, as the volume's), diffuse: it occludes the "
+                    "volume, casts and receives shadows (repeat for more)");
+    sub->add_option("--prop-color", a.propColor, "the props' reflectance R,G,B (default 0.8)")
+        ->delimiter(',')
+        ->expected(3)
+        ->check(CLI::Range(0.0, 1.0));
+    sub->add_option("--env-map", a.envMap,
+                    "environment light from a lat-long HDR image (EXR, HDR, ...; its centre looks "
+                    "along +x, y up), importance-sampled; times --env R,G,B when given (alone: no "
+                    "--light unless given)");
+}
+
 } // namespace
 
 Command addRenderVdbCommand(CLI::App& app)
@@ -340,21 +390,7 @@ Command addRenderVdbCommand(CLI::App& app)
         ->delimiter(',')
         ->expected(3)
         ->check(CLI::NonNegativeNumber);
-    sub->add_option("--light", a->light,
-                    "direction toward the light X,Y,Z[,R,G,B] (as vdb_render; default "
-                    "0.3,0.3,0,0.7,0.7,0.7 unless --env alone)")
-        ->delimiter(',')
-        ->expected(3, 6);
-    sub->add_option("--env", a->env,
-                    "environment light: radiance R,G,B from every direction (alone: no --light "
-                    "unless given)")
-        ->delimiter(',')
-        ->expected(3)
-        ->check(CLI::NonNegativeNumber);
-    sub->add_option("--env-map", a->envMap,
-                    "environment light from a lat-long HDR image (EXR, HDR, ...; its centre looks "
-                    "along +x, y up), importance-sampled; times --env R,G,B when given (alone: no "
-                    "--light unless given)");
+    addShotOptions(sub, *a);
     sub->add_option("--bounces", a->bounces,
                     "volume scattering events after the first (0: single scattering; more: "
                     "path tracing)")

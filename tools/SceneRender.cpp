@@ -24,11 +24,12 @@ render::Camera sceneCamera(const CameraSpec& c, const RenderSpec& r, int width)
                           c.eye, c.lookat, c.up, c.fovDegrees, c.orthoWidth, w, h);
 }
 
-/// The scene's [[prop]] meshes, imported and placed, for Embree.
-std::shared_ptr<const render::Props> sceneProps(const Scene& scene)
+} // namespace
+
+std::shared_ptr<const render::Props> importProps(const std::vector<PropSpec>& props)
 {
     std::vector<render::PropMesh> meshes;
-    for (const PropSpec& spec : scene.props) {
+    for (const PropSpec& spec : props) {
         const Mesh mesh = importMesh(spec.mesh, spec.transform, spec.where);
         render::PropMesh prop;
         prop.points = mesh.points;
@@ -42,8 +43,6 @@ std::shared_ptr<const render::Props> sceneProps(const Scene& scene)
     if (meshes.empty()) return nullptr;
     return std::make_shared<const render::Props>(std::move(meshes));
 }
-
-} // namespace
 
 std::shared_ptr<const render::EnvironmentMap> readSkyMap(const LightSpec& light)
 {
@@ -71,7 +70,7 @@ SceneRender::SceneRender(const Scene& scene, int threads, int width)
     settings.layers = r.layers;
     settings.seed = r.seed;
     settings.threads = threads;
-    mProps = sceneProps(scene);
+    mProps = importProps(scene.props);
     settings.props = mProps.get();
     for (const LightSpec& light : r.lights) mMaps.push_back(readSkyMap(light));
 }

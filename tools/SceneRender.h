@@ -16,6 +16,10 @@ class EnvironmentMap;
 
 namespace volmorph::cli {
 
+/// The props imported and placed, for Embree (null for none); UserError at a prop's `mesh` key
+/// when it cannot be read.
+std::shared_ptr<const render::Props> importProps(const std::vector<PropSpec>& props);
+
 /// The light's sky map read (null without one); UserError at its `map` key when it cannot be.
 std::shared_ptr<const render::EnvironmentMap> readSkyMap(const LightSpec& light);
 

@@ -9,7 +9,9 @@
 # tests/bench/cycles_render.py (the half-voxel shift and axes of NOTES.md). Prints each render's
 # time, then the comparison over pixels with alpha > 0.1 (volmorph_bench_image_compare: |dY|, mean
 # relative RGB difference, bias, relative RMSE).
-# usage: [SCENE=default|cloud] [OUT=DIR] [CYCLES=0]
+# SHOT=1 (issue 34): the same with a floor (scenes/meshes/floor.obj scaled 8 times, reflectance 0.5),
+# the sky map scenes/skies/sky.exr instead of the constant sky, and a sun 2 degrees across.
+# usage: [SCENE=default|cloud] [SHOT=1] [OUT=DIR] [CYCLES=0]
 #        tests/bench/cycles_compare.sh [BUILD_DIR [RES [CYCLES_SAMPLES [VOLMORPH_SAMPLES [BOUNCES]]]]]
 #        defaults: build 320x180 256 256 16; OUT=DIR keeps the images there (volmorph.exr,
 #        cycles.exr); CYCLES=0 renders volmorph alone and compares with OUT/cycles.exr as it is.
@@ -29,7 +31,7 @@ mkdir -p "$out"
 sky=0.3,0.35,0.45 fov=40
 case ${SCENE:-default} in
     default)
-        sed "s|meshes/|$src/scenes/meshes/|" "$src/scenes/bunny-to-knot.toml" >"$out/scene.toml"
+        sed "s|meshes/|$src/scenes/meshes/|; s|skies/|$src/scenes/skies/|" "$src/scenes/bunny-to-knot.toml" >"$out/scene.toml"
         VOLMORPH_CACHE="$out/cache" "$vm" morph "$out/scene.toml" --frames 12 -o "$out/m.####.vdb" -q
         vdb=$out/m.0012.vdb voxel=0.008 color=Cd
         eye=0.6,0.9,2.6 lookat=0,0.45,0 extinction=60 albedo=0.8
@@ -42,15 +44,24 @@ case ${SCENE:-default} in
     *) echo "SCENE is default or cloud"; exit 2 ;;
 esac
 
+# The sky, and with SHOT=1 the floor and the soft sun, for each renderer.
+vm_shot="--env $sky" cy_shot="--sky $sky"
+if [ "${SHOT:-0}" = 1 ]; then
+    awk '$1 == "v" { print "v", 8 * $2, 8 * $3, 8 * $4; next } { print }' \
+        "$src/scenes/meshes/floor.obj" >"$out/floor.obj"
+    vm_shot="--env-map $src/scenes/skies/sky.exr --prop $out/floor.obj --prop-color 0.5,0.5,0.5 --light-angle 2"
+    cy_shot="--sky-map $src/scenes/skies/sky.exr --floor $out/floor.obj --floor-color 0.5,0.5,0.5 --sun-angle 2"
+fi
+# shellcheck disable=SC2086
 /usr/bin/time -f "volmorph (%e s, $volmorph_samples samples, $bounces bounces)" \
     "$vm" render-vdb "$vdb" -o "$out/volmorph.exr" --grid density --translate $eye --lookat $lookat \
-    --fov $fov --res "$res" --extinction $extinction --albedo $albedo --light 1,1,0.5,3,2.85,2.7 --env $sky \
-    --bounces "$bounces" --samples "$volmorph_samples" --threads 2 --float >/dev/null
+    --fov $fov --res "$res" --extinction $extinction --albedo $albedo --light 1,1,0.5,3,2.85,2.7 $vm_shot \
+    --bounces "$bounces" --samples "$volmorph_samples" --threads 2 --float --no-layers >/dev/null
 if [ "${CYCLES:-1}" != 0 ]; then
     /usr/bin/time -f "cycles (%e s, $cycles_samples samples, $bounces bounces)" \
         blender -b --factory-startup --python "$src/tests/bench/cycles_render.py" -- "$vdb" \
         "$out/cycles.exr" --voxel $voxel --color-grid "$color" --eye $eye --lookat $lookat --fov $fov \
-        --res "$res" --extinction $extinction --albedo $albedo --sun=-1,-1,-0.5,3,1,0.95,0.9 --sky $sky \
+        --res "$res" --extinction $extinction --albedo $albedo --sun=-1,-1,-0.5,3,1,0.95,0.9 $cy_shot \
         --bounces "$bounces" --samples "$cycles_samples" --threads 2 >"$out/blender.log" 2>&1 ||
         { tail -20 "$out/blender.log"; exit 1; }
     grep "cycles: rendered" "$out/blender.log" || true

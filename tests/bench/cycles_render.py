@@ -2,7 +2,8 @@
 
 usage: blender -b --factory-startup --python tests/bench/cycles_render.py -- IN.vdb OUT.exr
            --voxel V --eye X,Y,Z --lookat X,Y,Z --fov DEG --res WxH --extinction S --albedo A
-           [--color-grid Cd] [--sun DX,DY,DZ,STRENGTH[,R,G,B]] [--sky R,G,B] [--bounces N]
+           [--color-grid Cd] [--sun DX,DY,DZ,STRENGTH[,R,G,B]] [--sun-angle DEG] [--sky R,G,B]
+           [--sky-map LATLONG.exr] [--floor MESH.obj --floor-color R,G,B] [--bounces N]
            [--samples N] [--step-rate R] [--threads N]
            [--velocity-grid NAME --shutter FRAMES --fps F]
 
@@ -17,6 +18,11 @@ samples), a transparent film (RGB premultiplied, A = coverage), no denoising, fl
 With --velocity-grid, Cycles blurs the volume along that grid (world units per second, Velocity
 Unit = Second, scale 1) over a shutter of FRAMES frames centred on the frame, at F frames per
 second (issue 36's cross-check: tests/bench/blender_motion_blur.sh).
+Issue 34's shot: --sky-map lights with a lat-long image (an Environment Texture, closest pixel, as
+volmorph reads it; Blender's equirectangular mapping of the turned world is volmorph's), --floor
+adds an OBJ mesh (y up, turned like the rest) with a Diffuse BSDF of --floor-color, and diffuse
+bounces as many as volume bounces (volmorph's bounces count every vertex, on a prop or in the
+medium).
 """
 import argparse
 import math
@@ -56,6 +62,10 @@ def parse():
     p.add_argument("--anisotropy", type=float, default=0.0)
     p.add_argument("--sun", default="")
     p.add_argument("--sky", default="")
+    p.add_argument("--sky-map", default="")
+    p.add_argument("--sun-angle", type=float, default=0.0)
+    p.add_argument("--floor", default="")
+    p.add_argument("--floor-color", default="0.8,0.8,0.8")
     p.add_argument("--bounces", type=int, default=16)
     p.add_argument("--samples", type=int, default=64)
     p.add_argument("--step-rate", type=float, default=0.1)
@@ -120,7 +130,7 @@ def lights(args):
         s = vec(args.sun, 4)
         sun = bpy.data.lights.new("sun", "SUN")
         sun.energy = s[3]
-        sun.angle = 0.0
+        sun.angle = math.radians(args.sun_angle)
         if len(s) >= 7:
             sun.color = s[4:7]
         obj = bpy.data.objects.new("sun", sun)
@@ -132,7 +142,37 @@ def lights(args):
     sky = vec(args.sky) if args.sky else [0.0, 0.0, 0.0]
     bg.inputs["Color"].default_value = (sky[0], sky[1], sky[2], 1.0)
     bg.inputs["Strength"].default_value = 1.0
+    if args.sky_map:
+        tex = world.node_tree.nodes.new("ShaderNodeTexEnvironment")
+        tex.image = bpy.data.images.load(args.sky_map)
+        tex.interpolation = "Closest"
+        world.node_tree.links.new(tex.outputs["Color"], bg.inputs["Color"])
     bpy.context.scene.world = world
+
+
+def floor(args):
+    """The OBJ's vertices and faces (y up, turned to z up), a Diffuse BSDF of --floor-color."""
+    points, faces = [], []
+    with open(args.floor) as f:
+        for line in f:
+            fields = line.split()
+            if fields and fields[0] == "v":
+                points.append(to_blender([float(v) for v in fields[1:4]]))
+            elif fields and fields[0] == "f":
+                faces.append([int(v.split("/")[0]) - 1 for v in fields[1:]])
+    mesh = bpy.data.meshes.new("floor")
+    mesh.from_pydata(points, [], faces)
+    obj = bpy.data.objects.new("floor", mesh)
+    bpy.context.scene.collection.objects.link(obj)
+    mat = bpy.data.materials.new("floor")
+    mat.use_nodes = True
+    bsdf = mat.node_tree.nodes.new("ShaderNodeBsdfDiffuse")
+    c = vec(args.floor_color)
+    bsdf.inputs["Color"].default_value = (c[0], c[1], c[2], 1.0)
+    bsdf.inputs["Roughness"].default_value = 0.0
+    out = mat.node_tree.nodes["Material Output"]
+    mat.node_tree.links.new(bsdf.outputs["BSDF"], out.inputs["Surface"])
+    obj.data.materials.append(mat)
 
 
 def settings(args):
@@ -145,7 +185,8 @@ def settings(args):
     c.use_denoising = False
     c.max_bounces = args.bounces + 1
     c.volume_bounces = args.bounces
-    c.diffuse_bounces = c.glossy_bounces = c.transmission_bounces = 0
+    c.diffuse_bounces = args.bounces if args.floor else 0
+    c.glossy_bounces = c.transmission_bounces = 0
     # A volume's boundary is a transparent surface to Cycles' shadow rays: with no transparent
     # bounces the sun would never reach the inside.
     c.transparent_max_bounces = 256
@@ -181,6 +222,8 @@ def main():
     volume_object(args)
     camera(args, width)
     lights(args)
+    if args.floor:
+        floor(args)
     start = time.time()
     bpy.ops.render.render(write_still=True)
     print("cycles: rendered %s in %.2f s" % (args.out, time.time() - start))

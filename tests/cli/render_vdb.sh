@@ -30,6 +30,15 @@ oiiotool --info "$out/rgba.exr" | grep -q "4 channel" || { echo "--no-layers wro
 stats=$(oiiotool "$out/sky.exr" --printstats)
 echo "$stats" | grep -q "NanCount: 0 0 0 0" || { echo "non-finite pixels under the sky map"; exit 1; }
 echo "$stats" | grep "Stats Max" | awk '{ exit !($3 > 0.05) }' || { echo "the sky map lit nothing: $stats"; exit 1; }
+# A floor prop (the unit square scaled 8 times) under a looking-down camera: the bottom row is floor,
+# opaque; with --light-angle the run still works.
+awk '$1 == "v" { print "v", 8 * $2, 8 * $3 - 0.4, 8 * $4; next } { print }' \
+    "$2/scenes/meshes/floor.obj" >"$out/floor.obj"
+"$volmorph" render-vdb "$out/sphere.vdb" -o "$out/prop.exr" --prop "$out/floor.obj" --prop-color 0.5,0.5,0.5 \
+    --translate 0,1.5,3 --lookat 0,0,0 --res 32x24 --samples 2 --extinction 8 --grid density \
+    --light-angle 2 --no-layers >/dev/null
+oiiotool "$out/prop.exr" --cut 32x1+0+23 --printstats | grep "Stats Min" | awk '{ exit !($6 == 1) }' \
+    || { echo "the floor prop is not opaque under the volume"; oiiotool "$out/prop.exr" --printstats; exit 1; }
 [ -s "$out/one.png" ] || { echo "no PNG preview"; exit 1; }
 [ "$(ls "$out" | grep -c partial || true)" -eq 0 ] || { echo "temporary files left"; exit 1; }
 echo "render-vdb: deterministic across thread counts, metadata present"
