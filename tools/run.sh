@@ -38,7 +38,7 @@ demo)
     "$build/bin/volmorph" preview "$scene" --frame 12 --sides -o "$out/bunny-to-knot.features.0012.png" -q
     echo
     echo "volmorph: the morph of $scene is rendered:"
-    echo "  frames         $out/bunny-to-knot.0001.exr ... .0024.exr (half RGBA OpenEXR, linear, premultiplied)"
+    echo "  frames         $out/bunny-to-knot.0001.exr ... .0024.exr (half OpenEXR: RGBA, linear, premultiplied, and the layers volume, direct, indirect, emission, shadow, depth.Z)"
     echo "  contact sheet  $out/bunny-to-knot.contact-sheet.png"
     echo "  feature pairs  $out/bunny-to-knot.features.0012.png (frame 12; amber: at t, blue: source, pink: target)"
     echo "The program is $build/bin/volmorph (volmorph --help)."

@@ -32,11 +32,11 @@ FRAME = 12
 
 
 def scene_text(across, mode, resolution):
-    """The default scene at `across` voxels, blend mode `mode`, meshes by absolute path."""
+    """The default scene at `across` voxels, blend mode `mode`, meshes and sky by absolute path."""
     text = open(SCENE).read()
     scenes = os.path.dirname(SCENE)
-    text = re.sub(r'mesh = "([^"]+)"', lambda m: 'mesh = "%s"' % os.path.join(scenes, m.group(1)),
-                  text)
+    text = re.sub(r'(mesh|map) = "([^"]+)"',
+                  lambda m: '%s = "%s"' % (m.group(1), os.path.join(scenes, m.group(2))), text)
     text, n = re.subn(r"^voxel_size = [0-9.]+", "voxel_size = %.9g" % (1.0 / across), text,
                       flags=re.M)
     assert n == 1, "the scene's voxel_size line moved"

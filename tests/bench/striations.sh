@@ -19,7 +19,7 @@ trap 'rm -rf "$out"' EXIT
 
 for across in $across_list; do
     voxel=$(awk -v n="$across" 'BEGIN { printf "%.6g", 0.008 * 125 / n }')
-    sed "s|meshes/|$src/scenes/meshes/|; s|^voxel_size = .*|voxel_size = $voxel|" \
+    sed "s|meshes/|$src/scenes/meshes/|; s|skies/|$src/scenes/skies/|; s|^voxel_size = .*|voxel_size = $voxel|" \
         "$src/scenes/bunny-to-knot.toml" >"$out/scene.toml"
     VOLMORPH_CACHE="$out/cache" "$vm" morph "$out/scene.toml" --frames 12 -o "$out/m.####.vdb" -q
     width=$(awk -v v="$voxel" 'BEGIN { printf "%.6g", 100 * v }')

@@ -77,7 +77,7 @@ grep -q "render: pixels" "$dir/err" && fail "the shadow maps were done before th
 # 3. During a frame's morph: the default scene with the exact warp on voxels of 0.003 (~330 across)
 #    times COARSEN.
 voxel=$(awk -v c="$coarsen" 'BEGIN { print 0.003 * c }')
-sed "s|meshes/|$source_dir/scenes/meshes/|; s|^voxel_size = .*|voxel_size = $voxel|; s|^tolerance = .*|tolerance = 0|" \
+sed "s|meshes/|$source_dir/scenes/meshes/|; s|skies/|$source_dir/scenes/skies/|; s|^voxel_size = .*|voxel_size = $voxel|; s|^tolerance = .*|tolerance = 0|" \
     "$source_dir/scenes/bunny-to-knot.toml" >"$dir/scene.toml"
 "$volmorph" cache "$dir/scene.toml" -q || fail "cache"
 for command in render morph preview; do

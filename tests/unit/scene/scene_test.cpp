@@ -94,7 +94,12 @@ TEST(Scene, DefaultSceneValues)
     EXPECT_EQ(s.blend.density.kind, ScheduleSpec::Kind::Sigmoid);
     EXPECT_DOUBLE_EQ(s.blend.density.k, 8.0);
     EXPECT_EQ(s.render.lights.size(), 2u);
-    EXPECT_EQ(s.render.lights[1].type, LightType::Point);
+    EXPECT_NEAR(s.render.lights[0].angleRadians, 2.0 * M_PI / 180.0, 1e-12);
+    EXPECT_EQ(s.render.lights[1].type, LightType::Environment);
+    EXPECT_EQ(s.render.lights[1].map, kRoot / "scenes" / "skies" / "sky.exr");
+    EXPECT_EQ(s.render.bounces, 4);
+    ASSERT_EQ(s.props.size(), 1u);
+    EXPECT_EQ(s.props[0].mesh, kRoot / "scenes" / "meshes" / "floor.obj");
     EXPECT_EQ(s.frames.first, 1);
     EXPECT_EQ(s.frames.last, 24);
 }
