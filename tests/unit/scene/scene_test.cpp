@@ -452,7 +452,10 @@ TEST(Scene, CommentedExampleInScenesReadmeParses)
     const Scene s = parseScene(toml, kRoot / "scenes" / "README-example.toml");
     EXPECT_EQ(s.pairs.size(), 2u);
     EXPECT_NEAR(s.source.transform.rotateRadians.y(), M_PI / 2, 1e-12);
-    EXPECT_EQ(s.render.lights.size(), 2u);
+    ASSERT_EQ(s.render.lights.size(), 2u);
+    EXPECT_EQ(s.render.lights[1].map, kRoot / "scenes" / "skies" / "sky.exr");
+    EXPECT_EQ(s.render.bounces, 4);
+    EXPECT_TRUE(s.render.layers);
     ASSERT_EQ(s.props.size(), 1u);
     EXPECT_EQ(s.props[0].color, Vec3d(0.6));
     EXPECT_EQ(s.frames.count(), 24);
