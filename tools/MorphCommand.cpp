@@ -19,7 +19,7 @@ namespace volmorph::cli {
 namespace {
 
 struct MorphArgs {
-    std::string scene, frames, output, mesh, sampling = "trilinear", preset = "volmorph";
+    std::string scene, frames, output, mesh, sampling = "trilinear", preset = "volmorph", side;
     bool exact = false, half = false, quiet = false, verbose = false;
     double memoryLimitGiB = 0.0;
     CacheArgs cache;
@@ -72,6 +72,7 @@ int runMorph(const MorphArgs& args)
                             "expected a pattern ending in .ply or .obj, got \"" + args.mesh + "\"");
     }
     if (args.exact) scene.warp.toleranceVoxels = 0.0;
+    if (!args.side.empty()) keepOneSide(scene.blend, args.side == "target");
 
     Interrupter interrupter(false, args.verbose);
     StopSignals signals(interrupter);
@@ -125,6 +126,10 @@ Command addMorphCommand(CLI::App& app)
                     "vel) or blender (sdf, density, color, velocity); carried grids keep theirs")
         ->check(CLI::IsMember({"volmorph", "houdini", "blender"}));
     sub->add_flag("--half", args->half, "store float and vec3 grids as 16-bit floats");
+    sub->add_option("--side", args->side,
+                    "write one side alone, warped at each frame's t: source or target (how each "
+                    "side bends; every schedule held at 0 or 1)")
+        ->check(CLI::IsMember({"source", "target"}));
     addCacheOptions(sub, args->cache);
     sub->add_flag("-q,--quiet", args->quiet, "print nothing on success");
     sub->add_flag("-v,--verbose", args->verbose,

@@ -52,4 +52,14 @@ VolumeSet SceneMorph::frame(int frame, MorphStats* stats)
     return v;
 }
 
+void keepOneSide(BlendSpec& blend, bool target)
+{
+    ScheduleSpec held;
+    held.kind = ScheduleSpec::Kind::Curve;
+    const double tau = target ? 1.0 : 0.0;
+    held.points = {{0.0, tau}, {1.0, tau}};
+    blend.density = blend.color = blend.sdf = held;
+    for (auto& entry : blend.grids) entry.second.schedule = held;
+}
+
 } // namespace volmorph::cli

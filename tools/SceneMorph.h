@@ -14,6 +14,10 @@
 
 namespace volmorph::cli {
 
+/// Holds every schedule of `blend` (density, colour, sdf and the carried grids') at 0 (the source)
+/// or 1 (`target`): the morph then shows that side alone, warped at each frame's t.
+void keepOneSide(BlendSpec& blend, bool target);
+
 class SceneMorph {
 public:
     /// Voxelizes (or reads from the cache) the scene's source and target, and builds the Morpher.
