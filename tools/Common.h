@@ -37,6 +37,7 @@ Command addDiffCommand(CLI::App& app);
 Command addCacheCommand(CLI::App& app);
 Command addPreviewCommand(CLI::App& app);
 Command addFramesCommand(CLI::App& app);
+Command addPairsCommand(CLI::App& app);
 
 std::string fmt(double v);
 std::string fmt(const Vec3d& v);

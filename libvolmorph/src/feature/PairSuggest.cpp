@@ -1,0 +1,234 @@
+#include <volmorph/PairSuggest.h>
+
+#include <Eigen/Eigenvalues>
+#include <openvdb/tools/Interpolation.h>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <stdexcept>
+
+namespace volmorph {
+namespace {
+
+constexpr size_t kMaxPoints = 20000; ///< interior points kept per side (evenly strided)
+constexpr double kTipReach =
+    0.15; ///< the farthest a tip pair moves a tip past the box, per diagonal
+
+/// One side: points inside it (density >= 0.5, world units), and the box of its principal axes.
+struct Shape {
+    std::vector<Vec3d> inside;
+    double volume = 0.0; ///< of the interior, world units cubed
+    Vec3d centroid{0.0};
+    std::array<Vec3d, 3> axes; ///< unit, right-handed, the largest spread first
+    Vec3d origin{0.0}, scale{0.0};
+
+    FeatureElement box() const { return FeatureElement{origin, axes[0], axes[1], axes[2], scale}; }
+
+    /// p in the box's frame, each axis scaled to [-1, 1] across the box.
+    Vec3d normalized(const Vec3d& p) const
+    {
+        const Vec3d d = p - origin;
+        Vec3d u;
+        for (int i = 0; i < 3; ++i) u[i] = d.dot(axes[i]) / (0.5 * scale[i]);
+        return u;
+    }
+};
+
+/// The interior points of `density`, strided to at most kMaxPoints; `count` gets how many there
+/// are before striding.
+std::vector<Vec3d> insidePoints(const openvdb::FloatGrid& density, size_t& count)
+{
+    std::vector<openvdb::Coord> all;
+    for (auto it = density.cbeginValueOn(); it; ++it) {
+        if (*it < 0.5f) continue;
+        if (it.isVoxelValue()) {
+            all.push_back(it.getCoord());
+        } else {
+            openvdb::CoordBBox box;
+            it.getBoundingBox(box);
+            for (auto c = box.begin(); c; ++c) all.push_back(*c);
+        }
+    }
+    count = all.size();
+    const size_t stride = std::max<size_t>(1, all.size() / kMaxPoints);
+    std::vector<Vec3d> points;
+    for (size_t i = 0; i < all.size(); i += stride)
+        points.push_back(density.indexToWorld(all[i].asVec3d()));
+    return points;
+}
+
+Shape shapeOf(const openvdb::FloatGrid& density, double voxel)
+{
+    Shape s;
+    size_t count = 0;
+    s.inside = insidePoints(density, count);
+    s.volume = double(count) * voxel * voxel * voxel;
+    if (s.inside.empty()) throw std::invalid_argument("a side has no interior (density >= 0.5)");
+    for (const Vec3d& p : s.inside) s.centroid += p;
+    s.centroid /= double(s.inside.size());
+    Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();
+    for (const Vec3d& p : s.inside) {
+        const Eigen::Vector3d d(p.x() - s.centroid.x(), p.y() - s.centroid.y(),
+                                p.z() - s.centroid.z());
+        covariance += d * d.transpose();
+    }
+    const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver(covariance);
+    const Eigen::Matrix3d v = solver.eigenvectors(); // ascending eigenvalues
+    s.axes[0] = Vec3d(v(0, 2), v(1, 2), v(2, 2)).unit();
+    s.axes[1] = Vec3d(v(0, 1), v(1, 1), v(2, 1)).unit();
+    s.axes[2] = s.axes[0].cross(s.axes[1]).unit();
+    Vec3d lo(1e300), hi(-1e300);
+    for (const Vec3d& p : s.inside)
+        for (int i = 0; i < 3; ++i) {
+            const double x = (p - s.centroid).dot(s.axes[i]);
+            lo[i] = std::min(lo[i], x);
+            hi[i] = std::max(hi[i], x);
+        }
+    s.origin = s.centroid;
+    for (int i = 0; i < 3; ++i) {
+        s.origin += s.axes[i] * (0.5 * (lo[i] + hi[i]));
+        s.scale[i] = std::max(hi[i] - lo[i] + voxel, voxel); // voxel centres: half a voxel out
+    }
+    return s;
+}
+
+/// The box pair's affine map from `from` to `to`.
+Vec3d boxMap(const FeatureElement& from, const FeatureElement& to, const Vec3d& p)
+{
+    const Vec3d d = p - from.origin;
+    const Vec3d fromAxes[3] = {from.xAxis, from.yAxis, from.zAxis};
+    const Vec3d toAxes[3] = {to.xAxis, to.yAxis, to.zAxis};
+    Vec3d q = to.origin;
+    for (int i = 0; i < 3; ++i) q += toAxes[i] * (d.dot(fromAxes[i]) * to.scale[i] / from.scale[i]);
+    return q;
+}
+
+/// The share of `from`'s interior points that the box map carries inside `density`.
+double carriedInside(const Shape& from, const FeatureElement& fromBox, const FeatureElement& toBox,
+                     const openvdb::FloatGrid& density)
+{
+    const auto accessor = density.getConstAccessor();
+    size_t inside = 0;
+    for (const Vec3d& p : from.inside) {
+        const Vec3d q = density.worldToIndex(boxMap(fromBox, toBox, p));
+        inside += openvdb::tools::BoxSampler::sample(accessor, q) >= 0.5f;
+    }
+    return double(inside) / double(from.inside.size());
+}
+
+/// The IoU of the source carried by the box map with the target (what the morph's source side
+/// becomes at t = 1 with this one pair): the intersection estimated both ways (the share of each
+/// side's points the map carries inside the other, times that side's volume where it lands).
+double boxIoU(const Shape& s, const FeatureElement& sourceBox,
+              const openvdb::FloatGrid& sourceDensity, const Shape& t,
+              const FeatureElement& targetBox, const openvdb::FloatGrid& targetDensity)
+{
+    const double stretch = (targetBox.scale[0] * targetBox.scale[1] * targetBox.scale[2]) /
+                           (sourceBox.scale[0] * sourceBox.scale[1] * sourceBox.scale[2]);
+    const double carried = s.volume * stretch; // the source's volume once mapped
+    const double common = 0.5 * (carriedInside(s, sourceBox, targetBox, targetDensity) * carried +
+                                 carriedInside(t, targetBox, sourceBox, sourceDensity) * t.volume);
+    return common / (carried + t.volume - common);
+}
+
+/// Each side's tips: the points farthest out in the box's normalized frame, each at least 60
+/// degrees from the others seen from the centre; at most six.
+std::vector<Vec3d> tipsOf(const Shape& s)
+{
+    std::vector<Vec3d> tips, directions;
+    for (int k = 0; k < 6; ++k) {
+        double best = 0.5; // beyond half the box
+        const Vec3d* tip = nullptr;
+        for (const Vec3d& p : s.inside) {
+            const Vec3d u = s.normalized(p);
+            const double r = u.length();
+            if (r <= best) continue;
+            const bool apart = std::all_of(directions.begin(), directions.end(),
+                                           [&](const Vec3d& d) { return u.dot(d) < 0.5 * r; });
+            if (!apart) continue;
+            best = r;
+            tip = &p;
+        }
+        if (!tip) break;
+        tips.push_back(*tip);
+        directions.push_back(s.normalized(*tip).unit());
+    }
+    return tips;
+}
+
+/// Point pairs at the tips: a source tip carried by the box map and a target tip that are each
+/// other's nearest, closer than kTipReach of the target box's diagonal (a correction of the box
+/// near its tips, not a jump) and farther than two voxels (else the box alone places it).
+std::vector<FeaturePairSpec> tipPairs(const Shape& source, const FeatureElement& sourceBox,
+                                      const Shape& target, const FeatureElement& targetBox,
+                                      double voxel)
+{
+    const std::vector<Vec3d> a = tipsOf(source), b = tipsOf(target);
+    std::vector<Vec3d> carried;
+    for (const Vec3d& p : a) carried.push_back(boxMap(sourceBox, targetBox, p));
+    auto nearest = [](const Vec3d& p, const std::vector<Vec3d>& among) {
+        size_t index = 0;
+        for (size_t j = 1; j < among.size(); ++j)
+            if ((among[j] - p).lengthSqr() < (among[index] - p).lengthSqr()) index = j;
+        return index;
+    };
+    const double reach = kTipReach * targetBox.scale.length();
+    std::vector<FeaturePairSpec> pairs;
+    for (size_t i = 0; i < a.size() && !b.empty(); ++i) {
+        const size_t j = nearest(carried[i], b);
+        const double apart = (carried[i] - b[j]).length();
+        if (nearest(b[j], carried) != i || apart > reach || apart <= 2.0 * voxel) continue;
+        // The box's frames and scales on both points: this pair's map is the box's, shifted to
+        // carry the tip onto the tip, so that blending the two only bends the box's map locally.
+        FeaturePairSpec pair;
+        pair.type = FeatureType::Point;
+        pair.source = sourceBox;
+        pair.target = targetBox;
+        pair.source.origin = a[i];
+        pair.target.origin = b[j];
+        pairs.push_back(pair);
+    }
+    return pairs;
+}
+
+} // namespace
+
+PairSuggestion suggestPairs(const VolumeSet& source, const VolumeSet& target)
+{
+    const double voxel = source.density->voxelSize()[0];
+    const Shape s = shapeOf(*source.density, voxel), t = shapeOf(*target.density, voxel);
+    PairSuggestion out;
+    FeaturePairSpec box;
+    box.type = FeatureType::Box;
+    box.source = s.box();
+    // The target's principal axes in any order and either sign, right-handed (24 frames): the one
+    // whose box map carries the most of each side inside the other. (Signs alone are not enough
+    // where the two shapes' longest axes differ.)
+    out.boxOverlap = -1.0;
+    const FeatureElement t0 = t.box();
+    const Vec3d axes[3] = {t0.xAxis, t0.yAxis, t0.zAxis};
+    for (int x = 0; x < 3; ++x)
+        for (int y = 0; y < 3; ++y) {
+            if (x == y) continue;
+            for (const auto& [sx, sy] :
+                 {std::pair{1.0, 1.0}, {1.0, -1.0}, {-1.0, 1.0}, {-1.0, -1.0}}) {
+                FeatureElement candidate = t0;
+                candidate.xAxis = axes[x] * sx;
+                candidate.yAxis = axes[y] * sy;
+                candidate.zAxis = candidate.xAxis.cross(candidate.yAxis);
+                candidate.scale = Vec3d(t0.scale[x], t0.scale[y], t0.scale[3 - x - y]);
+                const double overlap =
+                    boxIoU(s, box.source, *source.density, t, candidate, *target.density);
+                if (overlap > out.boxOverlap) {
+                    out.boxOverlap = overlap;
+                    box.target = candidate;
+                }
+            }
+        }
+    out.pairs.push_back(box);
+    for (FeaturePairSpec& p : tipPairs(s, box.source, t, box.target, voxel)) out.pairs.push_back(p);
+    return out;
+}
+
+} // namespace volmorph

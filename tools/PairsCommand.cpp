@@ -1,0 +1,123 @@
+// volmorph pairs suggest SCENE [-o OUT.toml]: first feature pairs from the two shapes alone
+// (PairSuggest.h). Without -o the new [[pair]] tables go to stdout; with -o the scene's text with
+// them appended after its own pairs (SceneDocument: every other byte kept) is written to OUT, which
+// may not be the scene itself.
+#include "Common.h"
+
+#include <volmorph/PairSuggest.h>
+#include <volmorph/SceneDocument.h>
+#include <volmorph/core/MemoryLimit.h>
+
+#include <cmath>
+#include <cstdio>
+#include <memory>
+
+namespace volmorph::cli {
+namespace {
+
+struct PairsArgs {
+    std::string scene, output;
+    bool quiet = false;
+    double memoryLimitGiB = 0.0;
+    CacheArgs cache;
+};
+
+const char* const kSuggested = "suggested by volmorph pairs suggest";
+
+/// A number to 1e-4 world units (a tenth of a millimetre at metre scale), as TOML: "0.25",
+/// "-0.0012".
+std::string rounded(double v)
+{
+    char text[64];
+    std::snprintf(text, sizeof text, "%.4f", std::round(v * 1e4) / 1e4 + 0.0);
+    std::string s(text);
+    while (s.size() > 1 && s.back() == '0' && s[s.size() - 2] != '.') s.pop_back();
+    return s == "-0.0" ? "0.0" : s;
+}
+
+std::string vec(const Vec3d& v)
+{
+    return "[" + rounded(v.x()) + ", " + rounded(v.y()) + ", " + rounded(v.z()) + "]";
+}
+
+/// One element as an inline table, as the scenes write theirs (a suggested point carries the box's
+/// frame and scale: PairSuggest.h).
+std::string element(const FeatureElement& e)
+{
+    return "{ origin = " + vec(e.origin) + ", axes = [" + vec(e.xAxis) + ", " + vec(e.yAxis) +
+           "], scale = " + vec(e.scale) + " }";
+}
+
+std::vector<std::string> pairLines(const FeaturePairSpec& pair)
+{
+    return {std::string("type = \"") + toString(pair.type) + "\"",
+            "source = " + element(pair.source), "target = " + element(pair.target)};
+}
+
+int runSuggest(const PairsArgs& args)
+{
+    const Scene scene = loadScene(args.scene);
+    SceneDocument document = SceneDocument::read(args.scene);
+    std::error_code ec;
+    if (!args.output.empty() && std::filesystem::equivalent(args.output, args.scene, ec))
+        throw UserError(SourceLocation{"-o"}, "\"" + args.output +
+                                                  "\" is the scene itself; pairs suggest never "
+                                                  "edits a scene in place: write a new file");
+    Interrupter interrupter(false, false);
+    StopSignals signals(interrupter);
+    // With the pairs on stdout, nothing else goes there.
+    const SceneVolumes volumes =
+        loadSceneVolumes(scene, args.cache, interrupter, memoryLimitBytes(args.memoryLimitGiB),
+                         args.quiet || args.output.empty());
+    const PairSuggestion suggestion = suggestPairs(volumes.source, volumes.target);
+    std::string printed;
+    for (const FeaturePairSpec& pair : suggestion.pairs) {
+        document.appendPair(pairLines(pair), {kSuggested});
+        printed += std::string("\n# ") + kSuggested + "\n[[pair]]\n";
+        for (const std::string& line : pairLines(pair)) printed += line + "\n";
+    }
+    if (args.output.empty()) {
+        std::printf("%s", printed.c_str() + 1);
+        return 0;
+    }
+    const auto folder = [](const std::string& p) {
+        return std::filesystem::absolute(p).lexically_normal().parent_path();
+    };
+    if (folder(args.output) != folder(args.scene))
+        std::fprintf(stderr,
+                     "volmorph: warning: %s is not beside %s: the paths it names relative to the "
+                     "scene's folder will be read from its own\n",
+                     args.output.c_str(), args.scene.c_str());
+    document.save(args.output);
+    if (!args.quiet)
+        std::printf("%zu pairs suggested (the box alone: IoU %.2f of the carried source with the "
+                    "target), "
+                    "appended after the scene's %zu -> %s\n",
+                    suggestion.pairs.size(), suggestion.boxOverlap, scene.pairs.size(),
+                    args.output.c_str());
+    return 0;
+}
+
+} // namespace
+
+Command addPairsCommand(CLI::App& app)
+{
+    auto args = std::make_shared<PairsArgs>();
+    CLI::App* pairs = app.add_subcommand("pairs", "Feature pairs: suggest first ones");
+    pairs->require_subcommand(1);
+    CLI::App* sub = pairs->add_subcommand(
+        "suggest", "Suggest feature pairs from the two shapes alone: a box pair from their "
+                   "principal axes, point pairs at matched extremities");
+    sub->add_option("SCENE", args->scene, "scene file (TOML)")->required();
+    sub->add_option("-o,--output", args->output,
+                    "write the scene with the suggested pairs appended after its own to this new "
+                    "file (default: print the new [[pair]] tables on stdout)");
+    sub->add_option("--memory-limit", args->memoryLimitGiB,
+                    "voxelization memory limit in GiB (default: half the machine's memory)")
+        ->check(CLI::PositiveNumber);
+    addCacheOptions(sub, args->cache);
+    sub->add_flag("-q,--quiet", args->quiet, "print nothing on success but the pairs");
+    return {sub, [args] { return runSuggest(*args); }};
+}
+
+} // namespace volmorph::cli
