@@ -118,6 +118,13 @@ const toml::table* tableAt(const toml::table& root, const std::vector<KeyStep>& 
     return t;
 }
 
+/// The file's line ending: "\r\n" where its first line ends so, else "\n".
+std::string lineEnding(const std::string& text)
+{
+    const size_t n = text.find('\n');
+    return n != std::string::npos && n > 0 && text[n - 1] == '\r' ? "\r\n" : "\n";
+}
+
 const toml::array* pairsOf(const toml::table& root)
 {
     const toml::node* n = root.get("pair");
@@ -161,8 +168,9 @@ void SceneDocument::set(const std::string& key, const std::string& value)
         next.insert(at, (empty ? " " : ", ") + name + " = " + value + (empty ? " " : ""));
     } else if (parent != &root && isHeaderTable(mText, *parent)) {
         const size_t at = lineStart(mText, lastOwnLine(mText, *parent) + 1);
-        const std::string before = at > 0 && mText[at - 1] != '\n' ? "\n" : "";
-        next.insert(at, before + name + " = " + value + "\n");
+        const std::string eol = lineEnding(mText);
+        const std::string before = at > 0 && mText[at - 1] != '\n' ? eol : "";
+        next.insert(at, before + name + " = " + value + eol);
     } else {
         throw std::invalid_argument("\"" + key + "\": a new key goes in a [table] or an inline " +
                                     "table; add this one by hand");
@@ -182,10 +190,11 @@ void SceneDocument::appendPair(const std::vector<std::string>& lines,
     const toml::array* pairs = pairsOf(root);
     const size_t at =
         pairs && !pairs->empty() ? lineStart(mText, lastLine(pairs->back()) + 1) : mText.size();
-    std::string block = at > 0 && mText[at - 1] != '\n' ? "\n\n" : "\n";
-    for (const std::string& c : comment) block += "# " + c + "\n";
-    block += "[[pair]]\n";
-    for (const std::string& line : lines) block += line + "\n";
+    const std::string eol = lineEnding(mText);
+    std::string block = at > 0 && mText[at - 1] != '\n' ? eol + eol : eol;
+    for (const std::string& c : comment) block += "# " + c + eol;
+    block += "[[pair]]" + eol;
+    for (const std::string& line : lines) block += line + eol;
     std::string next = mText;
     next.insert(at, block);
     try {
@@ -214,8 +223,10 @@ void SceneDocument::removePair(int index)
     const size_t b = lineStart(mText, lastLine(pair) + 1);
     // The blank line that separated the pair from what came before goes with it when another
     // blank line (or the end) follows.
-    const bool blankBefore = a >= 2 && mText[a - 1] == '\n' && mText[a - 2] == '\n';
-    if (blankBefore && (b >= mText.size() || mText[b] == '\n')) --a;
+    const std::string eol = lineEnding(mText);
+    const size_t k = eol.size();
+    const bool blankBefore = a >= 2 * k && mText.compare(a - 2 * k, 2 * k, eol + eol) == 0;
+    if (blankBefore && (b >= mText.size() || mText.compare(b, k, eol) == 0)) a -= k;
     mText.erase(a, b - a);
 }
 

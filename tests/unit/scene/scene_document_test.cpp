@@ -149,3 +149,29 @@ TEST(SceneDocument, NumbersAreWrittenToReadBackExactly)
     EXPECT_EQ(tomlNumber(3.0), "3.0");
     EXPECT_EQ(tomlArray({1.0, 0.25}), "[1.0, 0.25]");
 }
+
+TEST(SceneDocument, AFileWithWindowsLineEndingsKeepsThem)
+{
+    std::ifstream in(kScene, std::ios::binary);
+    std::ostringstream text;
+    text << in.rdbuf();
+    std::string crlf;
+    for (const char c : text.str()) crlf += c == '\n' ? std::string("\r\n") : std::string(1, c);
+    SceneDocument doc(crlf, kScene);
+    doc.set("pair[2].target.origin", "[-0.4, 0.425, 0.0]");
+    doc.set("warp.weighting", "\"beier-neely\"");
+    doc.appendPair({"type = \"point\"", "source = { origin = [0.0, 1.0, 0.0] }",
+                    "target = { origin = [0.0, 1.0, 0.0] }"});
+    // Every line still ends in CR LF: no bare LF anywhere.
+    for (size_t i = 0; i < doc.text().size(); ++i) {
+        if (doc.text()[i] == '\n') {
+            ASSERT_TRUE(i > 0 && doc.text()[i - 1] == '\r') << "at " << i;
+        }
+    }
+    const Scene scene = parseScene(doc.text(), kScene);
+    EXPECT_EQ(scene.pairs.size(), 4u);
+    doc.removePair(4);
+    doc.set("warp.epsilon", "0.02");
+    EXPECT_EQ(parseScene(doc.text(), kScene).pairs.size(), 3u);
+    EXPECT_EQ(doc.text().find("\r\n\r\n\r\n"), std::string::npos);
+}
