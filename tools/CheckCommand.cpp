@@ -145,7 +145,12 @@ void printVolume(const Scene& scene, const SceneMeshes& meshes, const SideExtent
 /// Every feature pair, numbered as the warp and `preview` number them.
 void printPairs(const Scene& scene)
 {
-    std::printf("pairs   %zu\n", scene.pairs.size());
+    if (scene.pairs.empty())
+        std::printf(
+            "pairs   0 (the identity warp); `volmorph pairs suggest %s` proposes first ones\n",
+            scene.file.string().c_str());
+    else
+        std::printf("pairs   %zu\n", scene.pairs.size());
     for (size_t i = 0; i < scene.pairs.size(); ++i) {
         const FeaturePairSpec& p = scene.pairs[i];
         auto element = [&p](const FeatureElement& e) {
