@@ -73,6 +73,12 @@ public:
     Morpher(VolumeSet source, VolumeSet target, std::vector<FeaturePairSpec> pairs, WarpSpec warp,
             BlendSpec blend, MorphOptions options = {});
 
+    /// The same morph with other pairs, sharing this one's blend setup (sdf mode's extended
+    /// distances, which depend on the two sides alone) when both this and `pairs` have pairs; built
+    /// anew when either has none (the identity warp sets up differently). What an editor does
+    /// after each change to the pairs: frames are bit for bit those of a Morpher built with them.
+    Morpher withPairs(std::vector<FeaturePairSpec> pairs) const;
+
     /// The in-between at t in [0, 1]: grids `density` and `Cd` on the shared transform.
     VolumeSet frame(double t, MorphStats* stats = nullptr,
                     Interrupter* interrupter = nullptr) const;

@@ -108,6 +108,15 @@ Morpher::Morpher(VolumeSet source, VolumeSet target, std::vector<FeaturePairSpec
     mMethod = detail::makeBlendMethod(setup);
 }
 
+Morpher Morpher::withPairs(std::vector<FeaturePairSpec> pairs) const
+{
+    if (pairs.empty() || mPairs.empty())
+        return Morpher(mSource, mTarget, std::move(pairs), mWarp, mBlend, mOptions);
+    Morpher other(*this);
+    other.mPairs = std::move(pairs);
+    return other;
+}
+
 CoordBBox Morpher::candidateBounds(double t) const
 {
     // The occupied blocks' bounds and a block more on each side.
