@@ -10,11 +10,12 @@
 namespace volmorph::render {
 namespace {
 
-/// The index of the bin of `cdf` (non-decreasing, from cdf[0]) holding `value`: the last i with
-/// cdf[i] <= value, at most cdf.size() - 2.
-size_t binOf(const double* cdf, size_t bins, double value)
+/// The index of the bin of `cdf` (bins + 1 non-decreasing values) holding `value`: the last i with
+/// cdf[i] <= value, at most bins - 1.
+template <typename T>
+size_t binOf(const T* cdf, size_t bins, T value)
 {
-    const double* it = std::upper_bound(cdf, cdf + bins + 1, value);
+    const T* it = std::upper_bound(cdf, cdf + bins + 1, value);
     const size_t i = it == cdf ? 0 : size_t(it - cdf) - 1;
     return std::min(i, bins - 1);
 }
@@ -108,8 +109,7 @@ Vec3d EnvironmentMap::sample(double u1, double u2, double& pdf) const
     const size_t j = binOf(mRowCdf.data(), h, rowValue);
     const double s = (rowValue - mRowCdf[j]) / (mRowCdf[j + 1] - mRowCdf[j]);
     const float* cdf = &mColumnCdf[j * (w + 1)];
-    const float* it = std::upper_bound(cdf, cdf + w + 1, float(u2));
-    const size_t i = std::min(it == cdf ? 0 : size_t(it - cdf) - 1, w - 1);
+    const size_t i = binOf(cdf, w, float(u2));
     const double width = double(cdf[i + 1]) - double(cdf[i]);
     const double t = width > 0.0 ? std::clamp((u2 - double(cdf[i])) / width, 0.0, 1.0) : 0.5;
     // Uniform over the pixel's solid angle: cos theta uniform between the row's boundaries.

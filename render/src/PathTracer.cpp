@@ -140,7 +140,7 @@ public:
             const Vec3d w = cosineDirection(n, u1, u2);
             const Vec3d E = sky.constant * M_PI; // a uniform sky's irradiance
             unoccluded += E;
-            received += E * visibility(x, w);
+            received += E * exactVisibility(mR, x, w, kNoProp);
         }
         if (sky.map) {
             const double u1 = mRandom.next(), u2 = mRandom.next();
@@ -150,7 +150,7 @@ public:
             if (pdf > 0.0 && cosine > 0.0) {
                 const Vec3d E = sky.mapRadiance(w) * (cosine / pdf);
                 unoccluded += E;
-                received += E * visibility(x, w);
+                received += E * exactVisibility(mR, x, w, kNoProp);
             }
         }
         return shadowMatte(received, unoccluded);
@@ -243,7 +243,7 @@ private:
         if (v.surface) {
             f = v.n.dot(w) / M_PI;
             if (f <= 0.0) return Vec3d(0.0);
-            T = visibility(v.x, w);
+            T = exactVisibility(mR, v.x, w, kNoProp);
         } else {
             const Vec3d x = mIn.density.indexToWorld(v.ip);
             const Vec3d dir = (mIn.density.worldToIndex(x + w) - v.ip).unit();
@@ -252,15 +252,6 @@ private:
         }
         if (T <= 0.0) return Vec3d(0.0);
         return sky.mapRadiance(w) * (f * T / pdf * powerHeuristic(pdf, f));
-    }
-
-    /// What reaches world point x from infinitely far along unit world direction w: 0 behind a
-    /// prop, else the volume's exact transmittance.
-    double visibility(const Vec3d& x, const Vec3d& w)
-    {
-        if (mIn.props && mIn.props->occluded(x, w, 0.0, kNoProp)) return 0.0;
-        return std::exp(-opticalDepth(mR.shadowInter, mIn.levelSet, mR.shadowDensity, x, w, kNoProp,
-                                      mIn.sigmaPerVoxel));
     }
 
     /// From world point x along unit world direction w: the first collision before the first prop

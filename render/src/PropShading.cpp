@@ -22,10 +22,7 @@ Vec3d directIrradiance(ThreadReaders& readers, const Vec3d& x, const Vec3d& n, V
         const double falloff = light.type == Light::Type::Point ? 1.0 / (distance * distance) : 1.0;
         const Vec3d E = light.color * (light.intensity * falloff * cosine);
         unoccluded += E;
-        if (in.props && in.props->occluded(x, toward, 0.0, distance)) continue;
-        const double tau = opticalDepth(readers.shadowInter, in.levelSet, readers.shadowDensity, x,
-                                        toward, distance, in.sigmaPerVoxel);
-        received += E * std::exp(-tau);
+        received += E * exactVisibility(readers, x, toward, distance);
     }
     return received;
 }

@@ -33,19 +33,24 @@ Vec3d towardLight(const Light& light, const Vec3d& p, double& distance)
     return toward / distance;
 }
 
+double exactVisibility(ThreadReaders& readers, const Vec3d& p, const Vec3d& w, double distance)
+{
+    const FrameInputs& in = readers.in;
+    if (in.props && in.props->occluded(p, w, 0.0, distance)) return 0.0;
+    return std::exp(-opticalDepth(readers.shadowInter, in.levelSet, readers.shadowDensity, p, w,
+                                  distance, in.sigmaPerVoxel));
+}
+
 namespace {
 
 /// The exact transmittance from index point ip toward `light` (no shadow map or cache: the march
 /// through every cell on the way), 0 behind a prop.
 double exactTransmittance(ThreadReaders& readers, const Light& light, const Vec3d& ip)
 {
-    const FrameInputs& in = readers.in;
-    const Vec3d p = in.density.indexToWorld(ip);
+    const Vec3d p = readers.in.density.indexToWorld(ip);
     double distance;
     const Vec3d toward = towardLight(light, p, distance);
-    if (in.props && in.props->occluded(p, toward, 0.0, distance)) return 0.0;
-    return std::exp(-opticalDepth(readers.shadowInter, in.levelSet, readers.shadowDensity, p,
-                                  toward, distance, in.sigmaPerVoxel));
+    return exactVisibility(readers, p, toward, distance);
 }
 
 } // namespace

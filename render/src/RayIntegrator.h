@@ -71,6 +71,12 @@ struct ThreadReaders {
 /// gets the world distance to it, 1e30 (beyond any grid) for a directional light.
 Vec3d towardLight(const Light& light, const Vec3d& p, double& distance);
 
+/// What reaches world point p from `distance` world units along unit world direction w (kNoProp:
+/// from infinitely far): 0 when a prop is in the way, else the volume's exact transmittance, cell
+/// by cell (Cell.h). Read by props' direct light, a sky map's light on props and catchers, and the
+/// single-scattering estimator without shadow maps.
+double exactVisibility(ThreadReaders& readers, const Vec3d& p, const Vec3d& w, double distance);
+
 /// Light `l`'s (directional or point) colour times intensity, over the squared distance for a point
 /// light, times the phase function at index point ip from the light toward -direction (unit).
 Vec3d lightPhased(const FrameInputs& in, size_t l, const Vec3d& ip, const Vec3d& direction);
