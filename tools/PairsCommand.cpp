@@ -56,8 +56,9 @@ std::vector<std::string> pairLines(const FeaturePairSpec& pair)
 
 int runSuggest(const PairsArgs& args)
 {
-    const Scene scene = loadScene(args.scene);
+    // One read: the scene parsed from the very text the new file is written from.
     SceneDocument document = SceneDocument::read(args.scene);
+    const Scene scene = parseScene(document.text(), args.scene);
     std::error_code ec;
     if (!args.output.empty() && std::filesystem::equivalent(args.output, args.scene, ec))
         throw UserError(SourceLocation{"-o"}, "\"" + args.output +

@@ -35,26 +35,34 @@ struct Shape {
     }
 };
 
-/// The interior points of `density`, strided to at most kMaxPoints; `count` gets how many there
-/// are before striding.
-std::vector<Vec3d> insidePoints(const openvdb::FloatGrid& density, size_t& count)
+/// Calls f(coord) for every interior voxel of `density` (density >= 0.5, tiles voxel by voxel).
+template <typename F>
+void forEachInside(const openvdb::FloatGrid& density, F&& f)
 {
-    std::vector<openvdb::Coord> all;
     for (auto it = density.cbeginValueOn(); it; ++it) {
         if (*it < 0.5f) continue;
         if (it.isVoxelValue()) {
-            all.push_back(it.getCoord());
-        } else {
-            openvdb::CoordBBox box;
-            it.getBoundingBox(box);
-            for (auto c = box.begin(); c; ++c) all.push_back(*c);
+            f(it.getCoord());
+            continue;
         }
+        openvdb::CoordBBox box;
+        it.getBoundingBox(box);
+        for (auto c = box.begin(); c; ++c) f(*c);
     }
-    count = all.size();
-    const size_t stride = std::max<size_t>(1, all.size() / kMaxPoints);
+}
+
+/// The interior points of `density`, every stride-th so that at most kMaxPoints are kept (nothing
+/// else is stored: hero grids hold 10^8 interior voxels); `count` gets how many there are.
+std::vector<Vec3d> insidePoints(const openvdb::FloatGrid& density, size_t& count)
+{
+    count = 0;
+    forEachInside(density, [&](const openvdb::Coord&) { ++count; });
+    const size_t stride = std::max<size_t>(1, count / kMaxPoints);
     std::vector<Vec3d> points;
-    for (size_t i = 0; i < all.size(); i += stride)
-        points.push_back(density.indexToWorld(all[i].asVec3d()));
+    size_t index = 0;
+    forEachInside(density, [&](const openvdb::Coord& c) {
+        if (index++ % stride == 0) points.push_back(density.indexToWorld(c.asVec3d()));
+    });
     return points;
 }
 
