@@ -14,6 +14,12 @@ find_package(assimp CONFIG REQUIRED)
 find_package(tomlplusplus CONFIG REQUIRED)
 find_package(CLI11 CONFIG REQUIRED)
 find_package(Eigen3 3.3 REQUIRED NO_MODULE)
+# The editor (volmorph edit): its JSON API and its local HTTP server. Debian's cpp-httplib is the
+# split build (a header and libcpp-httplib.so, built with OpenSSL, zlib and Brotli); it has a
+# pkg-config file and no CMake config.
+find_package(nlohmann_json 3.10 CONFIG REQUIRED)
+find_package(PkgConfig REQUIRED)
+pkg_check_modules(HTTPLIB REQUIRED IMPORTED_TARGET cpp-httplib)
 
 # libnifti2 (NIfTI volumes). Debian 12's NIFTIConfig.cmake points at /usr/lib/libnifti2.so.2.1.0,
 # which the package installs under /usr/lib/<arch>/: find the library and headers directly.

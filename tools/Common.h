@@ -38,6 +38,7 @@ Command addCacheCommand(CLI::App& app);
 Command addPreviewCommand(CLI::App& app);
 Command addFramesCommand(CLI::App& app);
 Command addPairsCommand(CLI::App& app);
+Command addEditCommand(CLI::App& app);
 
 std::string fmt(double v);
 std::string fmt(const Vec3d& v);

@@ -24,36 +24,6 @@ struct PairsArgs {
 
 const char* const kSuggested = "suggested by volmorph pairs suggest";
 
-/// A number to 1e-4 world units (a tenth of a millimetre at metre scale), as TOML: "0.25",
-/// "-0.0012".
-std::string rounded(double v)
-{
-    char text[64];
-    std::snprintf(text, sizeof text, "%.4f", std::round(v * 1e4) / 1e4 + 0.0);
-    std::string s(text);
-    while (s.size() > 1 && s.back() == '0' && s[s.size() - 2] != '.') s.pop_back();
-    return s == "-0.0" ? "0.0" : s;
-}
-
-std::string vec(const Vec3d& v)
-{
-    return "[" + rounded(v.x()) + ", " + rounded(v.y()) + ", " + rounded(v.z()) + "]";
-}
-
-/// One element as an inline table, as the scenes write theirs (a suggested point carries the box's
-/// frame and scale: PairSuggest.h).
-std::string element(const FeatureElement& e)
-{
-    return "{ origin = " + vec(e.origin) + ", axes = [" + vec(e.xAxis) + ", " + vec(e.yAxis) +
-           "], scale = " + vec(e.scale) + " }";
-}
-
-std::vector<std::string> pairLines(const FeaturePairSpec& pair)
-{
-    return {std::string("type = \"") + toString(pair.type) + "\"",
-            "source = " + element(pair.source), "target = " + element(pair.target)};
-}
-
 int runSuggest(const PairsArgs& args)
 {
     // One read: the scene parsed from the very text the new file is written from.
@@ -73,9 +43,9 @@ int runSuggest(const PairsArgs& args)
     const PairSuggestion suggestion = suggestPairs(volumes.source, volumes.target);
     std::string printed;
     for (const FeaturePairSpec& pair : suggestion.pairs) {
-        document.appendPair(pairLines(pair), {kSuggested});
+        document.appendPair(pairTableLines(pair), {kSuggested});
         printed += std::string("\n# ") + kSuggested + "\n[[pair]]\n";
-        for (const std::string& line : pairLines(pair)) printed += line + "\n";
+        for (const std::string& line : pairTableLines(pair)) printed += line + "\n";
     }
     if (args.output.empty()) {
         std::printf("%s", printed.c_str() + 1);

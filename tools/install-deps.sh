@@ -8,7 +8,12 @@ PACKAGES="build-essential cmake ninja-build pkg-config ccache
 libopenvdb-dev libboost-iostreams-dev libembree-dev libopenimageio-dev openimageio-tools
 libopenexr-dev libtbb-dev libassimp-dev libtomlplusplus-dev libcli11-dev libnifti2-dev
 libeigen3-dev libgtest-dev libgmock-dev libbenchmark-dev libopenvdb-tools python3-openvdb
+nlohmann-json3-dev libcpp-httplib-dev chromium curl
 fonts-dejavu-core clang libclang-rt-14-dev clang-tidy clang-format"
+
+# The editor's page and its browser tests come from npm (tools/editor/web): Node.js and npm from
+# Debian unless the machine has them already.
+if ! command -v npm >/dev/null 2>&1; then PACKAGES="$PACKAGES nodejs npm"; fi
 
 missing=""
 for p in $PACKAGES; do
@@ -19,7 +24,18 @@ for p in $PACKAGES; do
     esac
 done
 
+# three.js (the page) and playwright-core (its tests, driving Debian's chromium) at the versions
+# package-lock.json pins; again only when they are missing or the lock file changed.
+npm_modules() {
+    web=$(dirname "$0")/editor/web
+    stamp=$web/node_modules/.package-lock.json
+    if [ -f "$stamp" ] && [ ! "$web/package-lock.json" -nt "$stamp" ]; then return 0; fi
+    echo "volmorph: installing the editor's npm packages (tools/editor/web)" >&2
+    (cd "$web" && npm ci --no-audit --no-fund --loglevel=error >/dev/null)
+}
+
 if [ -z "$missing" ]; then
+    npm_modules
     exit 0
 fi
 
@@ -35,3 +51,4 @@ export DEBIAN_FRONTEND=noninteractive
 apt-get update -qq
 # shellcheck disable=SC2086
 apt-get install -y -qq --no-install-recommends $missing >/dev/null
+npm_modules

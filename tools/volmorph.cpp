@@ -14,11 +14,11 @@ int main(int argc, char** argv)
     app.set_version_flag("--version", std::string("volmorph ") + volmorph::versionString());
     app.require_subcommand(1);
     app.option_defaults()->always_capture_default(); // every --help shows each default
-    const std::vector<Command> commands = {addCheckCommand(app),  addVoxelizeCommand(app),
-                                           addMorphCommand(app),  addRenderVdbCommand(app),
-                                           addRenderCommand(app), addDiffCommand(app),
-                                           addCacheCommand(app),  addPreviewCommand(app),
-                                           addFramesCommand(app), addPairsCommand(app)};
+    const std::vector<Command> commands = {
+        addCheckCommand(app),     addVoxelizeCommand(app), addMorphCommand(app),
+        addRenderVdbCommand(app), addRenderCommand(app),   addDiffCommand(app),
+        addCacheCommand(app),     addPreviewCommand(app),  addFramesCommand(app),
+        addPairsCommand(app),     addEditCommand(app)};
 
     try {
         app.parse(argc, argv);

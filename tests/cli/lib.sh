@@ -18,3 +18,43 @@ volume_scene() {
     printf '[source]\nvolume = "%s"\n[target]\nmesh = "%s"\ntransform = { translate = [3, 0, 0] }\n%s\n' \
         "$1" "$src/tests/data/meshes/cube.obj" "${2:-}" >"$out/scene.toml"
 }
+
+# start_editor SCENE [ARGS]: runs `volmorph edit SCENE ARGS` in the background with its stdout in
+# $out/edit.out and stderr in $out/edit.err; sets editor_pid, url (the first line it prints), base
+# (http://127.0.0.1:PORT) and token. Fails if no URL comes within 300 s (a sanitizer build
+# voxelizes slowly).
+start_editor() {
+    scene=$1
+    shift
+    "$volmorph" edit "$scene" "$@" >"$out/edit.out" 2>"$out/edit.err" &
+    editor_pid=$!
+    i=0
+    while [ ! -s "$out/edit.out" ]; do
+        kill -0 "$editor_pid" 2>/dev/null || { echo "volmorph edit exited:"; cat "$out/edit.err"; exit 1; }
+        i=$((i + 1))
+        [ $i -lt 3000 ] || { echo "volmorph edit printed no URL"; exit 1; }
+        sleep 0.1
+    done
+    url=$(head -n 1 "$out/edit.out")
+    base=${url%%/?token=*}
+    token=${url##*token=}
+}
+
+# stop_editor LIMIT: SIGINT to the editor, which must exit 0 within LIMIT seconds.
+stop_editor() {
+    kill -INT "$editor_pid"
+    tenths=$(($1 * 10))
+    i=0
+    while kill -0 "$editor_pid" 2>/dev/null; do
+        i=$((i + 1))
+        [ $i -le "$tenths" ] || { echo "volmorph edit still running $1 s after SIGINT"; kill -9 "$editor_pid"; exit 1; }
+        sleep 0.1
+    done
+    wait "$editor_pid" || { echo "volmorph edit exited $? on SIGINT"; cat "$out/edit.err"; exit 1; }
+}
+
+# default_scene DEST: the default scene with its paths made absolute.
+default_scene() {
+    sed -e "s|\"meshes/|\"$src/scenes/meshes/|" -e "s|\"skies/|\"$src/scenes/skies/|" \
+        "$src/scenes/bunny-to-knot.toml" >"$1"
+}

@@ -11,6 +11,8 @@
 
 namespace volmorph {
 
+struct FeaturePairSpec;
+
 class SceneDocument {
 public:
     /// Reads `path`; throws UserError (file:line:col) when it is not TOML.
@@ -42,6 +44,16 @@ public:
     /// The number of [[pair]] tables.
     int pairCount() const;
 
+    /// Where a [[pair]] is written, in lines from 1: its header to its last line, and the lines
+    /// its `source` and `target` values span (0, 0 when absent). For placing a validator's error
+    /// at the element it concerns.
+    struct PairLines {
+        int header = 0, last = 0;
+        int sourceFirst = 0, sourceLast = 0, targetFirst = 0, targetLast = 0;
+    };
+    /// Every [[pair]]'s lines, in order.
+    std::vector<PairLines> pairLines() const;
+
     /// Writes the text to `path` atomically: the file is replaced whole or not at all.
     void save(const std::filesystem::path& path) const;
 
@@ -56,5 +68,13 @@ std::string tomlNumber(double value);
 
 /// "[a, b, c]" of tomlNumber's.
 std::string tomlArray(const std::vector<double>& values);
+
+/// A number to 1e-4 (a tenth of a millimetre at metre scale), as TOML: "0.25", "-0.0012", "3.0".
+std::string tomlRounded(double value);
+
+/// A [[pair]] table's lines as the scenes write theirs: `type = "box"`, then `source = { origin =
+/// [...], axes = [[...], [...]], scale = [...] }` and `target = ...`, numbers to 1e-4
+/// (tomlRounded). A point whose frame is the identity and whose scale is 1 writes its origin alone.
+std::vector<std::string> pairTableLines(const FeaturePairSpec& pair);
 
 } // namespace volmorph

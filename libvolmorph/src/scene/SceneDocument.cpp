@@ -1,5 +1,7 @@
 #include <volmorph/SceneDocument.h>
 
+#include <volmorph/Scene.h>
+
 #include <volmorph/core/AtomicFile.h>
 #include <volmorph/core/Diagnostics.h>
 
@@ -8,6 +10,8 @@
 #include <algorithm>
 #include <cctype>
 #include <charconv>
+#include <cmath>
+#include <cstdio>
 #include <fstream>
 #include <sstream>
 #include <stdexcept>
@@ -237,6 +241,27 @@ int SceneDocument::pairCount() const
     return pairs ? int(pairs->size()) : 0;
 }
 
+std::vector<SceneDocument::PairLines> SceneDocument::pairLines() const
+{
+    const toml::table root = parseText(mText, mPath);
+    std::vector<PairLines> lines;
+    const toml::array* pairs = pairsOf(root);
+    if (!pairs) return lines;
+    for (const toml::node& node : *pairs) {
+        PairLines p;
+        p.header = int(node.source().begin.line);
+        p.last = int(lastLine(node));
+        if (const toml::table* t = node.as_table()) {
+            if (const toml::node* n = t->get("source"))
+                p.sourceFirst = int(n->source().begin.line), p.sourceLast = int(lastLine(*n));
+            if (const toml::node* n = t->get("target"))
+                p.targetFirst = int(n->source().begin.line), p.targetLast = int(lastLine(*n));
+        }
+        lines.push_back(p);
+    }
+    return lines;
+}
+
 void SceneDocument::save(const std::filesystem::path& path) const
 {
     writeAtomically(path, [this](const std::filesystem::path& temporary) {
@@ -261,6 +286,41 @@ std::string tomlArray(const std::vector<double>& values)
     std::string text = "[";
     for (size_t i = 0; i < values.size(); ++i) text += (i ? ", " : "") + tomlNumber(values[i]);
     return text + "]";
+}
+
+std::string tomlRounded(double value)
+{
+    char text[64];
+    std::snprintf(text, sizeof text, "%.4f", std::round(value * 1e4) / 1e4 + 0.0);
+    std::string s(text);
+    while (s.size() > 1 && s.back() == '0' && s[s.size() - 2] != '.') s.pop_back();
+    return s == "-0.0" ? "0.0" : s;
+}
+
+namespace {
+
+std::string roundedVec(const Vec3d& v)
+{
+    return "[" + tomlRounded(v.x()) + ", " + tomlRounded(v.y()) + ", " + tomlRounded(v.z()) + "]";
+}
+
+std::string elementTable(const FeatureElement& e, FeatureType type)
+{
+    const FeatureElement identity;
+    const bool bare = type == FeatureType::Point && e.xAxis == identity.xAxis &&
+                      e.yAxis == identity.yAxis && e.scale == identity.scale;
+    if (bare) return "{ origin = " + roundedVec(e.origin) + " }";
+    return "{ origin = " + roundedVec(e.origin) + ", axes = [" + roundedVec(e.xAxis) + ", " +
+           roundedVec(e.yAxis) + "], scale = " + roundedVec(e.scale) + " }";
+}
+
+} // namespace
+
+std::vector<std::string> pairTableLines(const FeaturePairSpec& pair)
+{
+    return {std::string("type = \"") + toString(pair.type) + "\"",
+            "source = " + elementTable(pair.source, pair.type),
+            "target = " + elementTable(pair.target, pair.type)};
 }
 
 } // namespace volmorph

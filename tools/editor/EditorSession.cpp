@@ -1,0 +1,189 @@
+#include "EditorSession.h"
+
+#include <volmorph/PairSuggest.h>
+#include <volmorph/SceneVolumes.h>
+#include <volmorph/core/Diagnostics.h>
+#include <volmorph/core/Interrupter.h>
+
+#include <openvdb/tools/VolumeToMesh.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <limits>
+
+namespace volmorph::editor {
+namespace {
+
+using nlohmann::json;
+
+const char* const kSuggested = "suggested by volmorph pairs suggest";
+
+template <typename T>
+void put(std::string& out, const T& value)
+{
+    char bytes[sizeof(T)];
+    std::memcpy(bytes, &value, sizeof(T));
+    out.append(bytes, sizeof(T));
+}
+
+Reply error(int status, const std::string& message)
+{
+    return {status, "application/json", json{{"error", message}}.dump()};
+}
+
+Reply stateReply(const EditDocument& document)
+{
+    return {200, "application/json", document.state().dump()};
+}
+
+/// The request's JSON body; an empty body is {}.
+json parseBody(const std::string& body)
+{
+    if (body.empty()) return json::object();
+    json value = json::parse(body, nullptr, false);
+    if (value.is_discarded()) throw BadRequest("malformed JSON");
+    return value;
+}
+
+} // namespace
+
+std::string encodeMesh(const std::vector<openvdb::Vec3s>& points,
+                       const std::vector<openvdb::Vec3I>& triangles,
+                       const std::vector<openvdb::Vec4I>& quads)
+{
+    static_assert(sizeof(float) == 4 && sizeof(uint32_t) == 4, "32-bit floats and indices");
+    openvdb::Vec3s lo(std::numeric_limits<float>::max()), hi(-std::numeric_limits<float>::max());
+    for (const openvdb::Vec3s& p : points) lo = minComponent(lo, p), hi = maxComponent(hi, p);
+    if (points.empty()) lo = hi = openvdb::Vec3s(0.0f);
+    const uint32_t triangleCount = uint32_t(triangles.size() + 2 * quads.size());
+    std::string out = "VMM1";
+    out.reserve(32 + points.size() * 6 + 4 + size_t(triangleCount) * 12);
+    put(out, uint32_t(points.size()));
+    put(out, triangleCount);
+    for (int i = 0; i < 3; ++i) put(out, lo[i]);
+    for (int i = 0; i < 3; ++i) put(out, hi[i]);
+    for (const openvdb::Vec3s& p : points)
+        for (int i = 0; i < 3; ++i) {
+            const float extent = hi[i] - lo[i];
+            const float u = extent > 0.0f ? (p[i] - lo[i]) / extent : 0.0f;
+            put(out, uint16_t(std::lround(std::clamp(u, 0.0f, 1.0f) * 65535.0f)));
+        }
+    while (out.size() % 4) out.push_back('\0');
+    // volumeToMesh winds its faces the other way from three.js's front faces.
+    for (const openvdb::Vec3I& t : triangles) put(out, t[0]), put(out, t[2]), put(out, t[1]);
+    for (const openvdb::Vec4I& q : quads) {
+        put(out, q[0]), put(out, q[2]), put(out, q[1]);
+        put(out, q[0]), put(out, q[3]), put(out, q[2]);
+    }
+    return out;
+}
+
+std::string surfaceOf(const VolumeSet& volumes)
+{
+    std::vector<openvdb::Vec3s> points;
+    std::vector<openvdb::Vec3I> triangles;
+    std::vector<openvdb::Vec4I> quads;
+    if (volumes.sdf)
+        openvdb::tools::volumeToMesh(*volumes.sdf, points, triangles, quads, 0.0, 0.0);
+    else if (volumes.density)
+        openvdb::tools::volumeToMesh(*volumes.density, points, triangles, quads, 0.5, 0.0);
+    return encodeMesh(points, triangles, quads);
+}
+
+EditorSession::EditorSession(const std::filesystem::path& scene, int resolution,
+                             Interrupter* interrupter)
+    : mDocument(scene)
+{
+    Scene preview = mDocument.scene();
+    preview.volume.voxelSize.reset();
+    preview.volume.resolution = resolution;
+    SceneVolumes volumes = voxelizeScene(preview, interrupter);
+    mSource = std::move(volumes.source);
+    mTarget = std::move(volumes.target);
+    mSourceMesh = surfaceOf(mSource);
+    mTargetMesh = surfaceOf(mTarget);
+}
+
+EditorSession::~EditorSession() = default;
+
+const Morpher& EditorSession::morpher()
+{
+    const Scene& scene = mDocument.scene();
+    if (!mMorpher)
+        mMorpher.emplace(mSource, mTarget, scene.pairs, scene.warp, scene.blend);
+    else if (mMorpherVersion != mDocument.pairsVersion())
+        mMorpher = mMorpher->withPairs(scene.pairs);
+    mMorpherVersion = mDocument.pairsVersion();
+    return *mMorpher;
+}
+
+Reply EditorSession::mesh(const std::map<std::string, std::string>& query)
+{
+    const auto of = query.find("of");
+    const std::string which = of == query.end() ? "" : of->second;
+    if (which == "source" || which == "target")
+        return {200, "application/octet-stream", which == "source" ? mSourceMesh : mTargetMesh};
+    if (which != "morph") throw BadRequest("mesh: expected of=source, target or morph");
+    const auto tText = query.find("t");
+    char* end = nullptr;
+    const double t = tText == query.end() ? 0.5 : std::strtod(tText->second.c_str(), &end);
+    if (tText != query.end() && (end == tText->second.c_str() || *end != '\0'))
+        throw BadRequest("mesh: t is not a number");
+    if (!(t >= 0.0 && t <= 1.0)) throw BadRequest("mesh: t must lie in [0, 1]");
+    if (mMorphVersion != mDocument.pairsVersion() || mMorphT != t || !mMorpher) {
+        mMorphMesh = surfaceOf(morpher().frame(t));
+        mMorphVersion = mDocument.pairsVersion();
+        mMorphT = t;
+    }
+    return {200, "application/octet-stream", mMorphMesh};
+}
+
+Reply EditorSession::route(const std::string& method, const std::string& route,
+                           const std::map<std::string, std::string>& query, const std::string& body)
+{
+    if (route.rfind("/api/", 0) != 0) return error(404, "no such page");
+    const std::string name = route.substr(5);
+    if (method == "GET") {
+        if (name == "state") return stateReply(mDocument);
+        if (name == "mesh") return mesh(query);
+        return error(404, "no such API call: GET " + route.substr(0, 80));
+    }
+    if (method != "POST") return error(405, "only GET and POST");
+    const json request = parseBody(body);
+    if (name == "save") {
+        mDocument.save();
+    } else if (name == "suggest") {
+        mDocument.appendPairs(suggestPairs(mSource, mTarget).pairs, kSuggested);
+    } else if (name == "set" || name == "add" || name == "duplicate" || name == "delete" ||
+               name == "undo" || name == "redo") {
+        mDocument.apply(name, request);
+    } else {
+        return error(404, "no such API call: POST " + route.substr(0, 80));
+    }
+    return stateReply(mDocument);
+}
+
+Reply EditorSession::handle(const std::string& method, const std::string& path,
+                            const std::map<std::string, std::string>& query,
+                            const std::string& body)
+{
+    std::lock_guard<std::mutex> lock(mMutex);
+    try {
+        return route(method, path, query, body);
+    } catch (const BadRequest& e) {
+        return error(400, e.what());
+    } catch (const Conflict& e) {
+        return error(409, e.what());
+    } catch (const UserError& e) {
+        return error(500, e.what()); // the scene's own file could not be written
+    } catch (const std::invalid_argument& e) {
+        return error(400, e.what());
+    } catch (const nlohmann::json::exception& e) {
+        return error(400, std::string("malformed request: ") + e.what());
+    } catch (const std::exception& e) {
+        return error(500, e.what());
+    }
+}
+
+} // namespace volmorph::editor

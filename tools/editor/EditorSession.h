@@ -1,0 +1,84 @@
+// What `volmorph edit` serves, without the HTTP: the scene being edited (EditDocument), its two
+// sides voxelized once at a preview resolution, and a Morpher kept across edits (its blend setup
+// shared through Morpher::withPairs), so that after a drag only the in-between at t and its
+// surface are made anew. handle() answers the page's JSON API; the server (EditorServer.h) adds
+// the token, the size bounds and the page's files.
+//
+// API (every answer JSON but the meshes'; an error is {"error": message} with 400 or 409):
+//   GET  /api/state                       EditDocument::state()
+//   GET  /api/mesh?of=source|target       a side's surface (encodeMesh)
+//   GET  /api/mesh?of=morph&t=T           the in-between's surface at t in [0, 1]
+//   POST /api/set|add|duplicate|delete|undo|redo   an edit (EditDocument::apply); the new state
+//   POST /api/suggest                     `pairs suggest`'s pairs appended; the new state
+//   POST /api/save                        the scene written in place; the new state
+#pragma once
+
+#include "EditDocument.h"
+
+#include <volmorph/Morph.h>
+
+#include <openvdb/openvdb.h>
+
+#include <map>
+#include <memory>
+#include <mutex>
+#include <optional>
+#include <string>
+
+namespace volmorph {
+class Interrupter;
+}
+
+namespace volmorph::editor {
+
+struct Reply {
+    int status = 200;
+    std::string type = "application/json";
+    std::string body;
+};
+
+/// A surface for the page, compact: "VMM1", the vertex and triangle counts (uint32), the bounding
+/// box (6 float32, world units), each vertex's position quantized to uint16 over the box (a
+/// 65535th of it: far below a voxel), zero padding to 4 bytes, then the triangles (3 uint32
+/// each). Little-endian. A quad is two triangles.
+std::string encodeMesh(const std::vector<openvdb::Vec3s>& points,
+                       const std::vector<openvdb::Vec3I>& triangles,
+                       const std::vector<openvdb::Vec4I>& quads);
+
+/// The surface of a side or an in-between: the sdf's zero level set, or the density's 0.5 level
+/// where it has no sdf (a fog volume), by OpenVDB's volumeToMesh; encoded.
+std::string surfaceOf(const VolumeSet& volumes);
+
+class EditorSession {
+public:
+    /// Reads the scene (UserError when it is not valid) and voxelizes both sides at `resolution`
+    /// voxels across (the scene's own voxel size when that is coarser). Stops with Interrupted.
+    EditorSession(const std::filesystem::path& scene, int resolution, Interrupter* interrupter);
+    ~EditorSession();
+
+    /// Answers one API request; `query` holds the URL's parameters. Thread-safe: one request at a
+    /// time. Never throws for what a request holds.
+    Reply handle(const std::string& method, const std::string& route,
+                 const std::map<std::string, std::string>& query, const std::string& body);
+
+    const EditDocument& document() const { return mDocument; }
+
+private:
+    Reply route(const std::string& method, const std::string& route,
+                const std::map<std::string, std::string>& query, const std::string& body);
+    Reply mesh(const std::map<std::string, std::string>& query);
+    const Morpher& morpher();
+
+    std::mutex mMutex;
+    EditDocument mDocument;
+    VolumeSet mSource, mTarget;
+    std::string mSourceMesh, mTargetMesh;
+    std::optional<Morpher> mMorpher;
+    uint64_t mMorpherVersion = 0;
+    /// The last in-between's mesh, by the pairs' version and t.
+    std::string mMorphMesh;
+    uint64_t mMorphVersion = ~uint64_t(0);
+    double mMorphT = -1.0;
+};
+
+} // namespace volmorph::editor
