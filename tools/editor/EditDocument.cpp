@@ -4,7 +4,6 @@
 
 #include <algorithm>
 #include <fstream>
-#include <regex>
 #include <sstream>
 
 namespace volmorph::editor {
@@ -152,20 +151,43 @@ EditDocument::EditDocument(std::filesystem::path scene)
 {
 }
 
+namespace {
+
+/// The pair (from 1) and the field ("type", "origin", "axes" or "scale") a key names:
+/// pair[N].type or pair[N].source|target.origin|axes|scale; false for any other text.
+bool parseKey(const std::string& key, long& pair, std::string& field)
+{
+    const std::string head = "pair[";
+    const size_t close = key.find(']');
+    if (key.size() > 40 || key.compare(0, head.size(), head) != 0 || close == std::string::npos)
+        return false;
+    const std::string digits = key.substr(head.size(), close - head.size());
+    if (digits.empty() || digits.size() > 6 || digits[0] == '0' ||
+        digits.find_first_not_of("0123456789") != std::string::npos)
+        return false;
+    pair = std::stol(digits);
+    const std::string rest = key.substr(close + 1);
+    if (rest == ".type") return field = "type", true;
+    for (const char* side : {".source.", ".target."})
+        for (const char* name : {"origin", "axes", "scale"})
+            if (rest == std::string(side) + name) return field = name, true;
+    return false;
+}
+
+} // namespace
+
 void EditDocument::set(const json& body, SceneDocument& next) const
 {
-    static const std::regex kKey(
-        R"(pair\[([1-9][0-9]{0,5})\]\.(type|(source|target)\.(origin|axes|scale)))");
-    std::smatch m;
     const std::string& key = action(body, "key");
-    if (key.size() > 40 || !std::regex_match(key, m, kKey))
+    long pair = 0;
+    std::string field;
+    if (!parseKey(key, pair, field))
         throw BadRequest("key \"" + key.substr(0, 80) +
                          "\": expected pair[N].type or pair[N].source|target.origin|axes|scale");
-    if (std::stoi(m[1].str()) > next.pairCount())
-        throw BadRequest("no pair " + m[1].str() + " (the scene has " +
+    if (pair > next.pairCount())
+        throw BadRequest("no pair " + std::to_string(pair) + " (the scene has " +
                          std::to_string(next.pairCount()) + ")");
     if (!body.contains("value")) throw BadRequest("expected a \"value\"");
-    const std::string field = m[4].matched ? m[4].str() : m[2].str();
     try {
         next.set(key, tomlValue(field, body["value"]));
     } catch (const std::invalid_argument& e) {

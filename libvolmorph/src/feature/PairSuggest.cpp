@@ -12,6 +12,8 @@ namespace volmorph {
 namespace {
 
 constexpr size_t kMaxPoints = 20000; ///< interior points kept per side (evenly strided)
+/// Spreads (covariance eigenvalues) closer than this share of the largest are taken as equal.
+constexpr double kIsotropic = 0.05;
 constexpr double kTipReach =
     0.15; ///< the farthest a tip pair moves a tip past the box, per diagonal
 
@@ -21,7 +23,13 @@ struct Shape {
     double volume = 0.0; ///< of the interior, world units cubed
     Vec3d centroid{0.0};
     std::array<Vec3d, 3> axes; ///< unit, right-handed, the largest spread first
+    Vec3d spread{0.0};         ///< the covariance's eigenvalues along axes, descending
     Vec3d origin{0.0}, scale{0.0};
+
+    /// Whether two spreads are within kIsotropic of the largest: the axes across them are then
+    /// the shape's by chance (a sphere's, a cylinder's about its axis), not its own.
+    bool alike(int i, int j) const { return spread[i] - spread[j] < kIsotropic * spread[0]; }
+    bool determined() const { return !alike(0, 1) && !alike(1, 2); }
 
     FeatureElement box() const { return FeatureElement{origin, axes[0], axes[1], axes[2], scale}; }
 
@@ -86,6 +94,42 @@ Shape shapeOf(const openvdb::FloatGrid& density, double voxel)
     s.axes[0] = Vec3d(v(0, 2), v(1, 2), v(2, 2)).unit();
     s.axes[1] = Vec3d(v(0, 1), v(1, 1), v(2, 1)).unit();
     s.axes[2] = s.axes[0].cross(s.axes[1]).unit();
+    const Eigen::Vector3d lambda = solver.eigenvalues();
+    s.spread = Vec3d(lambda(2), lambda(1), lambda(0));
+    return s;
+}
+
+/// The unit vector in the plane normal to `n` nearest one of `frame`'s axes (the one whose
+/// projection is longest).
+Vec3d nearestInPlane(const Vec3d& n, const std::array<Vec3d, 3>& frame)
+{
+    Vec3d best(0.0);
+    for (const Vec3d& axis : frame) {
+        const Vec3d p = axis - n * n.dot(axis);
+        if (p.lengthSqr() > best.lengthSqr()) best = p;
+    }
+    return best.unit();
+}
+
+/// Where a's spreads are alike, the axes across them follow `lean` (the other side's, or the
+/// world's) instead of the eigen solver's arbitrary choice: a sphere turned into a cube then
+/// needs no turn.
+void settleAxes(Shape& a, const std::array<Vec3d, 3>& lean)
+{
+    if (a.alike(0, 1) && a.alike(1, 2)) {
+        a.axes = lean;
+    } else if (a.alike(1, 2)) { // the longest axis is the shape's own
+        a.axes[1] = nearestInPlane(a.axes[0], lean);
+        a.axes[2] = a.axes[0].cross(a.axes[1]).unit();
+    } else if (a.alike(0, 1)) { // the shortest is
+        a.axes[0] = nearestInPlane(a.axes[2], lean);
+        a.axes[1] = a.axes[2].cross(a.axes[0]).unit();
+    }
+}
+
+/// The box spanning the shape's interior points along its axes.
+void fitBox(Shape& s, double voxel)
+{
     Vec3d lo(1e300), hi(-1e300);
     for (const Vec3d& p : s.inside)
         for (int i = 0; i < 3; ++i) {
@@ -98,7 +142,6 @@ Shape shapeOf(const openvdb::FloatGrid& density, double voxel)
         s.origin += s.axes[i] * (0.5 * (lo[i] + hi[i]));
         s.scale[i] = std::max(hi[i] - lo[i] + voxel, voxel); // voxel centres: half a voxel out
     }
-    return s;
 }
 
 /// The box pair's affine map from `from` to `to`.
@@ -205,7 +248,14 @@ std::vector<FeaturePairSpec> tipPairs(const Shape& source, const FeatureElement&
 PairSuggestion suggestPairs(const VolumeSet& source, const VolumeSet& target)
 {
     const double voxel = source.density->voxelSize()[0];
-    const Shape s = shapeOf(*source.density, voxel), t = shapeOf(*target.density, voxel);
+    Shape s = shapeOf(*source.density, voxel), t = shapeOf(*target.density, voxel);
+    const std::array<Vec3d, 3> world = {Vec3d(1, 0, 0), Vec3d(0, 1, 0), Vec3d(0, 0, 1)};
+    const std::array<Vec3d, 3> sourceLean = t.determined() ? t.axes : world;
+    const std::array<Vec3d, 3> targetLean = s.determined() ? s.axes : world;
+    settleAxes(s, sourceLean);
+    settleAxes(t, targetLean);
+    fitBox(s, voxel);
+    fitBox(t, voxel);
     PairSuggestion out;
     FeaturePairSpec box;
     box.type = FeatureType::Box;
