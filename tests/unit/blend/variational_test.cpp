@@ -1,0 +1,183 @@
+// The variational implicit function (blend/variational/, issue 40) against what it must be: the
+// dense solve passes through its constraints and reproduces a linear function exactly, its
+// gradient is the derivative of its values, a sphere's constraints at t = 0 and t = 1 give that
+// sphere at every t between, a sphere into a larger concentric one grows monotonically, and the
+// constraints cover the surface evenly, on it, their partners inside.
+#include "blend/variational/Constraints.h"
+#include "blend/variational/Interpolant.h"
+
+#include <gtest/gtest.h>
+#include <openvdb/tools/LevelSetSphere.h>
+
+#include <random>
+
+using namespace volmorph::detail::variational;
+
+namespace {
+
+openvdb::FloatGrid::Ptr sphere(double radius, double voxel)
+{
+    openvdb::initialize();
+    return openvdb::tools::createLevelSetSphere<openvdb::FloatGrid>(
+        float(radius), openvdb::Vec3f(0.0f), float(voxel), 3.0f);
+}
+
+/// The zero of f along the ray from the origin in `direction` at fourth coordinate w, by bisection
+/// over [0, reach] (f > 0 inside).
+double radiusAlong(const Interpolant& f, const Eigen::Vector3d& direction, double w, double reach)
+{
+    double lo = 0.0, hi = reach;
+    for (int i = 0; i < 60; ++i) {
+        const double mid = 0.5 * (lo + hi);
+        const Eigen::Vector3d p = mid * direction;
+        (f(Point4(p.x(), p.y(), p.z(), w)) > 0.0 ? lo : hi) = mid;
+    }
+    return 0.5 * (lo + hi);
+}
+
+std::vector<Eigen::Vector3d> directions(int n)
+{
+    std::mt19937 rng(7);
+    std::normal_distribution<double> normal;
+    std::vector<Eigen::Vector3d> d;
+    for (int i = 0; i < n; ++i)
+        d.push_back(Eigen::Vector3d(normal(rng), normal(rng), normal(rng)).normalized());
+    return d;
+}
+
+} // namespace
+
+TEST(Variational, DenseSolvePassesThroughItsConstraints)
+{
+    std::mt19937 rng(3);
+    std::uniform_real_distribution<double> u(-1.0, 1.0);
+    std::vector<Constraint> c;
+    for (int i = 0; i < 300; ++i) c.push_back({Point4(u(rng), u(rng), u(rng), u(rng)), u(rng)});
+    const Interpolant f = Interpolant::solveDense(c);
+    double worst = 0.0;
+    for (const Constraint& k : c) worst = std::max(worst, std::abs(f(k.point) - k.value));
+    EXPECT_LT(worst, 1e-9);
+    // The side conditions: the weights sum to zero and have no first moment.
+    EXPECT_NEAR(f.weights().sum(), 0.0, 1e-9);
+}
+
+TEST(Variational, ALinearFunctionIsReproducedEverywhere)
+{
+    std::mt19937 rng(5);
+    std::uniform_real_distribution<double> u(-1.0, 1.0);
+    const Point4 slope(0.3, -1.2, 0.7, 2.0);
+    std::vector<Constraint> c;
+    for (int i = 0; i < 100; ++i) {
+        const Point4 p(u(rng), u(rng), u(rng), u(rng));
+        c.push_back({p, 0.25 + slope.dot(p)});
+    }
+    const Interpolant f = Interpolant::solveDense(c);
+    for (int i = 0; i < 50; ++i) {
+        const Point4 p(2 * u(rng), 2 * u(rng), 2 * u(rng), 2 * u(rng));
+        EXPECT_NEAR(f(p), 0.25 + slope.dot(p), 1e-8);
+        EXPECT_LT((f.gradient(p) - slope).norm(), 1e-7);
+    }
+}
+
+TEST(Variational, GradientIsTheDerivative)
+{
+    std::mt19937 rng(11);
+    std::uniform_real_distribution<double> u(-1.0, 1.0);
+    std::vector<Constraint> c;
+    for (int i = 0; i < 80; ++i) c.push_back({Point4(u(rng), u(rng), u(rng), u(rng)), u(rng)});
+    const Interpolant f = Interpolant::solveDense(c);
+    const double h = 1e-5;
+    for (int i = 0; i < 20; ++i) {
+        const Point4 p(u(rng), u(rng), u(rng), u(rng));
+        const Point4 g = f.gradient(p);
+        for (int k = 0; k < 4; ++k) {
+            Point4 a = p, b = p;
+            a[k] -= h, b[k] += h;
+            EXPECT_NEAR(g[k], (f(b) - f(a)) / (2 * h), 1e-5 * (1.0 + std::abs(g[k])));
+        }
+    }
+}
+
+TEST(Variational, ConstraintsLieOnTheSurfaceEvenly)
+{
+    const double voxel = 0.02, radius = 0.5;
+    const auto grid = sphere(radius, voxel);
+    const std::vector<Constraint> c = sampleConstraints(*grid, 500, 1.0 * voxel, 0.25);
+    ASSERT_GE(c.size(), 2 * 450u);
+    ASSERT_LE(c.size(), 2 * 500u);
+    double nearest = 1e9, farthest = 0.0;
+    for (size_t i = 0; i < c.size(); i += 2) {
+        EXPECT_NEAR(c[i].point.head<3>().norm(), radius, 0.05 * voxel);
+        EXPECT_NEAR(c[i + 1].point.head<3>().norm(), radius - voxel, 0.05 * voxel);
+        EXPECT_EQ(c[i].value, 0.0);
+        EXPECT_EQ(c[i + 1].value, voxel);
+        EXPECT_EQ(c[i].point[3], 0.25);
+        // Spacing: each point's nearest neighbour.
+        double d = 1e9;
+        for (size_t j = 0; j < c.size(); j += 2)
+            if (j != i) d = std::min(d, (c[i].point - c[j].point).norm());
+        nearest = std::min(nearest, d);
+        farthest = std::max(farthest, d);
+    }
+    // Evenly: 500 points on a sphere of area pi are about 0.079 apart; none crowded, no gap.
+    const double spacing = std::sqrt(4.0 * M_PI * radius * radius / double(c.size() / 2));
+    EXPECT_GT(nearest, 0.2 * spacing);
+    EXPECT_LT(farthest, 2.0 * spacing);
+}
+
+// The time axis's scale shapes the in-betweens (the function is smooth across the ends, so
+// far-apart ends bulge between and overshoot past them): with the ends 0.25 world units apart in t,
+// about half a sphere's radius, a sphere into a sphere of twice the radius grows monotonically and
+// one into itself bulges by under 2%; with them 1 apart (two radii) the growth overshoots the end
+// by 0.2% and the bulge is 20% (session 33's probe, BENCHMARKS.md).
+constexpr double kTimeScale = 0.25;
+
+TEST(Variational, ASphereIntoItselfIsSymmetricAndExactAtTheEnds)
+{
+    const double voxel = 0.02, radius = 0.5;
+    const auto grid = sphere(radius, voxel);
+    std::vector<Constraint> c = sampleConstraints(*grid, 300, voxel, 0.0);
+    const std::vector<Constraint> end = sampleConstraints(*grid, 300, voxel, kTimeScale);
+    c.insert(c.end(), end.begin(), end.end());
+    const Interpolant f = Interpolant::solveDense(c);
+    for (const Eigen::Vector3d& d : directions(20)) {
+        EXPECT_NEAR(radiusAlong(f, d, 0.0, 2.0), radius, 0.25 * voxel);
+        EXPECT_NEAR(radiusAlong(f, d, kTimeScale, 2.0), radius, 0.25 * voxel);
+        for (double t : {0.1, 0.3, 0.5}) {
+            const double r = radiusAlong(f, d, t * kTimeScale, 2.0);
+            EXPECT_NEAR(r, radiusAlong(f, d, (1.0 - t) * kTimeScale, 2.0), 1e-6);
+            EXPECT_GE(r, radius - 0.25 * voxel);
+            EXPECT_LT(r, 1.02 * radius);
+        }
+    }
+}
+
+TEST(Variational, ASphereIntoALargerOneGrowsMonotonically)
+{
+    const double voxel = 0.02;
+    std::vector<Constraint> c = sampleConstraints(*sphere(0.3, voxel), 300, voxel, 0.0);
+    const std::vector<Constraint> end =
+        sampleConstraints(*sphere(0.6, voxel), 300, voxel, kTimeScale);
+    c.insert(c.end(), end.begin(), end.end());
+    const Interpolant f = Interpolant::solveDense(c);
+    for (const Eigen::Vector3d& d : directions(20)) {
+        double previous = 0.0;
+        for (int k = 0; k <= 20; ++k) {
+            const double r = radiusAlong(f, d, 0.05 * k * kTimeScale, 2.0);
+            EXPECT_GT(r, previous) << "t = " << 0.05 * k;
+            previous = r;
+        }
+        EXPECT_NEAR(radiusAlong(f, d, 0.0, 2.0), 0.3, 0.25 * voxel);
+        EXPECT_NEAR(radiusAlong(f, d, kTimeScale, 2.0), 0.6, 0.25 * voxel);
+    }
+}
+
+TEST(Variational, ConstraintsInOneHyperplaneAreRefused)
+{
+    // All at w = 0: the polynomial's t coefficient is undetermined.
+    std::vector<Constraint> c;
+    for (int i = 0; i < 20; ++i)
+        c.push_back({Point4(std::cos(i), std::sin(i), 0.1 * i, 0.0), double(i % 3)});
+    EXPECT_THROW(Interpolant::solveDense(c), std::invalid_argument);
+    EXPECT_EQ(denseSolveBytes(995), 2u * 1000u * 1000u * 8u);
+}
