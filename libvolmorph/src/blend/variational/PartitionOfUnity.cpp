@@ -1,0 +1,159 @@
+#include "blend/variational/PartitionOfUnity.h"
+
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <numeric>
+#include <set>
+#include <stdexcept>
+
+namespace volmorph::detail::variational {
+namespace {
+
+double wendland(double d)
+{
+    return d >= 1.0 ? 0.0 : std::pow(1.0 - d, 4) * (4.0 * d + 1.0);
+}
+
+Eigen::Vector3d spatial(const Point4& p)
+{
+    return p.head<3>();
+}
+
+/// Lattice cells (of size h) holding at least one constraint.
+size_t occupiedCells(const std::vector<Constraint>& constraints, const Eigen::Vector3d& lo,
+                     double h)
+{
+    std::set<std::array<long, 3>> cells;
+    for (const Constraint& c : constraints) {
+        const Eigen::Vector3d u = (spatial(c.point) - lo) / h;
+        cells.insert({long(std::floor(u.x())), long(std::floor(u.y())), long(std::floor(u.z()))});
+    }
+    return cells.size();
+}
+
+/// The ball around `centre`: its radius (at least `least`, and enough to hold `perPatch`
+/// constraints) and the constraints its fit uses: those inside it and, when they all lie at one
+/// time, the nearest perPatch / 4 of other times too (the fit's t must be determined; the ball is
+/// not grown to reach them, which made balls near one shape hold thousands of the other's).
+std::pair<double, std::vector<size_t>> ball(const std::vector<Constraint>& constraints,
+                                            const Eigen::Vector3d& centre, size_t perPatch,
+                                            double least)
+{
+    std::vector<std::pair<double, size_t>> byDistance(constraints.size());
+    for (size_t i = 0; i < constraints.size(); ++i)
+        byDistance[i] = {(spatial(constraints[i].point) - centre).norm(), i};
+    std::sort(byDistance.begin(), byDistance.end());
+    const size_t count = std::min(perPatch, byDistance.size());
+    const double radius = std::max(least, byDistance[count - 1].first) * (1.0 + 1e-9);
+    std::vector<size_t> members;
+    const double firstTime = constraints[byDistance.front().second].point[3];
+    bool oneTime = true;
+    for (const auto& [d, i] : byDistance) {
+        if (d > radius) break;
+        members.push_back(i);
+        oneTime = oneTime && constraints[i].point[3] == firstTime;
+    }
+    if (oneTime) {
+        size_t others = 0;
+        for (const auto& [d, i] : byDistance)
+            if (constraints[i].point[3] != firstTime) {
+                members.push_back(i);
+                if (++others >= perPatch / 4) break;
+            }
+    }
+    return {radius, members};
+}
+
+} // namespace
+
+namespace {
+
+/// An even subset for the coarse level: every stride-th pair of constraints (sampleConstraints
+/// writes each surface point followed by its inward partner), about `count` in all.
+std::vector<Constraint> coarseSubset(const std::vector<Constraint>& constraints, size_t count)
+{
+    const size_t stride = (constraints.size() + count - 1) / count;
+    std::vector<Constraint> subset;
+    for (size_t i = 0; i < constraints.size(); ++i)
+        if ((i / 2) % stride == 0) subset.push_back(constraints[i]);
+    return subset;
+}
+
+} // namespace
+
+PartitionOfUnity PartitionOfUnity::solve(const std::vector<Constraint>& constraints,
+                                         const PartitionOptions& options)
+{
+    PartitionOfUnity pu;
+    if (constraints.size() <= options.coarse) {
+        pu.mCoarse = Interpolant::solveDense(constraints); // exact: no local level
+        return pu;
+    }
+    pu.mCoarse = Interpolant::solveDense(coarseSubset(constraints, options.coarse));
+    std::vector<Constraint> residual = constraints;
+    for (Constraint& c : residual) c.value -= pu.mCoarse(c.point);
+
+    Eigen::Vector3d lo = spatial(residual.front().point), hi = lo;
+    for (const Constraint& c : residual) {
+        lo = lo.cwiseMin(spatial(c.point));
+        hi = hi.cwiseMax(spatial(c.point));
+    }
+    // A lattice whose occupied cells hold about a third of a ball's constraints each.
+    const size_t wanted = std::max<size_t>(1, 3 * residual.size() / options.perPatch);
+    double h = (hi - lo).maxCoeff();
+    for (int round = 0; round < 40 && occupiedCells(residual, lo, h) < wanted; ++round) h *= 0.8;
+    pu.mLo = lo - Eigen::Vector3d::Constant(h);
+    pu.mCell = h;
+    pu.mCells = ((hi - pu.mLo) / h).array().ceil().cast<int>() + 1;
+    const double least = options.overlap * 0.5 * std::sqrt(3.0) * h;
+    pu.mPatches.resize(size_t(pu.mCells.prod()));
+    tbb::parallel_for(size_t(0), pu.mPatches.size(), [&](size_t n) {
+        const int k = int(n % size_t(pu.mCells.z())),
+                  j = int(n / size_t(pu.mCells.z())) % pu.mCells.y(),
+                  i = int(n / size_t(pu.mCells.z() * pu.mCells.y()));
+        const Eigen::Vector3d centre = pu.mLo + h * Eigen::Vector3d(i + 0.5, j + 0.5, k + 0.5);
+        auto [radius, members] = ball(residual, centre, options.perPatch, least);
+        std::vector<Constraint> local;
+        local.reserve(members.size());
+        for (size_t m : members) local.push_back(residual[m]);
+        pu.mPatches[n] = Patch{centre, radius, Interpolant::solveDense(local)};
+    });
+    for (const Patch& p : pu.mPatches) pu.mMaxRadius = std::max(pu.mMaxRadius, p.radius);
+    return pu;
+}
+
+double PartitionOfUnity::local(const Point4& x) const
+{
+    const Eigen::Vector3d p = spatial(x);
+    const Eigen::Array3d u = (p - mLo).array() / mCell;
+    const double reach = mMaxRadius / mCell;
+    Eigen::Array3i first, last;
+    for (int a = 0; a < 3; ++a) {
+        first[a] = std::clamp(int(std::floor(u[a] - reach)), 0, mCells[a] - 1);
+        last[a] = std::clamp(int(std::floor(u[a] + reach)), 0, mCells[a] - 1);
+    }
+    double sum = 0.0, weights = 0.0;
+    for (int i = first.x(); i <= last.x(); ++i)
+        for (int j = first.y(); j <= last.y(); ++j)
+            for (int k = first.z(); k <= last.z(); ++k) {
+                const Patch& patch = mPatches[size_t((i * mCells.y() + j) * mCells.z() + k)];
+                const double w = wendland((p - patch.centre).norm() / patch.radius);
+                if (w <= 0.0) continue;
+                sum += w * patch.f(x);
+                weights += w;
+            }
+    if (weights > 0.0) return sum / weights;
+    // Beyond every ball: the nearest lattice patch's fit, extended.
+    const Eigen::Array3i c = u.floor().cast<int>().max(0).min(mCells - 1);
+    return mPatches[size_t((c.x() * mCells.y() + c.y()) * mCells.z() + c.z())].f(x);
+}
+
+double PartitionOfUnity::operator()(const Point4& x) const
+{
+    return mCoarse(x) + (mPatches.empty() ? 0.0 : local(x));
+}
+
+} // namespace volmorph::detail::variational
