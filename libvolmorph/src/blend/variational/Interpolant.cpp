@@ -51,31 +51,27 @@ Interpolant Interpolant::solveDense(const std::vector<Constraint>& constraints)
 
 Interpolant::Interpolant(std::vector<Point4> centres, Eigen::VectorXd weights,
                          Eigen::Matrix<double, 5, 1> polynomial)
-    : mCentres(std::move(centres)), mWeights(std::move(weights)), mPolynomial(polynomial)
+    : mCentres(4, Eigen::Index(centres.size())), mWeights(std::move(weights)),
+      mPolynomial(polynomial)
 {
-    if (Eigen::Index(mCentres.size()) != mWeights.size())
+    if (Eigen::Index(centres.size()) != mWeights.size())
         throw std::invalid_argument("an interpolant needs one weight per centre");
+    for (size_t j = 0; j < centres.size(); ++j) mCentres.col(Eigen::Index(j)) = centres[j].array();
 }
 
 double Interpolant::operator()(const Point4& x) const
 {
-    double f = mPolynomial[0] + mPolynomial.tail<4>().dot(x);
-    for (size_t j = 0; j < mCentres.size(); ++j) {
-        const double r = (x - mCentres[j]).norm();
-        f += mWeights[Eigen::Index(j)] * r * r * r;
-    }
-    return f;
+    const Eigen::ArrayXd r = (mCentres.colwise() - x.array()).square().colwise().sum().sqrt();
+    return mPolynomial[0] + mPolynomial.tail<4>().dot(x) + (mWeights.array() * r.cube()).sum();
 }
 
 Point4 Interpolant::gradient(const Point4& x) const
 {
     // d(r^3)/dx = 3 r (x - c): smooth, zero at the centre.
-    Point4 g = mPolynomial.tail<4>();
-    for (size_t j = 0; j < mCentres.size(); ++j) {
-        const Point4 d = x - mCentres[j];
-        g += (3.0 * mWeights[Eigen::Index(j)] * d.norm()) * d;
-    }
-    return g;
+    const Eigen::Array<double, 4, Eigen::Dynamic> d = mCentres.colwise() - x.array();
+    const Eigen::ArrayXd scale =
+        3.0 * mWeights.array() * d.square().colwise().sum().sqrt().transpose();
+    return mPolynomial.tail<4>() - (d.rowwise() * scale.transpose()).rowwise().sum().matrix();
 }
 
 } // namespace volmorph::detail::variational

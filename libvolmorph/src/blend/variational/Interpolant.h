@@ -51,13 +51,13 @@ public:
     /// (df/dx, df/dy, df/dz, df/dt'), t' = t * time_scale.
     Point4 gradient(const Point4& x) const;
 
-    size_t size() const { return mCentres.size(); }
-    const std::vector<Point4>& centres() const { return mCentres; }
+    size_t size() const { return size_t(mWeights.size()); }
     const Eigen::VectorXd& weights() const { return mWeights; }
     const Eigen::Matrix<double, 5, 1>& polynomial() const { return mPolynomial; }
 
 private:
-    std::vector<Point4> mCentres;
+    /// The centres by coordinate (x, y, z, t' in rows): the sums over them run as Eigen's packets.
+    Eigen::Array<double, 4, Eigen::Dynamic> mCentres;
     Eigen::VectorXd mWeights;
     Eigen::Matrix<double, 5, 1> mPolynomial = Eigen::Matrix<double, 5, 1>::Zero();
 };
