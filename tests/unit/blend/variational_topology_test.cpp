@@ -138,3 +138,48 @@ TEST(VariationalTopology, ASphereIntoATorusOpensItsHoleOnce)
     EXPECT_EQ(previous, 0);
     EXPECT_EQ(changes, 1);
 }
+
+// The slice near its zero set from exact values every 2 voxels, tricubic between (sliceNearZero),
+// against the slice evaluated at every voxel: every voxel within 1.5 voxels of the zero set is
+// there, and its value is the exact one to 0.1 voxel (of the distance the local slope gives:
+// measured 0.0016 at t = 0.5 and 0.0084 at 0.8, just after the split; every 4 voxels gave 0.026
+// and 0.15, trilinear 0.14 and 0.95), from an eighth of the evaluations.
+TEST(VariationalTopology, TheSliceNearItsZeroSetFromACoarseLatticeIsTheExactOne)
+{
+    auto two = sphere(0.25, -0.35);
+    openvdb::tools::csgUnion(*two, *sphere(0.25, 0.35));
+    const Interpolant f = morph(*sphere(0.3), *two);
+    const auto fn = [&](const Point4& p) { return f(p); };
+    const auto transform = openvdb::math::Transform::createLinearTransform(kVoxel);
+    const openvdb::CoordBBox box(openvdb::Coord(-36), openvdb::Coord(36));
+    for (double t : {0.5, 0.8}) {
+        const auto exact = sliceOverBox(fn, t * kTimeScale, transform, box);
+        size_t evaluations = 0;
+        const auto near = sliceNearZero(fn, t * kTimeScale, transform, box, 2, 1.5, &evaluations);
+        auto e = exact->getConstAccessor();
+        auto n = near->getConstAccessor();
+        double worst = 0.0;
+        size_t checked = 0;
+        for (auto it = exact->cbeginValueOn(); it; ++it) {
+            const openvdb::Coord c = it.getCoord();
+            if (!box.isInside(c.offsetBy(-1)) || !box.isInside(c.offsetBy(1))) continue;
+            const double slope =
+                openvdb::Vec3d(e.getValue(c.offsetBy(1, 0, 0)) - e.getValue(c.offsetBy(-1, 0, 0)),
+                               e.getValue(c.offsetBy(0, 1, 0)) - e.getValue(c.offsetBy(0, -1, 0)),
+                               e.getValue(c.offsetBy(0, 0, 1)) - e.getValue(c.offsetBy(0, 0, -1)))
+                    .length() /
+                2.0; // per voxel
+            if (std::abs(*it) > 1.5 * slope) continue;
+            ASSERT_TRUE(n.isValueOn(c)) << "t = " << t << " " << c;
+            worst = std::max(worst, std::abs(double(n.getValue(c)) - *it) / slope);
+            ++checked;
+        }
+        std::printf("t %.1f: %zu voxels near the zero set, within %.4f voxel; %zu exact values "
+                    "(the box has %llu voxels), %llu kept\n",
+                    t, checked, worst, evaluations, (unsigned long long)box.volume(),
+                    (unsigned long long)near->activeVoxelCount());
+        EXPECT_GT(checked, 1000u);
+        EXPECT_LT(worst, 0.1);
+        EXPECT_LT(evaluations * 7, size_t(box.volume()));
+    }
+}

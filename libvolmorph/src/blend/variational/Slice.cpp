@@ -5,6 +5,7 @@
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 
 namespace volmorph::detail::variational {
@@ -31,6 +32,128 @@ openvdb::FloatGrid::Ptr sliceOverBox(const std::function<double(const Point4&)>&
     // copyFromDense makes voxels equal to the background inactive: every voxel of the box counts.
     grid->tree().voxelizeActiveTiles();
     for (auto it = grid->tree().beginLeaf(); it; ++it) it->setValuesOn();
+    grid->setTransform(transform);
+    grid->setGridClass(openvdb::GRID_LEVEL_SET);
+    return grid;
+}
+
+namespace {
+
+/// Exact values on the lattice box.min + stride * (a, b, c), covering the box.
+struct Lattice {
+    openvdb::Coord origin;
+    int stride = 1;
+    openvdb::Coord nodes; ///< per axis
+    std::vector<float> values;
+
+    float at(int a, int b, int c) const
+    {
+        return values[(size_t(a) * nodes.y() + b) * nodes.z() + c];
+    }
+
+    /// Catmull-Rom between the nodes around cell (a, b, c) at (u, v, s) in [0, 1)^3 (nodes
+    /// beyond the lattice clamped to its edge): exact for cubics along each axis, its error the
+    /// function's fourth derivatives times stride^4.
+    double tricubic(int a, int b, int c, double u, double v, double s) const
+    {
+        const auto weights = [](double x) {
+            return std::array<double, 4>{
+                0.5 * (-x * x * x + 2 * x * x - x), 0.5 * (3 * x * x * x - 5 * x * x + 2),
+                0.5 * (-3 * x * x * x + 4 * x * x + x), 0.5 * (x * x * x - x * x)};
+        };
+        const auto wu = weights(u), wv = weights(v), ws = weights(s);
+        const auto clampTo = [](int i, int n) { return std::clamp(i, 0, n - 1); };
+        double value = 0.0;
+        for (int i = 0; i < 4; ++i)
+            for (int j = 0; j < 4; ++j)
+                for (int k = 0; k < 4; ++k)
+                    value += wu[i] * wv[j] * ws[k] *
+                             at(clampTo(a + i - 1, nodes.x()), clampTo(b + j - 1, nodes.y()),
+                                clampTo(c + k - 1, nodes.z()));
+        return value;
+    }
+};
+
+Lattice evaluateLattice(const std::function<double(const Point4&)>& f, double w,
+                        const openvdb::math::Transform& transform, const openvdb::CoordBBox& box,
+                        int stride)
+{
+    Lattice l;
+    l.origin = box.min();
+    l.stride = stride;
+    const openvdb::Coord dim = box.dim();
+    for (int a = 0; a < 3; ++a) l.nodes[a] = (dim[a] - 1 + stride - 1) / stride + 1;
+    l.values.resize(size_t(l.nodes.x()) * l.nodes.y() * l.nodes.z());
+    tbb::parallel_for(0, l.nodes.x(), [&](int a) {
+        for (int b = 0; b < l.nodes.y(); ++b)
+            for (int c = 0; c < l.nodes.z(); ++c) {
+                const openvdb::Vec3d p = transform.indexToWorld(
+                    l.origin + openvdb::Coord(a * stride, b * stride, c * stride));
+                l.values[(size_t(a) * l.nodes.y() + b) * l.nodes.z() + c] =
+                    float(-f(Point4(p.x(), p.y(), p.z(), w)));
+            }
+    });
+    return l;
+}
+
+/// Whether lattice cell (a, b, c) can hold the zero set within `band` voxels of it.
+bool nearZero(const Lattice& l, int a, int b, int c, double band)
+{
+    float lo = 1e30f, hi = -1e30f, smallest = 1e30f, steepest = 0.0f;
+    for (int corner = 0; corner < 8; ++corner) {
+        const int i = a + (corner >> 2), j = b + ((corner >> 1) & 1), k = c + (corner & 1);
+        const float v = l.at(i, j, k);
+        lo = std::min(lo, v), hi = std::max(hi, v), smallest = std::min(smallest, std::abs(v));
+        if (i > a) steepest = std::max(steepest, std::abs(v - l.at(a, j, k)));
+        if (j > b) steepest = std::max(steepest, std::abs(v - l.at(i, b, k)));
+        if (k > c) steepest = std::max(steepest, std::abs(v - l.at(i, j, c)));
+    }
+    if (lo <= 0.0f && hi >= 0.0f) return true;
+    // The steepest edge's slope per voxel, over the cell's diagonal and the band.
+    const double slope = steepest / double(l.stride);
+    return smallest <= slope * (std::sqrt(3.0) * l.stride + band);
+}
+
+} // namespace
+
+openvdb::FloatGrid::Ptr sliceNearZero(const std::function<double(const Point4&)>& f, double w,
+                                      const openvdb::math::Transform::Ptr& transform,
+                                      const openvdb::CoordBBox& box, int stride, double bandVoxels,
+                                      size_t* evaluations)
+{
+    const Lattice l = evaluateLattice(f, w, *transform, box, stride);
+    if (evaluations) *evaluations = l.values.size();
+    const openvdb::Coord cells = l.nodes - openvdb::Coord(1);
+    std::vector<char> kept(size_t(cells.x()) * cells.y() * cells.z(), 0);
+    const auto index = [&](int a, int b, int c) {
+        return (size_t(a) * cells.y() + b) * cells.z() + c;
+    };
+    for (int a = 0; a < cells.x(); ++a)
+        for (int b = 0; b < cells.y(); ++b)
+            for (int c = 0; c < cells.z(); ++c)
+                if (nearZero(l, a, b, c, bandVoxels)) kept[index(a, b, c)] = 1;
+    auto grid = openvdb::FloatGrid::create(float(bandVoxels * transform->voxelSize()[0]));
+    auto acc = grid->getAccessor();
+    for (int a = 0; a < cells.x(); ++a)
+        for (int b = 0; b < cells.y(); ++b)
+            for (int c = 0; c < cells.z(); ++c) {
+                bool any = false; // the cell or a neighbour kept
+                for (int da = -1; da <= 1 && !any; ++da)
+                    for (int db = -1; db <= 1 && !any; ++db)
+                        for (int dc = -1; dc <= 1 && !any; ++dc) {
+                            const int i = a + da, j = b + db, k = c + dc;
+                            any = i >= 0 && j >= 0 && k >= 0 && i < cells.x() && j < cells.y() &&
+                                  k < cells.z() && kept[index(i, j, k)];
+                        }
+                if (!any) continue;
+                for (int x = 0; x < stride; ++x)
+                    for (int y = 0; y < stride; ++y)
+                        for (int z = 0; z < stride; ++z)
+                            acc.setValue(l.origin + openvdb::Coord(a * stride + x, b * stride + y,
+                                                                   c * stride + z),
+                                         float(l.tricubic(a, b, c, double(x) / stride,
+                                                          double(y) / stride, double(z) / stride)));
+            }
     grid->setTransform(transform);
     grid->setGridClass(openvdb::GRID_LEVEL_SET);
     return grid;

@@ -18,4 +18,17 @@ openvdb::FloatGrid::Ptr sliceOverBox(const std::function<double(const Point4&)>&
                                      const openvdb::math::Transform::Ptr& transform,
                                      const openvdb::CoordBBox& box);
 
+/// The same slice near its zero set only, from exact values on a lattice every `stride` voxels:
+/// a lattice cell is kept when its corners' values change sign, or when the smallest of them is
+/// within `bandVoxels` of zero at the steepest slope between its corners (f grows about as the
+/// distance near the shapes, its normal constraints' values being their offsets); kept cells and
+/// their neighbours get every voxel, tricubic (Catmull-Rom) between the lattice's values: at a
+/// stride of 2, within 0.01 voxel of the exact values on a sphere becoming two (4: 0.15; trilinear
+/// at 2: 0.15, at 4: 0.95). `evaluations` counts the exact values taken (the whole lattice: the
+/// frame's coarse-to-fine screening is still to come).
+openvdb::FloatGrid::Ptr sliceNearZero(const std::function<double(const Point4&)>& f, double w,
+                                      const openvdb::math::Transform::Ptr& transform,
+                                      const openvdb::CoordBBox& box, int stride, double bandVoxels,
+                                      size_t* evaluations = nullptr);
+
 } // namespace volmorph::detail::variational
