@@ -5,6 +5,8 @@
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
+#include <atomic>
+#include <limits>
 #include <array>
 #include <cmath>
 
@@ -74,25 +76,34 @@ struct Lattice {
     }
 };
 
+/// The lattice's values where `needed(a, b, c)` says (NaN elsewhere); `evaluations` counts them.
 Lattice evaluateLattice(const std::function<double(const Point4&)>& f, double w,
                         const openvdb::math::Transform& transform, const openvdb::CoordBBox& box,
-                        int stride)
+                        int stride, const std::function<bool(int, int, int)>& needed,
+                        size_t& evaluations)
 {
     Lattice l;
     l.origin = box.min();
     l.stride = stride;
     const openvdb::Coord dim = box.dim();
     for (int a = 0; a < 3; ++a) l.nodes[a] = (dim[a] - 1 + stride - 1) / stride + 1;
-    l.values.resize(size_t(l.nodes.x()) * l.nodes.y() * l.nodes.z());
+    l.values.assign(size_t(l.nodes.x()) * l.nodes.y() * l.nodes.z(),
+                    std::numeric_limits<float>::quiet_NaN());
+    std::atomic<size_t> count{0};
     tbb::parallel_for(0, l.nodes.x(), [&](int a) {
+        size_t here = 0;
         for (int b = 0; b < l.nodes.y(); ++b)
             for (int c = 0; c < l.nodes.z(); ++c) {
+                if (!needed(a, b, c)) continue;
                 const openvdb::Vec3d p = transform.indexToWorld(
                     l.origin + openvdb::Coord(a * stride, b * stride, c * stride));
                 l.values[(size_t(a) * l.nodes.y() + b) * l.nodes.z() + c] =
                     float(-f(Point4(p.x(), p.y(), p.z(), w)));
+                ++here;
             }
+        count += here;
     });
+    evaluations += count;
     return l;
 }
 
@@ -114,6 +125,27 @@ bool nearZero(const Lattice& l, int a, int b, int c, double band)
     return smallest <= slope * (std::sqrt(3.0) * l.stride + band);
 }
 
+/// Cells of `l` near the zero set (nearZero), grown by `grow` cells each way.
+std::vector<char> cellsNearZero(const Lattice& l, double band, int grow)
+{
+    const openvdb::Coord cells = l.nodes - openvdb::Coord(1);
+    const auto index = [&](int a, int b, int c) {
+        return (size_t(a) * cells.y() + b) * cells.z() + c;
+    };
+    std::vector<char> near(size_t(cells.x()) * cells.y() * cells.z(), 0);
+    for (int a = 0; a < cells.x(); ++a)
+        for (int b = 0; b < cells.y(); ++b)
+            for (int c = 0; c < cells.z(); ++c) {
+                if (!nearZero(l, a, b, c, band)) continue;
+                for (int i = std::max(0, a - grow); i <= std::min(cells.x() - 1, a + grow); ++i)
+                    for (int j = std::max(0, b - grow); j <= std::min(cells.y() - 1, b + grow); ++j)
+                        for (int k = std::max(0, c - grow); k <= std::min(cells.z() - 1, c + grow);
+                             ++k)
+                            near[index(i, j, k)] = 1;
+            }
+    return near;
+}
+
 } // namespace
 
 openvdb::FloatGrid::Ptr sliceNearZero(const std::function<double(const Point4&)>& f, double w,
@@ -121,8 +153,25 @@ openvdb::FloatGrid::Ptr sliceNearZero(const std::function<double(const Point4&)>
                                       const openvdb::CoordBBox& box, int stride, double bandVoxels,
                                       size_t* evaluations)
 {
-    const Lattice l = evaluateLattice(f, w, *transform, box, stride);
-    if (evaluations) *evaluations = l.values.size();
+    // Screening: exact values every 4 strides; the fine lattice only in the coarse cells near the
+    // zero set, grown by two (a fine cell's tricubic reads a node beyond it).
+    const int coarseStride = 4 * stride;
+    size_t count = 0;
+    const Lattice coarse = evaluateLattice(
+        f, w, *transform, box, coarseStride, [](int, int, int) { return true; }, count);
+    const std::vector<char> nodesNear = cellsNearZero(coarse, bandVoxels, 2);
+    const std::vector<char> cellsNear = cellsNearZero(coarse, bandVoxels, 1);
+    const openvdb::Coord coarseCells = coarse.nodes - openvdb::Coord(1);
+    const auto coarseCell = [&](const std::vector<char>& near, int a, int b, int c) {
+        const int i = std::min(a / 4, coarseCells.x() - 1),
+                  j = std::min(b / 4, coarseCells.y() - 1),
+                  k = std::min(c / 4, coarseCells.z() - 1);
+        return bool(near[(size_t(i) * coarseCells.y() + j) * coarseCells.z() + k]);
+    };
+    const Lattice l = evaluateLattice(
+        f, w, *transform, box, stride,
+        [&](int a, int b, int c) { return coarseCell(nodesNear, a, b, c); }, count);
+    if (evaluations) *evaluations = count;
     const openvdb::Coord cells = l.nodes - openvdb::Coord(1);
     std::vector<char> kept(size_t(cells.x()) * cells.y() * cells.z(), 0);
     const auto index = [&](int a, int b, int c) {
@@ -131,7 +180,8 @@ openvdb::FloatGrid::Ptr sliceNearZero(const std::function<double(const Point4&)>
     for (int a = 0; a < cells.x(); ++a)
         for (int b = 0; b < cells.y(); ++b)
             for (int c = 0; c < cells.z(); ++c)
-                if (nearZero(l, a, b, c, bandVoxels)) kept[index(a, b, c)] = 1;
+                if (coarseCell(cellsNear, a, b, c) && nearZero(l, a, b, c, bandVoxels))
+                    kept[index(a, b, c)] = 1;
     auto grid = openvdb::FloatGrid::create(float(bandVoxels * transform->voxelSize()[0]));
     auto acc = grid->getAccessor();
     for (int a = 0; a < cells.x(); ++a)

@@ -24,8 +24,8 @@ openvdb::FloatGrid::Ptr sliceOverBox(const std::function<double(const Point4&)>&
 /// distance near the shapes, its normal constraints' values being their offsets); kept cells and
 /// their neighbours get every voxel, tricubic (Catmull-Rom) between the lattice's values: at a
 /// stride of 2, within 0.01 voxel of the exact values on a sphere becoming two (4: 0.15; trilinear
-/// at 2: 0.15, at 4: 0.95). `evaluations` counts the exact values taken (the whole lattice: the
-/// frame's coarse-to-fine screening is still to come).
+/// at 2: 0.15, at 4: 0.95). The fine lattice is evaluated only in the cells of a lattice 4 strides
+/// apart that the same test keeps, grown by two. `evaluations` counts the exact values taken.
 openvdb::FloatGrid::Ptr sliceNearZero(const std::function<double(const Point4&)>& f, double w,
                                       const openvdb::math::Transform::Ptr& transform,
                                       const openvdb::CoordBBox& box, int stride, double bandVoxels,
