@@ -228,3 +228,30 @@ TEST(Variational, PartitionOfUnityPutsTheZeroSetWhereTheDenseSolveDoes)
                     worst, rays);
     }
 }
+
+// The partition of unity's gradient (the weights' derivatives included) against central
+// differences of its values, at points near the shapes and between them, at three times.
+TEST(Variational, PartitionOfUnityGradientIsTheDerivative)
+{
+    const double voxel = 0.02;
+    auto twoSpheres = sphere(0.25, voxel, -0.35);
+    openvdb::tools::csgUnion(*twoSpheres, *sphere(0.25, voxel, 0.35));
+    std::vector<Constraint> c = sampleConstraints(*sphere(0.3, voxel), 500, voxel, 0.0);
+    const std::vector<Constraint> e = sampleConstraints(*twoSpheres, 500, voxel, kTimeScale);
+    c.insert(c.end(), e.begin(), e.end());
+    PartitionOptions options;
+    options.coarse = 500;
+    const PartitionOfUnity pu = PartitionOfUnity::solve(c, options);
+    std::mt19937 rng(13);
+    std::uniform_real_distribution<double> u(-0.6, 0.6);
+    const double h = 1e-6;
+    for (int i = 0; i < 60; ++i) {
+        const Point4 p(u(rng), u(rng) / 2, u(rng) / 2, kTimeScale * (i % 3) / 2.0);
+        const Point4 g = pu.gradient(p);
+        for (int k = 0; k < 4; ++k) {
+            Point4 a = p, b = p;
+            a[k] -= h, b[k] += h;
+            EXPECT_NEAR(g[k], (pu(b) - pu(a)) / (2 * h), 1e-4 * (1.0 + g.norm())) << k;
+        }
+    }
+}

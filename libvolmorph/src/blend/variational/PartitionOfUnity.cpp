@@ -125,7 +125,7 @@ PartitionOfUnity PartitionOfUnity::solve(const std::vector<Constraint>& constrai
     return pu;
 }
 
-double PartitionOfUnity::local(const Point4& x) const
+double PartitionOfUnity::local(const Point4& x, Point4* gradient) const
 {
     const Eigen::Vector3d p = spatial(x);
     const Eigen::Array3d u = (p - mLo).array() / mCell;
@@ -135,25 +135,55 @@ double PartitionOfUnity::local(const Point4& x) const
         first[a] = std::clamp(int(std::floor(u[a] - reach)), 0, mCells[a] - 1);
         last[a] = std::clamp(int(std::floor(u[a] + reach)), 0, mCells[a] - 1);
     }
+    // f = S / W with S = sum w_k r_k, W = sum w_k; grad f = (grad S - f grad W) / W.
     double sum = 0.0, weights = 0.0;
+    Point4 gradSum = Point4::Zero(), gradWeights = Point4::Zero();
     for (int i = first.x(); i <= last.x(); ++i)
         for (int j = first.y(); j <= last.y(); ++j)
             for (int k = first.z(); k <= last.z(); ++k) {
                 const Patch& patch = mPatches[size_t((i * mCells.y() + j) * mCells.z() + k)];
-                const double w = wendland((p - patch.centre).norm() / patch.radius);
+                const Eigen::Vector3d offset = p - patch.centre;
+                const double d = offset.norm() / patch.radius;
+                const double w = wendland(d);
                 if (w <= 0.0) continue;
-                sum += w * patch.f(x);
+                const double r = patch.f(x);
+                sum += w * r;
                 weights += w;
+                if (!gradient) continue;
+                // psi'(d) = -20 d (1 - d)^3; d's gradient is offset / (|offset| R).
+                Point4 gradW = Point4::Zero();
+                if (d > 0.0)
+                    gradW.head<3>() =
+                        (-20.0 * std::pow(1.0 - d, 3) / (patch.radius * patch.radius)) * offset;
+                gradSum += gradW * r + w * patch.f.gradient(x);
+                gradWeights += gradW;
             }
-    if (weights > 0.0) return sum / weights;
+    if (weights > 0.0) {
+        const double value = sum / weights;
+        if (gradient) *gradient = (gradSum - value * gradWeights) / weights;
+        return value;
+    }
     // Beyond every ball: the nearest lattice patch's fit, extended.
     const Eigen::Array3i c = u.floor().cast<int>().max(0).min(mCells - 1);
-    return mPatches[size_t((c.x() * mCells.y() + c.y()) * mCells.z() + c.z())].f(x);
+    const Patch& nearest = mPatches[size_t((c.x() * mCells.y() + c.y()) * mCells.z() + c.z())];
+    if (gradient) *gradient = nearest.f.gradient(x);
+    return nearest.f(x);
 }
 
 double PartitionOfUnity::operator()(const Point4& x) const
 {
     return mCoarse(x) + (mPatches.empty() ? 0.0 : local(x));
+}
+
+Point4 PartitionOfUnity::gradient(const Point4& x) const
+{
+    Point4 g = mCoarse.gradient(x);
+    if (!mPatches.empty()) {
+        Point4 l;
+        local(x, &l);
+        g += l;
+    }
+    return g;
 }
 
 } // namespace volmorph::detail::variational

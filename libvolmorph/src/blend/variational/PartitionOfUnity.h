@@ -41,6 +41,8 @@ public:
     /// f(x); outside the lattice (beyond the constraints' box by a cell) the nearest patches'
     /// fits, extended.
     double operator()(const Point4& x) const;
+    /// (df/dx, df/dy, df/dz, df/dt'), t' = t * time_scale: the weights' derivatives included.
+    Point4 gradient(const Point4& x) const;
     size_t patchCount() const { return mPatches.size(); }
 
 private:
@@ -49,7 +51,8 @@ private:
         double radius = 0.0;
         Interpolant f;
     };
-    double local(const Point4& x) const;
+    /// The local level's value, and its gradient when `gradient` is given.
+    double local(const Point4& x, Point4* gradient = nullptr) const;
 
     Interpolant mCoarse;
     std::vector<Patch> mPatches; ///< lattice order: k fastest
