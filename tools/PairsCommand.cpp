@@ -8,7 +8,6 @@
 #include <volmorph/SceneDocument.h>
 #include <volmorph/core/MemoryLimit.h>
 
-#include <cmath>
 #include <cstdio>
 #include <memory>
 
@@ -21,8 +20,6 @@ struct PairsArgs {
     double memoryLimitGiB = 0.0;
     CacheArgs cache;
 };
-
-const char* const kSuggested = "suggested by volmorph pairs suggest";
 
 int runSuggest(const PairsArgs& args)
 {
@@ -43,8 +40,8 @@ int runSuggest(const PairsArgs& args)
     const PairSuggestion suggestion = suggestPairs(volumes.source, volumes.target);
     std::string printed;
     for (const FeaturePairSpec& pair : suggestion.pairs) {
-        document.appendPair(pairTableLines(pair), {kSuggested});
-        printed += std::string("\n# ") + kSuggested + "\n[[pair]]\n";
+        document.appendPair(pairTableLines(pair), {kSuggestedPairComment});
+        printed += std::string("\n# ") + kSuggestedPairComment + "\n[[pair]]\n";
         for (const std::string& line : pairTableLines(pair)) printed += line + "\n";
     }
     if (args.output.empty()) {

@@ -1,10 +1,9 @@
 #include "EditDocument.h"
 
 #include <volmorph/core/Diagnostics.h>
+#include <volmorph/core/FileText.h>
 
 #include <algorithm>
-#include <fstream>
-#include <sstream>
 
 namespace volmorph::editor {
 namespace {
@@ -13,14 +12,6 @@ using nlohmann::json;
 
 /// Undo keeps this many steps (texts of a few KB each).
 constexpr size_t kUndoSteps = 500;
-
-std::string readFile(const std::filesystem::path& path)
-{
-    std::ifstream in(path, std::ios::binary);
-    std::ostringstream text;
-    text << in.rdbuf();
-    return text.str();
-}
 
 double number(const json& value, const char* what)
 {
@@ -184,9 +175,9 @@ void EditDocument::set(const json& body, SceneDocument& next) const
     if (!parseKey(key, pair, field))
         throw BadRequest("key \"" + key.substr(0, 80) +
                          "\": expected pair[N].type or pair[N].source|target.origin|axes|scale");
-    if (pair > next.pairCount())
+    if (const int count = next.pairCount(); pair > count)
         throw BadRequest("no pair " + std::to_string(pair) + " (the scene has " +
-                         std::to_string(next.pairCount()) + ")");
+                         std::to_string(count) + ")");
     if (!body.contains("value")) throw BadRequest("expected a \"value\"");
     try {
         next.set(key, tomlValue(field, body["value"]));
@@ -271,7 +262,7 @@ void EditDocument::save()
     if (!valid())
         throw Conflict("the scene has errors (" + mErrors.front().where + ": " +
                        mErrors.front().message + "): fix or undo them before saving");
-    if (readFile(mPath) != mSaved)
+    if (readFileText(mPath) != mSaved)
         throw Conflict(mPath.string() +
                        " changed on disk since the editor read it; not overwritten (restart the "
                        "editor to edit the new file)");

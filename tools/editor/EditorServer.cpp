@@ -3,6 +3,7 @@
 #include "EditorSession.h"
 
 #include <volmorph/core/Diagnostics.h>
+#include <volmorph/core/FileText.h>
 #include <volmorph/core/Interrupter.h>
 
 #include <httplib.h>
@@ -11,8 +12,8 @@
 #include <atomic>
 #include <chrono>
 #include <cstdio>
-#include <fstream>
 #include <map>
+#include <optional>
 #include <random>
 #include <sstream>
 #include <thread>
@@ -41,11 +42,9 @@ std::map<std::string, Asset> readAssets(const std::filesystem::path& folder)
     std::map<std::string, Asset> assets;
     std::error_code ec;
     for (const auto& entry : std::filesystem::directory_iterator(folder, ec)) {
-        if (!entry.is_regular_file()) continue;
-        std::ifstream in(entry.path(), std::ios::binary);
-        std::ostringstream bytes;
-        bytes << in.rdbuf();
-        assets[entry.path().filename().string()] = {contentType(entry.path()), bytes.str()};
+        if (std::optional<std::string> bytes = readFileText(entry.path()))
+            assets[entry.path().filename().string()] = {contentType(entry.path()),
+                                                        std::move(*bytes)};
     }
     if (!assets.count("index.html"))
         throw UserError(SourceLocation{folder.string()},

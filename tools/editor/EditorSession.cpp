@@ -17,8 +17,6 @@ namespace {
 
 using nlohmann::json;
 
-const char* const kSuggested = "suggested by volmorph pairs suggest";
-
 template <typename T>
 void put(std::string& out, const T& value)
 {
@@ -154,7 +152,7 @@ Reply EditorSession::route(const std::string& method, const std::string& route,
     if (name == "save") {
         mDocument.save();
     } else if (name == "suggest") {
-        mDocument.appendPairs(suggestPairs(mSource, mTarget).pairs, kSuggested);
+        mDocument.appendPairs(suggestPairs(mSource, mTarget).pairs, kSuggestedPairComment);
     } else if (name == "set" || name == "add" || name == "duplicate" || name == "delete" ||
                name == "undo" || name == "redo") {
         mDocument.apply(name, request);

@@ -20,6 +20,9 @@
 
 namespace volmorph {
 
+/// The comment written above each suggested [[pair]] (by `pairs suggest -o` and the editor).
+inline constexpr const char* kSuggestedPairComment = "suggested by volmorph pairs suggest";
+
 struct PairSuggestion {
     std::vector<FeaturePairSpec> pairs; ///< the box pair first, then the point pairs
     double boxOverlap = 0.0; ///< the chosen box map's IoU of the carried source with the target

@@ -4,6 +4,7 @@
 
 #include <volmorph/core/AtomicFile.h>
 #include <volmorph/core/Diagnostics.h>
+#include <volmorph/core/FileText.h>
 
 #include <toml++/toml.h>
 
@@ -145,11 +146,9 @@ SceneDocument::SceneDocument(std::string text, std::filesystem::path path)
 
 SceneDocument SceneDocument::read(const std::filesystem::path& path)
 {
-    std::ifstream in(path, std::ios::binary);
-    if (!in) throw UserError(SourceLocation{path.string()}, "cannot read scene file");
-    std::ostringstream text;
-    text << in.rdbuf();
-    return SceneDocument(text.str(), path);
+    std::optional<std::string> text = readFileText(path);
+    if (!text) throw UserError(SourceLocation{path.string()}, "cannot read scene file");
+    return SceneDocument(std::move(*text), path);
 }
 
 void SceneDocument::set(const std::string& key, const std::string& value)

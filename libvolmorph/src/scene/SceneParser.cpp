@@ -5,6 +5,7 @@
 // syntax error stops parsing: after one, toml++ has no tree to check.
 #include <volmorph/Frames.h>
 #include <volmorph/Scene.h>
+#include <volmorph/core/FileText.h>
 
 #include <optional>
 
@@ -14,9 +15,7 @@
 #include <toml++/toml.h>
 
 #include <cmath>
-#include <fstream>
 #include <limits>
-#include <sstream>
 
 namespace volmorph {
 namespace {
@@ -170,14 +169,11 @@ Scene parseScene(std::string_view text, const std::filesystem::path& file)
 
 Scene loadScene(const std::filesystem::path& file)
 {
-    std::ifstream in(file, std::ios::binary);
-    std::error_code ec;
-    if (std::filesystem::is_directory(file, ec) || !in)
+    const std::optional<std::string> text = readFileText(file);
+    if (!text)
         throw UserError(SourceLocation{file.string()},
                         "cannot read scene file (expected a readable TOML file)");
-    std::ostringstream text;
-    text << in.rdbuf();
-    return parseScene(text.str(), file);
+    return parseScene(*text, file);
 }
 
 } // namespace volmorph

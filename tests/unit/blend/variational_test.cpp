@@ -54,6 +54,19 @@ std::vector<Eigen::Vector3d> directions(int n)
     return d;
 }
 
+/// f's gradient by central differences of step h.
+template <typename F>
+Point4 centralDifferences(const F& f, const Point4& p, double h)
+{
+    Point4 g;
+    for (int k = 0; k < 4; ++k) {
+        Point4 a = p, b = p;
+        a[k] -= h, b[k] += h;
+        g[k] = (f(b) - f(a)) / (2 * h);
+    }
+    return g;
+}
+
 } // namespace
 
 TEST(Variational, DenseSolvePassesThroughItsConstraints)
@@ -98,12 +111,9 @@ TEST(Variational, GradientIsTheDerivative)
     const double h = 1e-5;
     for (int i = 0; i < 20; ++i) {
         const Point4 p(u(rng), u(rng), u(rng), u(rng));
-        const Point4 g = f.gradient(p);
-        for (int k = 0; k < 4; ++k) {
-            Point4 a = p, b = p;
-            a[k] -= h, b[k] += h;
-            EXPECT_NEAR(g[k], (f(b) - f(a)) / (2 * h), 1e-5 * (1.0 + std::abs(g[k])));
-        }
+        const Point4 g = f.gradient(p), differences = centralDifferences(f, p, h);
+        for (int k = 0; k < 4; ++k)
+            EXPECT_NEAR(g[k], differences[k], 1e-5 * (1.0 + std::abs(g[k])));
     }
 }
 
@@ -247,11 +257,7 @@ TEST(Variational, PartitionOfUnityGradientIsTheDerivative)
     const double h = 1e-6;
     for (int i = 0; i < 60; ++i) {
         const Point4 p(u(rng), u(rng) / 2, u(rng) / 2, kTimeScale * (i % 3) / 2.0);
-        const Point4 g = pu.gradient(p);
-        for (int k = 0; k < 4; ++k) {
-            Point4 a = p, b = p;
-            a[k] -= h, b[k] += h;
-            EXPECT_NEAR(g[k], (pu(b) - pu(a)) / (2 * h), 1e-4 * (1.0 + g.norm())) << k;
-        }
+        const Point4 g = pu.gradient(p), differences = centralDifferences(pu, p, h);
+        for (int k = 0; k < 4; ++k) EXPECT_NEAR(g[k], differences[k], 1e-4 * (1.0 + g.norm())) << k;
     }
 }

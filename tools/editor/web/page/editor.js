@@ -3,7 +3,7 @@
 // (window.volmorphEditor).
 import * as api from './api.js';
 import { View } from './view.js';
-import { elementOf, interpolate } from './features.js';
+import { elementOf, interpolate, round4 } from './features.js';
 import { showPairs, showFields, showErrors, showLabels } from './panels.js';
 
 const $ = (id) => document.getElementById(id);
@@ -126,18 +126,15 @@ async function sendEdit(action, body) {
   }
 }
 
+/** A new pair at the centres of the two sides, a non-point element a quarter of each side's box. */
 function addPair() {
-  const centre = (name) => {
-    const box = view.surfaces[name].geometry.boundingBox;
-    return { c: box.getCenter(view.surfaces[name].position.clone()).toArray(), s: box.getSize(view.surfaces[name].position.clone()) };
-  };
   const type = $('new-type').value;
   const element = (name) => {
-    const { c, s } = centre(name);
-    const e = { origin: c.map((v) => Math.round(v * 1e4) / 1e4) };
+    const { centre, size } = view.surfaceBox(name);
+    const e = { origin: centre.map(round4) };
     if (type !== 'point') {
       e.axes = [[1, 0, 0], [0, 1, 0]];
-      e.scale = [s.x, s.y, s.z].map((v) => Math.max(Math.round(v * 2500) / 1e4, 1e-3));
+      e.scale = size.map((v) => Math.max(round4(v / 4), 1e-3));
     }
     return e;
   };
@@ -149,7 +146,7 @@ function gizmoEdited() {
   if (!group || !group.userData.pick) return;
   const { pair, side: s } = group.userData.pick;
   const field = { translate: 'origin', rotate: 'axes', scale: 'scale' }[view.gizmo.getMode()];
-  const round = (v) => JSON.stringify(v, (k, x) => (typeof x === 'number' ? Math.round(x * 1e4) / 1e4 : x));
+  const round = (v) => JSON.stringify(v, (k, x) => (typeof x === 'number' ? round4(x) : x));
   if (round(elementOf(group)[field]) === round(state.pairs[pair - 1][s][field])) return; // a click
   edit('set', { key: `pair[${pair}].${s}.${field}`, value: elementOf(group)[field] });
 }
@@ -165,7 +162,7 @@ function pointerUp(event) {
   if (!start || Math.hypot(event.clientX - start.x, event.clientY - start.y) > 4) return; // an orbit
   if (event.shiftKey && selected) {
     const p = view.surfacePoint(event, side);
-    if (p) edit('set', { key: `pair[${selected}].${side}.origin`, value: p.toArray().map((v) => Math.round(v * 1e4) / 1e4) });
+    if (p) edit('set', { key: `pair[${selected}].${side}.origin`, value: p.toArray().map(round4) });
     return;
   }
   const hit = view.pick(event);

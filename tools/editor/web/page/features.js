@@ -72,15 +72,17 @@ export function keepMarkerSize(group) {
   group.userData.marker.scale.set(1 / Math.max(s.x, 1e-6), 1 / Math.max(s.y, 1e-6), 1 / Math.max(s.z, 1e-6));
 }
 
-/** The element a placed group stands for, rounded as the scene writes numbers (1e-4). */
+/** A number as the scene writes it: to 1e-4 (SceneDocument's tomlRounded), never -0. */
+export const round4 = (v) => Math.round(v * 1e4) / 1e4 + 0;
+
+/** The element a placed group stands for, rounded as the scene writes numbers. */
 export function elementOf(group) {
-  const round = (v) => Math.round(v * 1e4) / 1e4 + 0;
   const x = new THREE.Vector3(1, 0, 0).applyQuaternion(group.quaternion);
   const y = new THREE.Vector3(0, 1, 0).applyQuaternion(group.quaternion);
   return {
-    origin: group.position.toArray().map(round),
-    axes: [x.toArray().map(round), y.toArray().map(round)],
-    scale: group.scale.toArray().map((v) => Math.max(round(Math.abs(v)), 1e-4)),
+    origin: group.position.toArray().map(round4),
+    axes: [x.toArray().map(round4), y.toArray().map(round4)],
+    scale: group.scale.toArray().map((v) => Math.max(round4(Math.abs(v)), 1e-4)),
   };
 }
 

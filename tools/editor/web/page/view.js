@@ -87,6 +87,12 @@ export class View {
     this.render();
   }
 
+  /** Surface `name`'s bounding box: its centre and size, world units. */
+  surfaceBox(name) {
+    const box = this.surfaces[name].geometry.boundingBox;
+    return { centre: box.getCenter(new THREE.Vector3()).toArray(), size: box.getSize(new THREE.Vector3()).toArray() };
+  }
+
   /** World units for an origin's marker: a hundredth of the sides' size. */
   markerSize() {
     const box = new THREE.Box3();
@@ -121,8 +127,9 @@ export class View {
   }
 
   select(selected, side) {
-    this.pairs.forEach((p, i) => highlight(p[side === 'source' ? 'target' : 'source'], false));
-    this.pairs.forEach((p, i) => highlight(p[side], i + 1 === selected));
+    this.pairs.forEach((p, i) => {
+      for (const s of ['source', 'target']) highlight(p[s], i + 1 === selected && s === side);
+    });
     const drawn = this.pairs[selected - 1];
     if (drawn) this.gizmo.attach(drawn[side]); else this.gizmo.detach();
     this.render();
