@@ -174,8 +174,21 @@ void printSettings(const Scene& scene)
                 w.toleranceVoxels == 0.0 ? " (exact)" : "");
     const BlendSpec& b = scene.blend;
     std::printf("blend   %s mode; density %s, colour %s, sdf %s\n",
-                b.mode == BlendMode::Sdf ? "sdf" : "density", describe(b.density).c_str(),
-                describe(b.color).c_str(), describe(b.sdf).c_str());
+                b.mode == BlendMode::Sdf           ? "sdf"
+                : b.mode == BlendMode::Variational ? "variational"
+                                                   : "density",
+                describe(b.density).c_str(), describe(b.color).c_str(), describe(b.sdf).c_str());
+    if (b.mode == BlendMode::Variational) {
+        const VariationalSpec& v = b.variational;
+        std::printf("        %d constraints per shape, normal offset %s voxels, time scale %s; "
+                    "feature pairs not used\n",
+                    v.constraints, fmt(v.normalOffsetVoxels).c_str(),
+                    v.timeScale ? (fmt(*v.timeScale) + " world units").c_str()
+                                : "from the shapes' size");
+        for (const InfluenceSpec& i : v.influence)
+            std::printf("        influence at t = %s: %s\n", fmt(i.t).c_str(),
+                        i.object.file().string().c_str());
+    }
     for (const auto& [name, grid] : b.grids)
         std::printf("        carried grid %s: %s\n", name.c_str(), describe(grid.schedule).c_str());
     const RenderSpec& r = scene.render;

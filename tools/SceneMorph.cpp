@@ -36,6 +36,7 @@ void SceneMorph::load(int frame)
         loadSceneVolumes(scene, mCache, mInterrupter, mOptions.memoryLimitBytes, mQuiet);
     MorphOptions options = mOptions;
     options.setupInterrupter = &mInterrupter;
+    options.influences = std::move(volumes.influences);
     mMorpher.emplace(std::move(volumes.source), std::move(volumes.target), scene.pairs, scene.warp,
                      scene.blend, options);
     mLoaded = inputs;

@@ -99,6 +99,7 @@ EditorSession::EditorSession(const std::filesystem::path& scene, int resolution,
     SceneVolumes volumes = voxelizeScene(preview, interrupter);
     mSource = std::move(volumes.source);
     mTarget = std::move(volumes.target);
+    mInfluences = std::move(volumes.influences);
     mSourceMesh = surfaceOf(mSource);
     mTargetMesh = surfaceOf(mTarget);
 }
@@ -108,9 +109,11 @@ EditorSession::~EditorSession() = default;
 const Morpher& EditorSession::morpher()
 {
     const Scene& scene = mDocument.scene();
-    if (!mMorpher)
-        mMorpher.emplace(mSource, mTarget, scene.pairs, scene.warp, scene.blend);
-    else if (mMorpherVersion != mDocument.pairsVersion())
+    if (!mMorpher) {
+        MorphOptions options;
+        options.influences = mInfluences;
+        mMorpher.emplace(mSource, mTarget, scene.pairs, scene.warp, scene.blend, options);
+    } else if (mMorpherVersion != mDocument.pairsVersion())
         mMorpher = mMorpher->withPairs(scene.pairs);
     mMorpherVersion = mDocument.pairsVersion();
     return *mMorpher;

@@ -72,6 +72,7 @@ private:
     std::mutex mMutex;
     EditDocument mDocument;
     VolumeSet mSource, mTarget;
+    std::vector<TimedVolume> mInfluences; ///< variational mode's
     std::string mSourceMesh, mTargetMesh;
     std::optional<Morpher> mMorpher;
     uint64_t mMorpherVersion = 0;

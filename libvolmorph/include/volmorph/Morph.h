@@ -42,6 +42,8 @@ struct MorphOptions {
     /// Stops the one-time setup of the blend (sdf mode's extended distances) when it asks to,
     /// with volmorph::Interrupted; null: never stops. Frames take their own.
     Interrupter* setupInterrupter = nullptr;
+    /// Variational mode's influence shapes (SceneVolumes::influences), on the sides' transform.
+    std::vector<TimedVolume> influences;
 };
 
 /// What one kept output leaf costs while an sdf-mode frame is made: density, colour, the distance
@@ -74,8 +76,9 @@ public:
             BlendSpec blend, MorphOptions options = {});
 
     /// The same morph with other pairs, sharing this one's blend setup (sdf mode's extended
-    /// distances, which depend on the two sides alone) when both this and `pairs` have pairs; built
-    /// anew when either has none (the identity warp sets up differently). What an editor does
+    /// distances, which depend on the two sides alone) when both this and `pairs` have pairs, and
+    /// always in variational mode (which uses no pairs); built anew when either has none (the
+    /// identity warp sets up differently). What an editor does
     /// after each change to the pairs: frames are bit for bit those of a Morpher built with them.
     Morpher withPairs(std::vector<FeaturePairSpec> pairs) const;
 

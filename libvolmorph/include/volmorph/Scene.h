@@ -124,7 +124,30 @@ struct ScheduleSpec {
     std::vector<std::pair<double, double>> points;
 };
 
-enum class BlendMode { Density, Sdf };
+enum class BlendMode { Density, Sdf, Variational };
+
+/// An extra shape the variational function passes through at time t, steering the in-betweens
+/// near t toward it (Turk and O'Brien's intermediate shapes).
+struct InfluenceSpec {
+    ObjectSpec object; ///< a mesh or a single volume file (no sequence), placed as a side is
+    double t = 0.5;    ///< in (0, 1)
+};
+
+/// [variational]: Turk and O'Brien's variational implicit morph (blend.mode = "variational").
+struct VariationalSpec {
+    int constraints = 5000;          ///< surface points per shape, each with an inward partner
+    double normalOffsetVoxels = 1.0; ///< the inward partners' depth, voxels
+    /// World units per unit of t (the fourth axis's scale); unset: kVariationalTimeScale times the
+    /// longest side of the shapes' bounds together.
+    std::optional<double> timeScale;
+    std::vector<InfluenceSpec> influence;
+    SourceLocation where; ///< the [variational] table, when given
+};
+
+/// The default time scale over the longest side of the shapes' bounds (BENCHMARKS.md: a sphere
+/// into itself bulges 1.8% mid-way at a quarter of its diameter, 20% at one diameter; a sphere into
+/// one twice its size grows monotonically up to 0.4 of the larger's diameter, not at 0.8).
+inline constexpr double kVariationalTimeScale = 0.2;
 
 struct BlendSpec {
     BlendMode mode = BlendMode::Density;
@@ -142,6 +165,7 @@ struct BlendSpec {
         SourceLocation where;
     };
     std::map<std::string, GridSchedule> grids;
+    VariationalSpec variational; ///< variational mode only
 };
 
 enum class Projection { Perspective, Orthographic };

@@ -32,12 +32,20 @@ double sceneVoxelSize(const VolumeSpec& volume, const SideExtent& source, const 
 struct SceneVolumes {
     SceneMeshes meshes; ///< the imported meshes (empty for a volume side)
     VolumeSet source, target;
+    /// Variational mode's influence shapes on the same transform, each with its time.
+    std::vector<TimedVolume> influences;
 };
 
 /// Imports and voxelizes (or reads) both sides of `scene` (the same code as `volmorph voxelize`);
-/// a sequence at the scene's first frame (sceneAtFrame() picks another). In sdf mode a fog volume
-/// gets a derived level set (VolumeInput.h).
+/// a sequence at the scene's first frame (sceneAtFrame() picks another). In sdf and variational
+/// modes a fog volume gets a derived level set (VolumeInput.h). The influence shapes too.
 SceneVolumes voxelizeScene(const Scene& scene, Interrupter* interrupter = nullptr,
                            uint64_t memoryLimitBytes = 0);
+
+/// Variational mode's influence shapes (none in another mode), voxelized or read at `voxelSize`,
+/// each with a level set.
+std::vector<TimedVolume> voxelizeInfluences(const Scene& scene, double voxelSize,
+                                            Interrupter* interrupter = nullptr,
+                                            uint64_t memoryLimitBytes = 0);
 
 } // namespace volmorph

@@ -38,6 +38,12 @@ struct VolumeSet {
     }
 };
 
+/// A shape placed at one time of a morph (variational mode's influence shapes).
+struct TimedVolume {
+    VolumeSet volume;
+    double t = 0.5;
+};
+
 /// Puts `grid` in the part of `volumes` its name gives (sdf, density, Cd, vel or Blender's
 /// velocity; a part of another type is left empty); false for any other name.
 inline bool setPartByName(VolumeSet& volumes, const openvdb::GridBase::Ptr& grid)

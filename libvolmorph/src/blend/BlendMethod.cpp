@@ -2,6 +2,7 @@
 
 #include "blend/DensityBlend.h"
 #include "blend/SdfBlend.h"
+#include "blend/VariationalBlend.h"
 
 #include <stdexcept>
 
@@ -14,6 +15,8 @@ std::unique_ptr<const BlendMethod> makeBlendMethod(const BlendSetup& setup)
         return makeDensityBlend(setup);
     case BlendMode::Sdf:
         return makeSdfBlend(setup);
+    case BlendMode::Variational:
+        return makeVariationalBlend(setup);
     }
     throw std::logic_error("makeBlendMethod: unknown blend mode");
 }

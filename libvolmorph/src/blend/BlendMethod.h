@@ -33,6 +33,8 @@ struct BlendSetup {
     openvdb::CoordBBox candidates;      ///< the domain at t = 0 (index space), for kept values
     uint64_t memoryLimitBytes = 0;      ///< resolved (never 0)
     Interrupter* interrupter = nullptr; ///< stops the method's one-time work (null: never)
+    /// Variational mode's influence shapes, on the sides' transform (null: none).
+    const std::vector<TimedVolume>* influences = nullptr;
 };
 
 /// One frame's request.

@@ -187,7 +187,9 @@ std::string voxelCacheKey(const Scene& sequenced)
     if (scene.volume.resolution) s << "resolution " << *scene.volume.resolution << '\n';
     // A fog volume gets a derived level set in sdf mode only.
     if (scene.source.isVolume() || scene.target.isVolume())
-        s << "sdf mode " << (scene.blend.mode == BlendMode::Sdf) << '\n';
+        s << "sdf mode "
+          << (scene.blend.mode == BlendMode::Sdf || scene.blend.mode == BlendMode::Variational)
+          << '\n';
     return OIIO::SHA1::digest(s.str().data(), s.str().size());
 }
 
@@ -209,6 +211,9 @@ SceneVolumes voxelizeSceneCached(const Scene& scene, const std::filesystem::path
         r.problem = readEntry(r.entry, key, cached);
         if (r.problem.empty()) {
             r.outcome = CacheReport::Outcome::Hit;
+            // The influence shapes are not cached: voxelized each time at the sides' voxel size.
+            cached.influences =
+                voxelizeInfluences(scene, cached.source.voxelSize(), interrupter, memoryLimitBytes);
             return cached;
         }
     }

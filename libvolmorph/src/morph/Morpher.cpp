@@ -104,13 +104,15 @@ Morpher::Morpher(VolumeSet source, VolumeSet target, std::vector<FeaturePairSpec
                                    mPairs.size(),
                                    mPairs.empty() ? candidateBounds(0.0) : CoordBBox(),
                                    mOptions.memoryLimitBytes,
-                                   mOptions.setupInterrupter};
+                                   mOptions.setupInterrupter,
+                                   &mOptions.influences};
     mMethod = detail::makeBlendMethod(setup);
 }
 
 Morpher Morpher::withPairs(std::vector<FeaturePairSpec> pairs) const
 {
-    if (pairs.empty() || mPairs.empty())
+    // The variational method does not use the pairs; the others set up apart with none.
+    if (mBlend.mode != BlendMode::Variational && (pairs.empty() || mPairs.empty()))
         return Morpher(mSource, mTarget, std::move(pairs), mWarp, mBlend, mOptions);
     Morpher other(*this);
     other.mPairs = std::move(pairs);

@@ -1,4 +1,4 @@
-// [warp] (weights, tolerance) and [blend] (mode, schedules, dust).
+// [warp] (weights, tolerance), [blend] (mode, schedules, dust) and [variational].
 #include "TableParsers.h"
 
 #include <cmath>
@@ -11,6 +11,8 @@ namespace {
 const std::vector<std::string> kWarpKeys = {"epsilon", "tolerance", "weighting", "a", "b", "p"};
 const std::vector<std::string> kBlendKeys = {"mode", "density",    "color",
                                              "sdf",  "min_island", "grids"};
+const std::vector<std::string> kVariationalKeys = {"constraints", "normal_offset", "time_scale",
+                                                   "influence"};
 
 void parseSchedule(Reader& r, const toml::node& node, const std::string& path, ScheduleSpec& s)
 {
@@ -136,8 +138,10 @@ void parseBlend(Reader& r, const toml::node& node, BlendSpec& b)
     r.checkKeys(*t, "blend", kBlendKeys);
 
     if (const toml::node* n = t->get("mode"))
-        if (auto s = r.choice(*n, "blend.mode", {"density", "sdf"}))
-            b.mode = *s == "sdf" ? BlendMode::Sdf : BlendMode::Density;
+        if (auto s = r.choice(*n, "blend.mode", {"density", "sdf", "variational"}))
+            b.mode = *s == "sdf"           ? BlendMode::Sdf
+                     : *s == "variational" ? BlendMode::Variational
+                                           : BlendMode::Density;
     if (const toml::node* n = t->get("density")) parseSchedule(r, *n, "blend.density", b.density);
     if (const toml::node* n = t->get("color")) parseSchedule(r, *n, "blend.color", b.color);
     if (const toml::node* n = t->get("sdf")) parseSchedule(r, *n, "blend.sdf", b.sdf);
@@ -145,6 +149,49 @@ void parseBlend(Reader& r, const toml::node& node, BlendSpec& b)
         if (auto v = r.integerIn(*n, "blend.min_island", 0, 1000000000))
             b.minIslandVoxels = int(*v);
     if (const toml::node* n = t->get("grids")) parseGridSchedules(r, *n, b);
+}
+
+void parseVariational(Reader& r, const toml::node& node, const std::filesystem::path& folder,
+                      VariationalSpec& v)
+{
+    const toml::table* t = r.table(node, "variational");
+    if (!t) return;
+    r.checkKeys(*t, "variational", kVariationalKeys);
+    v.where = r.at(node);
+    if (const toml::node* n = t->get("constraints"))
+        if (auto c = r.integerIn(*n, "variational.constraints", 100, 1000000))
+            v.constraints = int(*c);
+    if (const toml::node* n = t->get("normal_offset"))
+        if (auto d = r.numberIn(*n, "variational.normal_offset", 0.0, false, 16.0,
+                                "a depth in voxels, 0 < depth <= 16"))
+            v.normalOffsetVoxels = *d;
+    if (const toml::node* n = t->get("time_scale"))
+        if (auto s = r.numberIn(*n, "variational.time_scale", 0.0, false,
+                                std::numeric_limits<double>::max(),
+                                "a positive length in world units per unit of t"))
+            v.timeScale = *s;
+    if (const toml::node* n = t->get("influence"))
+        r.eachTable(
+            *n, "variational.influence", [&](const toml::table& shape, const std::string& path) {
+                InfluenceSpec influence;
+                parseObject(r, shape, path, folder, influence.object, {"t"});
+                if (influence.object.isSequence())
+                    r.error(r.at(*shape.get("volume")),
+                            path + ".volume: an influence shape is one volume, not a sequence");
+                if (const toml::node* time = shape.get("t")) {
+                    if (auto at = r.numberIn(*time, path + ".t", 0.0, false, 1.0,
+                                             "a time strictly between 0 and 1")) {
+                        if (*at >= 1.0)
+                            r.error(r.at(*time), path +
+                                                     ".t: expected a time strictly between 0 and "
+                                                     "1 (the sides are at 0 and 1), got 1");
+                        influence.t = *at;
+                    }
+                } else {
+                    r.missing(shape, path + ".t", "the time the shape is placed at, 0 < t < 1");
+                }
+                v.influence.push_back(std::move(influence));
+            });
 }
 
 } // namespace volmorph::detail

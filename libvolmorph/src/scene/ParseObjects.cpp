@@ -135,11 +135,14 @@ PropSpec parseProp(Reader& r, const toml::table& t, const std::string& path,
 } // namespace
 
 void parseObject(Reader& r, const toml::node& node, const std::string& path,
-                 const std::filesystem::path& folder, ObjectSpec& object)
+                 const std::filesystem::path& folder, ObjectSpec& object,
+                 const std::vector<std::string>& extraKeys)
 {
     const toml::table* t = r.table(node, path);
     if (!t) return;
-    r.checkKeys(*t, path, kObjectKeys);
+    std::vector<std::string> keys = kObjectKeys;
+    keys.insert(keys.end(), extraKeys.begin(), extraKeys.end());
+    r.checkKeys(*t, path, keys);
     const toml::node* mesh = t->get("mesh");
     const toml::node* volume = t->get("volume");
     if (mesh && volume)

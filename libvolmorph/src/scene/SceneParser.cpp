@@ -26,8 +26,8 @@ using detail::typeName;
 
 // Keys allowed at the root and in [frames]; each table group's are in its unit. Anything else is
 // reported with a "did you mean" for near misses.
-const std::vector<std::string> kRootKeys = {"source", "target", "volume", "pair",  "warp",
-                                            "blend",  "render", "prop",   "frames"};
+const std::vector<std::string> kRootKeys = {"source", "target",      "volume", "pair", "warp",
+                                            "blend",  "variational", "render", "prop", "frames"};
 const std::vector<std::string> kFramesKeys = {"range", "output", "fps"};
 
 class SceneParser {
@@ -56,6 +56,11 @@ public:
         if (const toml::node* n = root.get("pair")) detail::parsePairs(r, *n, mScene.pairs);
         if (const toml::node* n = root.get("warp")) detail::parseWarp(r, *n, mScene.warp);
         if (const toml::node* n = root.get("blend")) detail::parseBlend(r, *n, mScene.blend);
+        if (const toml::node* n = root.get("variational")) {
+            detail::parseVariational(r, *n, mScene.folder, mScene.blend.variational);
+            if (mScene.blend.mode != BlendMode::Variational)
+                r.error(r.at(*n), "[variational]: only used with blend.mode = \"variational\"");
+        }
         if (const toml::node* n = root.get("render"))
             detail::parseRender(r, *n, mScene.folder, mScene.render);
         if (const toml::node* n = root.get("prop"))

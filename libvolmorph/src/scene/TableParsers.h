@@ -16,9 +16,11 @@ namespace volmorph::detail {
 
 inline constexpr double kDegreesToRadians = 3.14159265358979323846 / 180.0;
 
-/// [source] and [target]: mesh (resolved against `folder`), transform, color.
+/// [source] and [target]: mesh (resolved against `folder`), transform, color; `extraKeys` are
+/// the caller's own keys in the same table (an influence shape's t).
 void parseObject(Reader& r, const toml::node& node, const std::string& path,
-                 const std::filesystem::path& folder, ObjectSpec& object);
+                 const std::filesystem::path& folder, ObjectSpec& object,
+                 const std::vector<std::string>& extraKeys = {});
 /// [[prop]]: meshes in the shot (mesh, transform, color, holdout, shadow_catcher).
 void parseProps(Reader& r, const toml::node& node, const std::filesystem::path& folder,
                 std::vector<PropSpec>& props);
@@ -29,6 +31,9 @@ void parsePairs(Reader& r, const toml::node& node, std::vector<FeaturePairSpec>&
 /// [warp] and [blend] (with its schedules).
 void parseWarp(Reader& r, const toml::node& node, WarpSpec& warp);
 void parseBlend(Reader& r, const toml::node& node, BlendSpec& blend);
+/// [variational], its influence shapes' files resolved against `folder`.
+void parseVariational(Reader& r, const toml::node& node, const std::filesystem::path& folder,
+                      VariationalSpec& variational);
 /// [render], its camera and lights (with their keys); a sky map's path resolved against `folder`.
 void parseRender(Reader& r, const toml::node& node, const std::filesystem::path& folder,
                  RenderSpec& render);

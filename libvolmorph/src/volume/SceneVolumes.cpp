@@ -43,6 +43,34 @@ double sceneVoxelSize(const VolumeSpec& volume, const SideExtent& source, const 
     return longest / double(std::max(1, volume.resolution.value_or(128)));
 }
 
+namespace {
+
+/// One object at the scene's voxel size: a mesh voxelized, a volume read and resampled.
+VolumeSet objectVolumes(const ObjectSpec& spec, const Mesh* mesh, const VolumeInput* input,
+                        double voxelSize, bool needSdf, Interrupter* interrupter,
+                        uint64_t memoryLimitBytes)
+{
+    if (input) {
+        VolumeInputOptions o;
+        o.voxelSize = voxelSize;
+        o.needSdf = needSdf;
+        o.memoryLimitBytes = memoryLimitBytes;
+        return input->resample(o, interrupter);
+    }
+    VoxelizeOptions o;
+    o.voxelSize = voxelSize;
+    o.memoryLimitBytes = memoryLimitBytes;
+    if (spec.color) o.color = Vec3f(*spec.color);
+    return voxelize(*mesh, o, interrupter);
+}
+
+bool needsSdf(const Scene& scene)
+{
+    return scene.blend.mode == BlendMode::Sdf || scene.blend.mode == BlendMode::Variational;
+}
+
+} // namespace
+
 SceneVolumes voxelizeScene(const Scene& sequenced, Interrupter* interrupter,
                            uint64_t memoryLimitBytes)
 {
@@ -60,20 +88,29 @@ SceneVolumes voxelizeScene(const Scene& sequenced, Interrupter* interrupter,
     }
     const double voxelSize = sceneVoxelSize(scene.volume, extents[0], extents[1]);
     VolumeSet* sides[2] = {&out.source, &out.target};
-    for (int i = 0; i < 2; ++i) {
-        if (inputs[i]) {
-            VolumeInputOptions o;
-            o.voxelSize = voxelSize;
-            o.needSdf = scene.blend.mode == BlendMode::Sdf;
-            o.memoryLimitBytes = memoryLimitBytes;
-            *sides[i] = inputs[i]->resample(o, interrupter);
-            continue;
-        }
-        VoxelizeOptions o;
-        o.voxelSize = voxelSize;
-        o.memoryLimitBytes = memoryLimitBytes;
-        if (specs[i]->color) o.color = Vec3f(*specs[i]->color);
-        *sides[i] = voxelize(*meshes[i], o, interrupter);
+    for (int i = 0; i < 2; ++i)
+        *sides[i] = objectVolumes(*specs[i], meshes[i], inputs[i] ? &*inputs[i] : nullptr,
+                                  voxelSize, needsSdf(scene), interrupter, memoryLimitBytes);
+    out.influences = voxelizeInfluences(scene, voxelSize, interrupter, memoryLimitBytes);
+    return out;
+}
+
+std::vector<TimedVolume> voxelizeInfluences(const Scene& scene, double voxelSize,
+                                            Interrupter* interrupter, uint64_t memoryLimitBytes)
+{
+    std::vector<TimedVolume> out;
+    if (scene.blend.mode != BlendMode::Variational) return out;
+    for (const InfluenceSpec& influence : scene.blend.variational.influence) {
+        std::optional<VolumeInput> input;
+        Mesh mesh;
+        if (influence.object.isVolume())
+            input.emplace(influence.object);
+        else
+            mesh = importMesh(influence.object.mesh, influence.object.transform,
+                              influence.object.fileWhere);
+        out.push_back({objectVolumes(influence.object, &mesh, input ? &*input : nullptr, voxelSize,
+                                     true, interrupter, memoryLimitBytes),
+                       influence.t});
     }
     return out;
 }

@@ -122,24 +122,28 @@ TEST(Variational, ConstraintsLieOnTheSurfaceEvenly)
     const double voxel = 0.02, radius = 0.5;
     const auto grid = sphere(radius, voxel);
     const std::vector<Constraint> c = sampleConstraints(*grid, 500, 1.0 * voxel, 0.25);
-    ASSERT_GE(c.size(), 2 * 450u);
-    ASSERT_LE(c.size(), 2 * 500u);
+    const size_t k = kConstraintsPerPoint;
+    ASSERT_GE(c.size(), k * 450u);
+    ASSERT_LE(c.size(), k * 500u);
     double nearest = 1e9, farthest = 0.0;
-    for (size_t i = 0; i < c.size(); i += 2) {
+    for (size_t i = 0; i < c.size(); i += k) {
         EXPECT_NEAR(c[i].point.head<3>().norm(), radius, 0.05 * voxel);
         EXPECT_NEAR(c[i + 1].point.head<3>().norm(), radius - voxel, 0.05 * voxel);
+        EXPECT_NEAR(c[i + 2].point.head<3>().norm(), radius + voxel, 0.05 * voxel);
         EXPECT_EQ(c[i].value, 0.0);
-        EXPECT_EQ(c[i + 1].value, voxel);
+        // The sphere's own distances there, a voxel in and out.
+        EXPECT_NEAR(c[i + 1].value, voxel, 0.05 * voxel);
+        EXPECT_NEAR(c[i + 2].value, -voxel, 0.05 * voxel);
         EXPECT_EQ(c[i].point[3], 0.25);
         // Spacing: each point's nearest neighbour.
         double d = 1e9;
-        for (size_t j = 0; j < c.size(); j += 2)
+        for (size_t j = 0; j < c.size(); j += k)
             if (j != i) d = std::min(d, (c[i].point - c[j].point).norm());
         nearest = std::min(nearest, d);
         farthest = std::max(farthest, d);
     }
     // Evenly: 500 points on a sphere of area pi are about 0.079 apart; none crowded, no gap.
-    const double spacing = std::sqrt(4.0 * M_PI * radius * radius / double(c.size() / 2));
+    const double spacing = std::sqrt(4.0 * M_PI * radius * radius / double(c.size() / k));
     EXPECT_GT(nearest, 0.2 * spacing);
     EXPECT_LT(farthest, 2.0 * spacing);
 }

@@ -154,8 +154,10 @@ TEST(VariationalTopology, TheSliceNearItsZeroSetFromACoarseLatticeIsTheExactOne)
     const openvdb::CoordBBox box(openvdb::Coord(-36), openvdb::Coord(36));
     for (double t : {0.5, 0.8}) {
         const auto exact = sliceOverBox(fn, t * kTimeScale, transform, box);
-        size_t evaluations = 0;
-        const auto near = sliceNearZero(fn, t * kTimeScale, transform, box, 2, 1.5, &evaluations);
+        const NearZeroSlice slice = sliceNearZero([&](const Point4& p, double*) { return f(p); },
+                                                  t * kTimeScale, transform, box, 2, 1.5);
+        const auto& near = slice.values;
+        const size_t evaluations = slice.evaluations;
         auto e = exact->getConstAccessor();
         auto n = near->getConstAccessor();
         double worst = 0.0;

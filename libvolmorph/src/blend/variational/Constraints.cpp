@@ -1,5 +1,7 @@
 #include "blend/variational/Constraints.h"
 
+#include <openvdb/tools/Interpolation.h>
+
 #include <openvdb/math/Operators.h>
 
 #include <algorithm>
@@ -94,11 +96,21 @@ std::vector<Constraint> sampleConstraints(const openvdb::FloatGrid& sdf, size_t 
     const std::vector<SurfacePoint> surface = evenly(surfacePoints(sdf), count, sdf.voxelSize()[0]);
     if (surface.empty()) throw std::invalid_argument("a shape has no surface to constrain");
     std::vector<Constraint> constraints;
-    constraints.reserve(2 * surface.size());
+    constraints.reserve(kConstraintsPerPoint * surface.size());
+    auto acc = sdf.getConstAccessor();
+    // The shape's own distance at a partner (world units, positive inside as f is): about the
+    // offset, less where the shape is thinner than twice it (+offset there would claim inside
+    // what is near the other side); the offset itself beyond the grid's band.
+    const auto depth = [&](const openvdb::Vec3d& p, double beyond) {
+        const double d = openvdb::tools::BoxSampler::sample(acc, sdf.worldToIndex(p));
+        return std::abs(d) < sdf.background() ? -d : beyond;
+    };
     for (const SurfacePoint& s : surface) {
-        const openvdb::Vec3d in = s.position - s.normal * offset;
+        const openvdb::Vec3d in = s.position - s.normal * offset,
+                             out = s.position + s.normal * offset;
         constraints.push_back({Point4(s.position.x(), s.position.y(), s.position.z(), w), 0.0});
-        constraints.push_back({Point4(in.x(), in.y(), in.z(), w), offset});
+        constraints.push_back({Point4(in.x(), in.y(), in.z(), w), depth(in, offset)});
+        constraints.push_back({Point4(out.x(), out.y(), out.z(), w), depth(out, -offset)});
     }
     return constraints;
 }

@@ -17,6 +17,7 @@
 
 #include <Eigen/Core>
 
+#include <array>
 #include <cstdint>
 #include <vector>
 
@@ -50,14 +51,18 @@ public:
     double operator()(const Point4& x) const;
     /// (df/dx, df/dy, df/dz, df/dt'), t' = t * time_scale.
     Point4 gradient(const Point4& x) const;
+    /// f(x), and its gradient into `gradient` when not null: one pass for both.
+    double evaluate(const Point4& x, Point4* gradient) const;
 
     size_t size() const { return size_t(mWeights.size()); }
     const Eigen::VectorXd& weights() const { return mWeights; }
     const Eigen::Matrix<double, 5, 1>& polynomial() const { return mPolynomial; }
 
 private:
-    /// The centres by coordinate (x, y, z, t' in rows): the sums over them run as Eigen's packets.
-    Eigen::Array<double, 4, Eigen::Dynamic> mCentres;
+    /// The centres by coordinate (x, y, z, t'), and the weights again beside them, each padded to
+    /// an even count (a zero weight) for the two-lane loop.
+    std::array<std::vector<double>, 4> mCentres;
+    std::vector<double> mPaddedWeights;
     Eigen::VectorXd mWeights;
     Eigen::Matrix<double, 5, 1> mPolynomial = Eigen::Matrix<double, 5, 1>::Zero();
 };

@@ -1,13 +1,17 @@
 #include "blend/variational/PartitionOfUnity.h"
 
+#include "blend/variational/Constraints.h"
+
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
 #include <array>
+#include <atomic>
 #include <cmath>
 #include <numeric>
 #include <set>
 #include <stdexcept>
+#include <thread>
 
 namespace volmorph::detail::variational {
 namespace {
@@ -71,46 +75,71 @@ std::pair<double, std::vector<size_t>> ball(const std::vector<Constraint>& const
 
 namespace {
 
-/// An even subset for the coarse level: every stride-th pair of constraints (sampleConstraints
-/// writes each surface point followed by its inward partner), about `count` in all.
-std::vector<Constraint> coarseSubset(const std::vector<Constraint>& constraints, size_t count)
+/// The coarse level's constraints: the first `leading`, and an even subset of the others, every
+/// stride-th group (sampleConstraints writes each surface point followed by its partners),
+/// about `count` in all.
+std::vector<Constraint> coarseSubset(const std::vector<Constraint>& constraints, size_t count,
+                                     size_t leading)
 {
-    const size_t stride = (constraints.size() + count - 1) / count;
-    std::vector<Constraint> subset;
-    for (size_t i = 0; i < constraints.size(); ++i)
-        if ((i / 2) % stride == 0) subset.push_back(constraints[i]);
+    const size_t rest = constraints.size() - leading;
+    const size_t stride = (rest + count - 1) / count;
+    std::vector<Constraint> subset(constraints.begin(), constraints.begin() + long(leading));
+    for (size_t i = 0; i < rest; ++i)
+        if ((i / kConstraintsPerPoint) % stride == 0) subset.push_back(constraints[leading + i]);
     return subset;
 }
 
 } // namespace
 
+uint64_t PartitionOfUnity::estimateBytes(size_t count, const PartitionOptions& options)
+{
+    // Measured (BENCHMARKS.md) about 1 KiB a constraint for the balls' fits; twice that here.
+    const uint64_t threads = std::max(1u, std::thread::hardware_concurrency());
+    const uint64_t perThread =
+        denseSolveBytes(4 * options.perPatch) + uint64_t(count) * 2 * sizeof(double);
+    return denseSolveBytes(std::min(count, options.coarse + options.leading)) +
+           uint64_t(count) * 2048 + threads * perThread;
+}
+
 PartitionOfUnity PartitionOfUnity::solve(const std::vector<Constraint>& constraints,
-                                         const PartitionOptions& options)
+                                         const PartitionOptions& options, Interrupter* interrupter)
 {
     PartitionOfUnity pu;
-    if (constraints.size() <= options.coarse) {
+    if (options.leading > constraints.size())
+        throw std::invalid_argument("PartitionOfUnity: more leading constraints than constraints");
+    if (constraints.size() <= options.coarse + options.leading) {
         pu.mCoarse = Interpolant::solveDense(constraints); // exact: no local level
         return pu;
     }
-    pu.mCoarse = Interpolant::solveDense(coarseSubset(constraints, options.coarse));
+    pu.mCoarse =
+        Interpolant::solveDense(coarseSubset(constraints, options.coarse, options.leading));
     std::vector<Constraint> residual = constraints;
     for (Constraint& c : residual) c.value -= pu.mCoarse(c.point);
 
-    Eigen::Vector3d lo = spatial(residual.front().point), hi = lo;
-    for (const Constraint& c : residual) {
+    // The balls' lattice covers the shapes' constraints (not the leading ones, which the coarse
+    // level interpolates and which lie far out), its occupied cells holding about a third of a
+    // ball's constraints each.
+    const std::vector<Constraint> shapes(constraints.begin() + long(options.leading),
+                                         constraints.end());
+    Eigen::Vector3d lo = spatial(shapes.front().point), hi = lo;
+    for (const Constraint& c : shapes) {
         lo = lo.cwiseMin(spatial(c.point));
         hi = hi.cwiseMax(spatial(c.point));
     }
-    // A lattice whose occupied cells hold about a third of a ball's constraints each.
-    const size_t wanted = std::max<size_t>(1, 3 * residual.size() / options.perPatch);
+    const size_t wanted = std::max<size_t>(1, 3 * shapes.size() / options.perPatch);
     double h = (hi - lo).maxCoeff();
-    for (int round = 0; round < 40 && occupiedCells(residual, lo, h) < wanted; ++round) h *= 0.8;
+    for (int round = 0; round < 40 && occupiedCells(shapes, lo, h) < wanted; ++round) h *= 0.8;
     pu.mLo = lo - Eigen::Vector3d::Constant(h);
     pu.mCell = h;
     pu.mCells = ((hi - pu.mLo) / h).array().ceil().cast<int>() + 1;
     const double least = options.overlap * 0.5 * std::sqrt(3.0) * h;
     pu.mPatches.resize(size_t(pu.mCells.prod()));
+    std::atomic<bool> stopped{false};
     tbb::parallel_for(size_t(0), pu.mPatches.size(), [&](size_t n) {
+        if (stopped || (interrupter && interrupter->wasInterrupted())) {
+            stopped = true;
+            return;
+        }
         const int k = int(n % size_t(pu.mCells.z())),
                   j = int(n / size_t(pu.mCells.z())) % pu.mCells.y(),
                   i = int(n / size_t(pu.mCells.z() * pu.mCells.y()));
@@ -121,6 +150,7 @@ PartitionOfUnity PartitionOfUnity::solve(const std::vector<Constraint>& constrai
         for (size_t m : members) local.push_back(residual[m]);
         pu.mPatches[n] = Patch{centre, radius, Interpolant::solveDense(local)};
     });
+    if (stopped) throw Interrupted();
     for (const Patch& p : pu.mPatches) pu.mMaxRadius = std::max(pu.mMaxRadius, p.radius);
     return pu;
 }
@@ -146,7 +176,8 @@ double PartitionOfUnity::local(const Point4& x, Point4* gradient) const
                 const double d = offset.norm() / patch.radius;
                 const double w = wendland(d);
                 if (w <= 0.0) continue;
-                const double r = patch.f(x);
+                Point4 gradR;
+                const double r = patch.f.evaluate(x, gradient ? &gradR : nullptr);
                 sum += w * r;
                 weights += w;
                 if (!gradient) continue;
@@ -155,7 +186,7 @@ double PartitionOfUnity::local(const Point4& x, Point4* gradient) const
                 if (d > 0.0)
                     gradW.head<3>() =
                         (-20.0 * std::pow(1.0 - d, 3) / (patch.radius * patch.radius)) * offset;
-                gradSum += gradW * r + w * patch.f.gradient(x);
+                gradSum += gradW * r + w * gradR;
                 gradWeights += gradW;
             }
     if (weights > 0.0) {
@@ -172,18 +203,24 @@ double PartitionOfUnity::local(const Point4& x, Point4* gradient) const
 
 double PartitionOfUnity::operator()(const Point4& x) const
 {
-    return mCoarse(x) + (mPatches.empty() ? 0.0 : local(x));
+    return evaluate(x, nullptr);
 }
 
 Point4 PartitionOfUnity::gradient(const Point4& x) const
 {
-    Point4 g = mCoarse.gradient(x);
-    if (!mPatches.empty()) {
-        Point4 l;
-        local(x, &l);
-        g += l;
-    }
+    Point4 g;
+    evaluate(x, &g);
     return g;
+}
+
+double PartitionOfUnity::evaluate(const Point4& x, Point4* gradient) const
+{
+    double value = mCoarse.evaluate(x, gradient);
+    if (mPatches.empty()) return value;
+    Point4 l;
+    value += local(x, gradient ? &l : nullptr);
+    if (gradient) *gradient += l;
+    return value;
 }
 
 } // namespace volmorph::detail::variational

@@ -21,6 +21,8 @@
 
 #include "blend/variational/Interpolant.h"
 
+#include <volmorph/core/Interrupter.h>
+
 #include <vector>
 
 namespace volmorph::detail::variational {
@@ -29,20 +31,31 @@ struct PartitionOptions {
     size_t perPatch = 300; ///< constraints each ball holds at least
     double overlap = 1.5;  ///< a ball's least radius, in half-diagonals of a lattice cell
     size_t coarse = 2000;  ///< constraints in the global coarse level (all, when fewer)
+    /// The first `leading` constraints all go into the coarse level, beside its even subset of
+    /// the others (the exterior constraints, which hold the function's sign far from the shapes).
+    size_t leading = 0;
 };
 
 class PartitionOfUnity {
 public:
     /// Throws std::invalid_argument as Interpolant::solveDense does (too few constraints, or
-    /// all at one time).
+    /// all at one time); Interrupted when `interrupter` asks to stop.
     static PartitionOfUnity solve(const std::vector<Constraint>& constraints,
-                                  const PartitionOptions& options = {});
+                                  const PartitionOptions& options = {},
+                                  Interrupter* interrupter = nullptr);
+
+    /// An upper estimate of the bytes solve() holds at its peak for `count` constraints: the
+    /// coarse level's dense solve, the balls' fits (each constraint in a few balls, their centres
+    /// and weights), and each thread's sort and dense solve of one ball.
+    static uint64_t estimateBytes(size_t count, const PartitionOptions& options = {});
 
     /// f(x); outside the lattice (beyond the constraints' box by a cell) the nearest patches'
     /// fits, extended.
     double operator()(const Point4& x) const;
     /// (df/dx, df/dy, df/dz, df/dt'), t' = t * time_scale: the weights' derivatives included.
     Point4 gradient(const Point4& x) const;
+    /// f(x), and its gradient into `gradient` when not null: one pass for both.
+    double evaluate(const Point4& x, Point4* gradient) const;
     size_t patchCount() const { return mPatches.size(); }
 
 private:

@@ -41,74 +41,93 @@ openvdb::FloatGrid::Ptr sliceOverBox(const std::function<double(const Point4&)>&
 
 namespace {
 
-/// Exact values on the lattice box.min + stride * (a, b, c), covering the box.
+using openvdb::Coord;
+
+/// Exact values (and rates) on the lattice box.min + stride * (a, b, c), covering the box; NaN
+/// where not evaluated.
 struct Lattice {
-    openvdb::Coord origin;
+    Coord origin;
     int stride = 1;
-    openvdb::Coord nodes; ///< per axis
-    std::vector<float> values;
+    Coord nodes; ///< per axis
+    std::vector<float> values, rates;
 
-    float at(int a, int b, int c) const
-    {
-        return values[(size_t(a) * nodes.y() + b) * nodes.z() + c];
-    }
+    size_t node(int a, int b, int c) const { return (size_t(a) * nodes.y() + b) * nodes.z() + c; }
+    float at(int a, int b, int c) const { return values[node(a, b, c)]; }
+    Coord cells() const { return nodes - Coord(1); }
 
-    /// Catmull-Rom between the nodes around cell (a, b, c) at (u, v, s) in [0, 1)^3 (nodes
+    /// Catmull-Rom in `v` between the nodes around cell (a, b, c) at (u, v, s) in [0, 1)^3 (nodes
     /// beyond the lattice clamped to its edge): exact for cubics along each axis, its error the
     /// function's fourth derivatives times stride^4.
-    double tricubic(int a, int b, int c, double u, double v, double s) const
+    double tricubic(const std::vector<float>& field, int a, int b, int c,
+                    const std::array<std::array<double, 4>, 3>& w) const
     {
-        const auto weights = [](double x) {
-            return std::array<double, 4>{
-                0.5 * (-x * x * x + 2 * x * x - x), 0.5 * (3 * x * x * x - 5 * x * x + 2),
-                0.5 * (-3 * x * x * x + 4 * x * x + x), 0.5 * (x * x * x - x * x)};
-        };
-        const auto wu = weights(u), wv = weights(v), ws = weights(s);
         const auto clampTo = [](int i, int n) { return std::clamp(i, 0, n - 1); };
         double value = 0.0;
         for (int i = 0; i < 4; ++i)
-            for (int j = 0; j < 4; ++j)
+            for (int j = 0; j < 4; ++j) {
+                double row = 0.0;
+                const size_t base = (size_t(clampTo(a + i - 1, nodes.x())) * nodes.y() +
+                                     size_t(clampTo(b + j - 1, nodes.y()))) *
+                                    nodes.z();
                 for (int k = 0; k < 4; ++k)
-                    value += wu[i] * wv[j] * ws[k] *
-                             at(clampTo(a + i - 1, nodes.x()), clampTo(b + j - 1, nodes.y()),
-                                clampTo(c + k - 1, nodes.z()));
+                    row += w[2][k] * field[base + size_t(clampTo(c + k - 1, nodes.z()))];
+                value += w[0][i] * w[1][j] * row;
+            }
         return value;
     }
 };
 
-/// The lattice's values where `needed(a, b, c)` says (NaN elsewhere); `evaluations` counts them.
-Lattice evaluateLattice(const std::function<double(const Point4&)>& f, double w,
-                        const openvdb::math::Transform& transform, const openvdb::CoordBBox& box,
-                        int stride, const std::function<bool(int, int, int)>& needed,
-                        size_t& evaluations)
+std::array<double, 4> catmullRom(double x)
+{
+    return {0.5 * (-x * x * x + 2 * x * x - x), 0.5 * (3 * x * x * x - 5 * x * x + 2),
+            0.5 * (-3 * x * x * x + 4 * x * x + x), 0.5 * (x * x * x - x * x)};
+}
+
+/// The lattice's values where `needed(a, b, c)` says; `evaluations` counts them.
+Lattice evaluateLattice(const SliceFunction& f, double w, const openvdb::math::Transform& transform,
+                        const openvdb::CoordBBox& box, int stride,
+                        const std::function<bool(int, int, int)>& needed, bool withRates,
+                        size_t& evaluations, Interrupter* interrupter)
 {
     Lattice l;
     l.origin = box.min();
     l.stride = stride;
-    const openvdb::Coord dim = box.dim();
+    const Coord dim = box.dim();
     for (int a = 0; a < 3; ++a) l.nodes[a] = (dim[a] - 1 + stride - 1) / stride + 1;
-    l.values.assign(size_t(l.nodes.x()) * l.nodes.y() * l.nodes.z(),
-                    std::numeric_limits<float>::quiet_NaN());
-    std::atomic<size_t> count{0};
+    const size_t count = size_t(l.nodes.x()) * l.nodes.y() * l.nodes.z();
+    l.values.assign(count, std::numeric_limits<float>::quiet_NaN());
+    if (withRates) l.rates.assign(count, 0.0f);
+    std::atomic<size_t> taken{0};
+    std::atomic<bool> stopped{false};
     tbb::parallel_for(0, l.nodes.x(), [&](int a) {
+        if (stopped || (interrupter && interrupter->wasInterrupted())) {
+            stopped = true;
+            return;
+        }
         size_t here = 0;
         for (int b = 0; b < l.nodes.y(); ++b)
             for (int c = 0; c < l.nodes.z(); ++c) {
                 if (!needed(a, b, c)) continue;
-                const openvdb::Vec3d p = transform.indexToWorld(
-                    l.origin + openvdb::Coord(a * stride, b * stride, c * stride));
-                l.values[(size_t(a) * l.nodes.y() + b) * l.nodes.z() + c] =
-                    float(-f(Point4(p.x(), p.y(), p.z(), w)));
+                const openvdb::Vec3d p =
+                    transform.indexToWorld(l.origin + Coord(a * stride, b * stride, c * stride));
+                double rate = 0.0;
+                const size_t n = l.node(a, b, c);
+                l.values[n] =
+                    float(-f(Point4(p.x(), p.y(), p.z(), w), withRates ? &rate : nullptr));
+                if (withRates) l.rates[n] = float(-rate);
                 ++here;
             }
-        count += here;
+        taken += here;
     });
-    evaluations += count;
+    if (stopped) throw Interrupted();
+    evaluations += taken;
     return l;
 }
 
-/// Whether lattice cell (a, b, c) can hold the zero set within `band` voxels of it.
-bool nearZero(const Lattice& l, int a, int b, int c, double band)
+/// Whether lattice cell (a, b, c) can hold the zero set within `band` voxels of it: its corners
+/// change sign, or the smallest is within reach at the steepest slope between them (never taken
+/// under `leastSlope` per voxel, about a distance's: f is flat between the shapes in places).
+bool nearZero(const Lattice& l, int a, int b, int c, double band, double leastSlope)
 {
     float lo = 1e30f, hi = -1e30f, smallest = 1e30f, steepest = 0.0f;
     for (int corner = 0; corner < 8; ++corner) {
@@ -121,92 +140,169 @@ bool nearZero(const Lattice& l, int a, int b, int c, double band)
     }
     if (lo <= 0.0f && hi >= 0.0f) return true;
     // The steepest edge's slope per voxel, over the cell's diagonal and the band.
-    const double slope = steepest / double(l.stride);
+    const double slope = std::max(double(steepest) / l.stride, leastSlope);
     return smallest <= slope * (std::sqrt(3.0) * l.stride + band);
 }
 
-/// Cells of `l` near the zero set (nearZero), grown by `grow` cells each way.
-std::vector<char> cellsNearZero(const Lattice& l, double band, int grow)
+/// A mask over a lattice's cells.
+struct CellMask {
+    Coord cells;
+    std::vector<char> on;
+
+    bool at(int a, int b, int c) const { return on[(size_t(a) * cells.y() + b) * cells.z() + c]; }
+    /// Whether the cell of this mask holding the cell (a, b, c) of a lattice `ratio` times finer
+    /// is on.
+    bool holds(int a, int b, int c, int ratio) const
+    {
+        return at(std::min(a / ratio, cells.x() - 1), std::min(b / ratio, cells.y() - 1),
+                  std::min(c / ratio, cells.z() - 1));
+    }
+};
+
+/// Cells of `l` near the zero set (nearZero) among those `candidate` allows, grown by `grow`
+/// cells each way.
+CellMask cellsNearZero(const Lattice& l, double band, double leastSlope, int grow,
+                       const std::function<bool(int, int, int)>& candidate)
 {
-    const openvdb::Coord cells = l.nodes - openvdb::Coord(1);
-    const auto index = [&](int a, int b, int c) {
-        return (size_t(a) * cells.y() + b) * cells.z() + c;
-    };
-    std::vector<char> near(size_t(cells.x()) * cells.y() * cells.z(), 0);
+    CellMask m{l.cells(), {}};
+    const Coord& n = m.cells;
+    m.on.assign(size_t(n.x()) * n.y() * n.z(), 0);
+    for (int a = 0; a < n.x(); ++a)
+        for (int b = 0; b < n.y(); ++b)
+            for (int c = 0; c < n.z(); ++c) {
+                if (!candidate(a, b, c) || !nearZero(l, a, b, c, band, leastSlope)) continue;
+                for (int i = std::max(0, a - grow); i <= std::min(n.x() - 1, a + grow); ++i)
+                    for (int j = std::max(0, b - grow); j <= std::min(n.y() - 1, b + grow); ++j)
+                        for (int k = std::max(0, c - grow); k <= std::min(n.z() - 1, c + grow); ++k)
+                            m.on[(size_t(i) * n.y() + j) * n.z() + k] = 1;
+            }
+    return m;
+}
+
+/// The fine lattice's values (and rates) where the screening keeps cells: levels `kRatio` times
+/// coarser each, the coarsest over the whole box.
+constexpr int kLevels = 3, kRatio = 4;
+
+struct Screened {
+    Lattice fine;
+    CellMask kept; ///< the fine lattice's cells near the zero set
+};
+
+Screened screen(const SliceFunction& f, double w, const openvdb::math::Transform& transform,
+                const openvdb::CoordBBox& box, int stride, double band, bool withRates,
+                size_t& evaluations, Interrupter* interrupter)
+{
+    const double leastSlope = transform.voxelSize()[0]; // a distance's, per voxel
+    int levelStride = stride;
+    for (int level = 1; level < kLevels; ++level) levelStride *= kRatio;
+    std::function<bool(int, int, int)> needed = [](int, int, int) { return true; };
+    std::function<bool(int, int, int)> candidate = needed;
+    CellMask nodesNear, cellsNear;
+    for (int level = 0;; ++level, levelStride /= kRatio) {
+        const bool last = level == kLevels - 1;
+        Lattice l = evaluateLattice(f, w, transform, box, levelStride, needed, last && withRates,
+                                    evaluations, interrupter);
+        if (last) return Screened{l, cellsNearZero(l, band, leastSlope, 0, candidate)};
+        // The next level tests the cells kept here grown by one (the test is not a bound), and
+        // evaluates its nodes one cell further (a cell's neighbours and the tricubic's stencil).
+        CellMask cells = cellsNearZero(l, band, leastSlope, 1, candidate);
+        nodesNear = cellsNearZero(l, band, leastSlope, 2, candidate); // before cellsNear changes
+        cellsNear = std::move(cells);
+        needed = [&nodesNear](int a, int b, int c) { return nodesNear.holds(a, b, c, kRatio); };
+        candidate = [&cellsNear](int a, int b, int c) { return cellsNear.holds(a, b, c, kRatio); };
+    }
+}
+
+/// The leaves (their origins, in order) holding voxels of the kept cells and their neighbours.
+std::vector<Coord> leavesWritten(const Lattice& l, const CellMask& kept,
+                                 const openvdb::CoordBBox& box)
+{
+    const Coord lo(box.min().x() >> 3, box.min().y() >> 3, box.min().z() >> 3);
+    const Coord hi(box.max().x() >> 3, box.max().y() >> 3, box.max().z() >> 3);
+    const Coord dim = hi - lo + Coord(1);
+    std::vector<char> mark(size_t(dim.x()) * dim.y() * dim.z(), 0);
+    const Coord cells = l.cells();
     for (int a = 0; a < cells.x(); ++a)
         for (int b = 0; b < cells.y(); ++b)
             for (int c = 0; c < cells.z(); ++c) {
-                if (!nearZero(l, a, b, c, band)) continue;
-                for (int i = std::max(0, a - grow); i <= std::min(cells.x() - 1, a + grow); ++i)
-                    for (int j = std::max(0, b - grow); j <= std::min(cells.y() - 1, b + grow); ++j)
-                        for (int k = std::max(0, c - grow); k <= std::min(cells.z() - 1, c + grow);
-                             ++k)
-                            near[index(i, j, k)] = 1;
+                if (!kept.at(a, b, c)) continue;
+                // The voxels of the cell and its neighbours, clipped to the box, in leaves.
+                Coord first, last;
+                const int abc[3] = {a, b, c};
+                for (int axis = 0; axis < 3; ++axis) {
+                    const int v0 = l.origin[axis] + (abc[axis] - 1) * l.stride;
+                    const int v1 = l.origin[axis] + (abc[axis] + 2) * l.stride - 1;
+                    first[axis] = (std::max(v0, box.min()[axis]) >> 3) - lo[axis];
+                    last[axis] = (std::min(v1, box.max()[axis]) >> 3) - lo[axis];
+                }
+                for (int i = first.x(); i <= last.x(); ++i)
+                    for (int j = first.y(); j <= last.y(); ++j)
+                        for (int k = first.z(); k <= last.z(); ++k)
+                            mark[(size_t(i) * dim.y() + j) * dim.z() + k] = 1;
             }
-    return near;
+    std::vector<Coord> origins;
+    for (int i = 0; i < dim.x(); ++i)
+        for (int j = 0; j < dim.y(); ++j)
+            for (int k = 0; k < dim.z(); ++k)
+                if (mark[(size_t(i) * dim.y() + j) * dim.z() + k])
+                    origins.push_back(Coord((lo.x() + i) * 8, (lo.y() + j) * 8, (lo.z() + k) * 8));
+    return origins;
 }
 
 } // namespace
 
-openvdb::FloatGrid::Ptr sliceNearZero(const std::function<double(const Point4&)>& f, double w,
-                                      const openvdb::math::Transform::Ptr& transform,
-                                      const openvdb::CoordBBox& box, int stride, double bandVoxels,
-                                      size_t* evaluations)
+NearZeroSlice sliceNearZero(const SliceFunction& f, double w,
+                            const openvdb::math::Transform::Ptr& transform,
+                            const openvdb::CoordBBox& box, int stride, double bandVoxels,
+                            bool withRates, Interrupter* interrupter)
 {
-    // Screening: exact values every 4 strides; the fine lattice only in the coarse cells near the
-    // zero set, grown by two (a fine cell's tricubic reads a node beyond it).
-    const int coarseStride = 4 * stride;
-    size_t count = 0;
-    const Lattice coarse = evaluateLattice(
-        f, w, *transform, box, coarseStride, [](int, int, int) { return true; }, count);
-    const std::vector<char> nodesNear = cellsNearZero(coarse, bandVoxels, 2);
-    const std::vector<char> cellsNear = cellsNearZero(coarse, bandVoxels, 1);
-    const openvdb::Coord coarseCells = coarse.nodes - openvdb::Coord(1);
-    const auto coarseCell = [&](const std::vector<char>& near, int a, int b, int c) {
-        const int i = std::min(a / 4, coarseCells.x() - 1),
-                  j = std::min(b / 4, coarseCells.y() - 1),
-                  k = std::min(c / 4, coarseCells.z() - 1);
-        return bool(near[(size_t(i) * coarseCells.y() + j) * coarseCells.z() + k]);
+    NearZeroSlice out;
+    const Screened s =
+        screen(f, w, *transform, box, stride, bandVoxels, withRates, out.evaluations, interrupter);
+    const Lattice& l = s.fine;
+    const Coord cells = l.cells();
+    // A voxel is written when its cell or a neighbour is kept; leaf by leaf, in parallel.
+    const auto written = [&](int a, int b, int c) {
+        for (int i = std::max(0, a - 1); i <= std::min(cells.x() - 1, a + 1); ++i)
+            for (int j = std::max(0, b - 1); j <= std::min(cells.y() - 1, b + 1); ++j)
+                for (int k = std::max(0, c - 1); k <= std::min(cells.z() - 1, c + 1); ++k)
+                    if (s.kept.at(i, j, k)) return true;
+        return false;
     };
-    const Lattice l = evaluateLattice(
-        f, w, *transform, box, stride,
-        [&](int a, int b, int c) { return coarseCell(nodesNear, a, b, c); }, count);
-    if (evaluations) *evaluations = count;
-    const openvdb::Coord cells = l.nodes - openvdb::Coord(1);
-    std::vector<char> kept(size_t(cells.x()) * cells.y() * cells.z(), 0);
-    const auto index = [&](int a, int b, int c) {
-        return (size_t(a) * cells.y() + b) * cells.z() + c;
-    };
-    for (int a = 0; a < cells.x(); ++a)
-        for (int b = 0; b < cells.y(); ++b)
-            for (int c = 0; c < cells.z(); ++c)
-                if (coarseCell(cellsNear, a, b, c) && nearZero(l, a, b, c, bandVoxels))
-                    kept[index(a, b, c)] = 1;
-    auto grid = openvdb::FloatGrid::create(float(bandVoxels * transform->voxelSize()[0]));
-    auto acc = grid->getAccessor();
-    for (int a = 0; a < cells.x(); ++a)
-        for (int b = 0; b < cells.y(); ++b)
-            for (int c = 0; c < cells.z(); ++c) {
-                bool any = false; // the cell or a neighbour kept
-                for (int da = -1; da <= 1 && !any; ++da)
-                    for (int db = -1; db <= 1 && !any; ++db)
-                        for (int dc = -1; dc <= 1 && !any; ++dc) {
-                            const int i = a + da, j = b + db, k = c + dc;
-                            any = i >= 0 && j >= 0 && k >= 0 && i < cells.x() && j < cells.y() &&
-                                  k < cells.z() && kept[index(i, j, k)];
-                        }
-                if (!any) continue;
-                for (int x = 0; x < stride; ++x)
-                    for (int y = 0; y < stride; ++y)
-                        for (int z = 0; z < stride; ++z)
-                            acc.setValue(l.origin + openvdb::Coord(a * stride + x, b * stride + y,
-                                                                   c * stride + z),
-                                         float(l.tricubic(a, b, c, double(x) / stride,
-                                                          double(y) / stride, double(z) / stride)));
-            }
-    grid->setTransform(transform);
-    grid->setGridClass(openvdb::GRID_LEVEL_SET);
-    return grid;
+    const std::vector<Coord> origins = leavesWritten(l, s.kept, box);
+    using Leaf = openvdb::FloatTree::LeafNodeType;
+    std::vector<std::unique_ptr<Leaf>> values(origins.size()), rates(origins.size());
+    const float background = float(bandVoxels * transform->voxelSize()[0]);
+    tbb::parallel_for(size_t(0), origins.size(), [&](size_t n) {
+        auto value = std::make_unique<Leaf>(origins[n], background, false);
+        auto rate = withRates ? std::make_unique<Leaf>(origins[n], 0.0f, false) : nullptr;
+        for (openvdb::Index i = 0; i < Leaf::SIZE; ++i) {
+            const Coord v = origins[n] + Leaf::offsetToLocalCoord(i) - l.origin;
+            if (!box.isInside(v + l.origin)) continue;
+            const int a = v.x() / stride, b = v.y() / stride, c = v.z() / stride;
+            if (a >= cells.x() || b >= cells.y() || c >= cells.z() || !written(a, b, c)) continue;
+            const std::array<std::array<double, 4>, 3> weights{
+                catmullRom(double(v.x() - a * stride) / stride),
+                catmullRom(double(v.y() - b * stride) / stride),
+                catmullRom(double(v.z() - c * stride) / stride)};
+            value->setValueOn(i, float(l.tricubic(l.values, a, b, c, weights)));
+            if (rate) rate->setValueOn(i, float(l.tricubic(l.rates, a, b, c, weights)));
+        }
+        values[n] = std::move(value);
+        rates[n] = std::move(rate);
+    });
+    out.values = openvdb::FloatGrid::create(background);
+    for (auto& leaf : values)
+        if (!leaf->isEmpty()) out.values->tree().addLeaf(leaf.release());
+    out.values->setTransform(transform);
+    out.values->setGridClass(openvdb::GRID_LEVEL_SET);
+    if (withRates) {
+        out.rates = openvdb::FloatGrid::create(0.0f);
+        for (auto& leaf : rates)
+            if (!leaf->isEmpty()) out.rates->tree().addLeaf(leaf.release());
+        out.rates->setTransform(transform);
+    }
+    return out;
 }
 
 } // namespace volmorph::detail::variational

@@ -1,15 +1,21 @@
-// The variational function's slice at one time over a box of voxels, evaluated at every voxel: the
-// reference that the frame's sparse domain (to come) is checked against, and what the topology
-// tests of issue 40 read.
+// The variational function's slice at one time: over a box of voxels, evaluated at every voxel
+// (the reference the tests compare against), or near its zero set only, from a coarse lattice (a
+// frame's).
 #pragma once
 
 #include "blend/variational/Interpolant.h"
+
+#include <volmorph/core/Interrupter.h>
 
 #include <openvdb/openvdb.h>
 
 #include <functional>
 
 namespace volmorph::detail::variational {
+
+/// The function at a point (x, y, z world units, w = t * time_scale) and, when `rate` is not
+/// null, its derivative along w there.
+using SliceFunction = std::function<double(const Point4&, double* rate)>;
 
 /// -f(x, y, z, w) at every voxel of `box` (index space of `transform`), so negative inside as
 /// volmorph's signed distances are (not a distance: the function's own values), every voxel
@@ -18,17 +24,28 @@ openvdb::FloatGrid::Ptr sliceOverBox(const std::function<double(const Point4&)>&
                                      const openvdb::math::Transform::Ptr& transform,
                                      const openvdb::CoordBBox& box);
 
-/// The same slice near its zero set only, from exact values on a lattice every `stride` voxels:
-/// a lattice cell is kept when its corners' values change sign, or when the smallest of them is
+struct NearZeroSlice {
+    /// -f near its zero set, background +bandVoxels voxels (world units), level set class.
+    openvdb::FloatGrid::Ptr values;
+    /// -df/dw at the same voxels (dimensionless: world units of f per world unit of w), when
+    /// asked for.
+    openvdb::FloatGrid::Ptr rates;
+    size_t evaluations = 0; ///< exact values taken
+};
+
+/// The slice near its zero set only, from exact values on a lattice every `stride` voxels: a
+/// lattice cell is kept when its corners' values change sign, or when the smallest of them is
 /// within `bandVoxels` of zero at the steepest slope between its corners (f grows about as the
 /// distance near the shapes, its normal constraints' values being their offsets); kept cells and
 /// their neighbours get every voxel, tricubic (Catmull-Rom) between the lattice's values: at a
 /// stride of 2, within 0.01 voxel of the exact values on a sphere becoming two (4: 0.15; trilinear
-/// at 2: 0.15, at 4: 0.95). The fine lattice is evaluated only in the cells of a lattice 4 strides
-/// apart that the same test keeps, grown by two. `evaluations` counts the exact values taken.
-openvdb::FloatGrid::Ptr sliceNearZero(const std::function<double(const Point4&)>& f, double w,
-                                      const openvdb::math::Transform::Ptr& transform,
-                                      const openvdb::CoordBBox& box, int stride, double bandVoxels,
-                                      size_t* evaluations = nullptr);
+/// at 2: 0.15, at 4: 0.95). The lattice is screened first, coarsest first: 16 strides apart over
+/// the box, then 4 strides apart in the cells the same test keeps (grown by two), then every
+/// stride in theirs. With `withRates`, df/dw is taken at the same lattice points and interpolated
+/// the same way. Throws Interrupted when `interrupter` asks to stop.
+NearZeroSlice sliceNearZero(const SliceFunction& f, double w,
+                            const openvdb::math::Transform::Ptr& transform,
+                            const openvdb::CoordBBox& box, int stride, double bandVoxels,
+                            bool withRates = false, Interrupter* interrupter = nullptr);
 
 } // namespace volmorph::detail::variational

@@ -1,0 +1,315 @@
+#include "blend/VariationalBlend.h"
+
+#include "blend/ExtendedDistance.h"
+#include "blend/Redistance.h"
+#include "blend/variational/Constraints.h"
+#include "blend/variational/PartitionOfUnity.h"
+#include "blend/variational/Slice.h"
+
+#include <volmorph/core/Diagnostics.h>
+#include <volmorph/core/MemoryLimit.h>
+#include <volmorph/Schedule.h>
+
+#include <openvdb/tools/Interpolation.h>
+#include <openvdb/tools/SignedFloodFill.h>
+#include <openvdb/tree/LeafManager.h>
+
+#include <tbb/parallel_invoke.h>
+
+#include <algorithm>
+#include <cstdio>
+#include <limits>
+#include <stdexcept>
+#include <string>
+
+namespace volmorph::detail {
+namespace {
+
+using openvdb::Coord;
+using openvdb::CoordBBox;
+using variational::Constraint;
+using variational::PartitionOfUnity;
+using variational::Point4;
+using Sampler = openvdb::tools::BoxSampler;
+
+/// The frame's exact values lie on a lattice this many voxels apart, tricubic between: within
+/// 0.01 voxel of the exact slice near its zero set (Slice.h).
+constexpr int kStride = 2;
+/// The fog's ramp across the surface, voxels (as sdf mode's).
+constexpr float kRampVoxels = 1.5f;
+/// Exterior constraints per edge of the box (kExterior^3 - (kExterior - 2)^3 on its faces).
+constexpr int kExterior = 9;
+/// |grad f| is taken no smaller than this (world units of f per world unit) in the velocity: where
+/// the topology changes the zero set's normal speed has no bound.
+constexpr double kLeastGradient = 0.05;
+
+struct Shape {
+    const VolumeSet* volume;
+    double t;
+};
+
+/// The index-space box of the shapes' narrow bands together.
+CoordBBox bandBox(const std::vector<Shape>& shapes)
+{
+    CoordBBox box;
+    for (const Shape& s : shapes) box.expand(s.volume->sdf->evalActiveVoxelBoundingBox());
+    return box;
+}
+
+/// Exterior constraints (an extension: Turk and O'Brien place none): points on the faces of `box`
+/// (index space) at w, each with minus its distance to the shape (world units), so that f stays
+/// negative, outside, all around the shapes and the zero set never reaches the box (without them
+/// f turned positive far from the dino of dino-to-eight at 128 voxels across, and the frame's
+/// inside leaked to the whole world).
+std::vector<Constraint> exteriorConstraints(const CoordBBox& box,
+                                            const openvdb::math::Transform& transform,
+                                            const ExtendedDistance& distance, double w)
+{
+    ExtendedDistance::Reader<Sampler> d(distance);
+    std::vector<Constraint> out;
+    const openvdb::Vec3d lo = box.min().asVec3d(), size = (box.max() - box.min()).asVec3d();
+    for (int i = 0; i < kExterior; ++i)
+        for (int j = 0; j < kExterior; ++j)
+            for (int k = 0; k < kExterior; ++k) {
+                const auto edge = [](int n) { return n == 0 || n == kExterior - 1; };
+                if (!edge(i) && !edge(j) && !edge(k)) continue;
+                const openvdb::Vec3d p =
+                    lo + size * openvdb::Vec3d(i, j, k) / double(kExterior - 1);
+                const openvdb::Vec3d x = transform.indexToWorld(p);
+                out.push_back({Point4(x.x(), x.y(), x.z(), w), -double(d(p))});
+            }
+    return out;
+}
+
+UserError variationalError(const VariationalSpec& spec, const std::string& message)
+{
+    return UserError(spec.where.line > 0 ? spec.where : SourceLocation{"variational"}, message);
+}
+
+/// Refuses a solve whose estimated memory exceeds what the limit leaves.
+void checkMemory(const VariationalSpec& spec, size_t shapes, uint64_t limit)
+{
+    const size_t count = variational::kConstraintsPerPoint * size_t(spec.constraints) * shapes;
+    const uint64_t need = PartitionOfUnity::estimateBytes(count), resident = residentBytes();
+    if (resident + need <= limit) return;
+    const auto gib = [](uint64_t b) { return double(b) / double(1ull << 30); };
+    char text[400];
+    std::snprintf(text, sizeof text,
+                  "variational.constraints: %d per shape (%zu constraints over %zu shapes) need "
+                  "about %.2f GiB to solve, over the memory limit of %.2f GiB (%.2f GiB in use); "
+                  "lower variational.constraints or raise --memory-limit",
+                  spec.constraints, count, shapes, gib(need), gib(limit), gib(resident));
+    throw variationalError(spec, text);
+}
+
+class VariationalBlend final : public BlendMethod {
+public:
+    explicit VariationalBlend(const BlendSetup& setup)
+        : mSource(setup.source), mTarget(setup.target), mSpec(setup.spec)
+    {
+        std::vector<Shape> shapes{{&mSource, 0.0}, {&mTarget, 1.0}};
+        if (setup.influences)
+            for (const TimedVolume& i : *setup.influences) shapes.push_back({&i.volume, i.t});
+        for (const Shape& s : shapes)
+            if (!s.volume->sdf)
+                throw std::invalid_argument("variational blending needs an sdf grid per shape");
+        const VariationalSpec& spec = mSpec.variational;
+        mVoxel = mSource.voxelSize();
+        mWidth = std::min(mSource.sdf->background(), mTarget.sdf->background());
+        const CoordBBox shapesBox = bandBox(shapes);
+        const Coord dim = shapesBox.dim();
+        mTimeScale = spec.timeScale.value_or(kVariationalTimeScale * mVoxel *
+                                             double(std::max({dim.x(), dim.y(), dim.z()})));
+        checkMemory(spec, shapes.size(), setup.memoryLimitBytes);
+        // The in-betweens lie near the shapes' box: a margin of an eighth, at least 8 voxels.
+        const Coord margin(8 + dim.x() / 8, 8 + dim.y() / 8, 8 + dim.z() / 8);
+        mBox = CoordBBox(shapesBox.min() - margin, shapesBox.max() + margin);
+        tbb::parallel_invoke(
+            [&] {
+                mFarSource =
+                    std::make_unique<const ExtendedDistance>(mSource.sdf, mBox, setup.interrupter);
+            },
+            [&] {
+                mFarTarget =
+                    std::make_unique<const ExtendedDistance>(mTarget.sdf, mBox, setup.interrupter);
+            });
+        const openvdb::math::Transform& xform = mSource.density->transform();
+        std::vector<Constraint> constraints = exteriorConstraints(mBox, xform, *mFarSource, 0.0);
+        const std::vector<Constraint> far =
+            exteriorConstraints(mBox, xform, *mFarTarget, mTimeScale);
+        constraints.insert(constraints.end(), far.begin(), far.end());
+        variational::PartitionOptions options;
+        options.leading = constraints.size();
+        const std::vector<Constraint> shapeConstraints = sample(shapes);
+        constraints.insert(constraints.end(), shapeConstraints.begin(), shapeConstraints.end());
+        solve(constraints, options, setup.interrupter);
+    }
+
+    BlendedFrame frame(const BlendRequest& r, OutputLeaves& leaves) const override
+    {
+        const bool velocity = r.velocityScale > 0.0;
+        const auto f = [this](const Point4& p, double* rate) {
+            if (!rate) return mFunction(p);
+            Point4 g;
+            const double value = mFunction.evaluate(p, &g);
+            *rate = g[3];
+            return value;
+        };
+        variational::NearZeroSlice slice =
+            variational::sliceNearZero(f, r.t * mTimeScale, mSource.density->transformPtr(), mBox,
+                                       kStride, mWidth / mVoxel + 1.0, velocity, r.interrupter);
+        std::vector<std::unique_ptr<openvdb::Vec3STree::LeafNodeType>> velocities;
+        if (velocity) velocities = normalMotion(slice, r.velocityScale / mVoxel);
+        std::vector<OutputLeaves::ValueLeaf*> values;
+        slice.values->tree().stealNodes(values);
+        for (size_t i = 0; i < values.size(); ++i) {
+            ExtraLeaves extras;
+            if (velocity) extras.velocity = std::move(velocities[i]);
+            leaves.keep(std::unique_ptr<OutputLeaves::ValueLeaf>(values[i]),
+                        leaves.make(values[i]->origin(), 0.0f).second, std::move(extras));
+        }
+        return assemble(r, leaves, velocity, slice.evaluations);
+    }
+
+private:
+    /// Each shape's constraints at its time.
+    std::vector<Constraint> sample(const std::vector<Shape>& shapes) const
+    {
+        const VariationalSpec& spec = mSpec.variational;
+        std::vector<Constraint> all;
+        for (const Shape& s : shapes) {
+            try {
+                const std::vector<Constraint> c = variational::sampleConstraints(
+                    *s.volume->sdf, size_t(spec.constraints), spec.normalOffsetVoxels * mVoxel,
+                    s.t * mTimeScale);
+                all.insert(all.end(), c.begin(), c.end());
+            } catch (const std::invalid_argument& e) {
+                throw variationalError(spec,
+                                       "the shape at t = " + std::to_string(s.t) + ": " + e.what());
+            }
+        }
+        return all;
+    }
+
+    void solve(const std::vector<Constraint>& constraints,
+               const variational::PartitionOptions& options, Interrupter* interrupter)
+    {
+        try {
+            mFunction = PartitionOfUnity::solve(constraints, options, interrupter);
+        } catch (const std::invalid_argument& e) {
+            throw variationalError(mSpec.variational, e.what());
+        }
+    }
+
+    /// The zero set's normal motion, -f_t grad f / |grad f|^2, at the slice's voxels, in world
+    /// units per second (`perSecond`: world units per second of one world unit per unit t); one
+    /// leaf per leaf of the slice's values, in their order.
+    std::vector<std::unique_ptr<openvdb::Vec3STree::LeafNodeType>>
+    normalMotion(const variational::NearZeroSlice& slice, double perSecond) const
+    {
+        using VelocityLeaf = openvdb::Vec3STree::LeafNodeType;
+        openvdb::tree::LeafManager<const openvdb::FloatTree> manager(slice.values->tree());
+        std::vector<std::unique_ptr<VelocityLeaf>> out(manager.leafCount());
+        const double inv2dx = 0.5 / mVoxel;
+        manager.foreach ([&](const OutputLeaves::ValueLeaf& leaf, size_t n) {
+            auto b = slice.values->getConstAccessor();
+            auto rates = slice.rates->getConstAccessor();
+            auto v = std::make_unique<VelocityLeaf>(leaf.origin(), openvdb::Vec3s(0.0f), false);
+            for (auto it = leaf.cbeginValueOn(); it; ++it) {
+                const Coord c = it.getCoord();
+                const openvdb::Vec3d g(
+                    b.getValue(c.offsetBy(1, 0, 0)) - b.getValue(c.offsetBy(-1, 0, 0)),
+                    b.getValue(c.offsetBy(0, 1, 0)) - b.getValue(c.offsetBy(0, -1, 0)),
+                    b.getValue(c.offsetBy(0, 0, 1)) - b.getValue(c.offsetBy(0, 0, -1)));
+                const openvdb::Vec3d grad = g * inv2dx;
+                const double ft = double(rates.getValue(c)) * mTimeScale; // per unit t
+                const double norm2 = std::max(grad.lengthSqr(), kLeastGradient * kLeastGradient);
+                v->setValueOn(it.pos(), openvdb::Vec3s(grad * (-ft * perSecond / norm2)));
+            }
+            out[n] = std::move(v);
+        });
+        return out;
+    }
+
+    /// The grids from the kept leaves: the interior by sign, the band rebuilt as distances with
+    /// its fog, colour on the band, the velocity cut to the band.
+    BlendedFrame assemble(const BlendRequest& r, OutputLeaves& leaves, bool velocity,
+                          size_t evaluations) const
+    {
+        BlendedFrame out;
+        openvdb::FloatGrid::Ptr values = openvdb::FloatGrid::create(mWidth);
+        values->setTransform(mSource.density->transform().copy());
+        values->setGridClass(openvdb::GRID_LEVEL_SET);
+        out.grids.color = openvdb::Vec3SGrid::create(leaves.background());
+        openvdb::Vec3SGrid::Ptr motion = openvdb::Vec3SGrid::create(openvdb::Vec3s(0.0f));
+        ExtraTrees trees;
+        if (velocity) trees.velocity = &motion->tree();
+        out.keptLeaves = leaves.size();
+        leaves.moveInto(values->tree(), out.grids.color->tree(), -mWidth, trees);
+        openvdb::tools::signedFloodFill(values->tree());
+        const RedistanceBands bands{float(mVoxel), mWidth,
+                                    [](const Coord&) { return std::numeric_limits<float>::max(); }};
+        out.grids.density = redistance(*values, bands, kRampVoxels * float(mVoxel));
+        colorBand(*values, float(scheduleValue(mSpec.color, r.t)), *out.grids.color);
+        if (velocity) {
+            motion->tree().topologyIntersection(values->tree());
+            out.grids.velocity = motion;
+        }
+        out.grids.sdf = values;
+        out.blendSamples = evaluations;
+        return out;
+    }
+
+    /// Each side's colour at its surface point nearest the voxel (p - d grad d / |grad d| on its
+    /// extended distance), mixed by tauColor, at the band's voxels.
+    void colorBand(const openvdb::FloatGrid& sdf, float tauColor, openvdb::Vec3SGrid& color) const
+    {
+        openvdb::tree::LeafManager<openvdb::Vec3STree> manager(color.tree());
+        manager.foreach ([&](openvdb::Vec3STree::LeafNodeType& leaf, size_t) {
+            const auto* band = sdf.tree().probeConstLeaf(leaf.origin());
+            if (!band) {
+                leaf.setValuesOff();
+                return;
+            }
+            ExtendedDistance::Reader<Sampler> dS(*mFarSource), dT(*mFarTarget);
+            auto cS = mSource.color->getConstAccessor();
+            auto cT = mTarget.color->getConstAccessor();
+            leaf.setValueMask(band->getValueMask());
+            for (auto it = leaf.beginValueOn(); it; ++it) {
+                const openvdb::Vec3R p = it.getCoord().asVec3d();
+                const openvdb::Vec3s s = Sampler::sample(cS, nearestSurfacePoint(dS, p));
+                const openvdb::Vec3s t = Sampler::sample(cT, nearestSurfacePoint(dT, p));
+                it.setValue(s + tauColor * (t - s));
+            }
+        });
+    }
+
+    /// p - d grad d / |grad d| (index space), grad d by central differences.
+    openvdb::Vec3R nearestSurfacePoint(ExtendedDistance::Reader<Sampler>& d,
+                                       const openvdb::Vec3R& p) const
+    {
+        const openvdb::Vec3R g(d(p + openvdb::Vec3R(1, 0, 0)) - d(p - openvdb::Vec3R(1, 0, 0)),
+                               d(p + openvdb::Vec3R(0, 1, 0)) - d(p - openvdb::Vec3R(0, 1, 0)),
+                               d(p + openvdb::Vec3R(0, 0, 1)) - d(p - openvdb::Vec3R(0, 0, 1)));
+        const double length = g.length();
+        if (length < 1e-9) return p;
+        return p - g * (double(d(p)) / mVoxel / length);
+    }
+
+    VolumeSet mSource, mTarget;
+    BlendSpec mSpec;
+    double mVoxel = 1.0, mTimeScale = 1.0;
+    float mWidth = 0.0f;
+    CoordBBox mBox; ///< where the in-betweens are looked for (index space)
+    PartitionOfUnity mFunction;
+    std::unique_ptr<const ExtendedDistance> mFarSource, mFarTarget;
+};
+
+} // namespace
+
+std::unique_ptr<const BlendMethod> makeVariationalBlend(const BlendSetup& setup)
+{
+    return std::make_unique<VariationalBlend>(setup);
+}
+
+} // namespace volmorph::detail
