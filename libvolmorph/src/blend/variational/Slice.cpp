@@ -181,7 +181,7 @@ CellMask cellsNearZero(const Lattice& l, double band, double leastSlope, int gro
 
 /// The fine lattice's values (and rates) where the screening keeps cells: levels `kRatio` times
 /// coarser each, the coarsest over the whole box.
-constexpr int kLevels = 3, kRatio = 4;
+constexpr int kLevels = 5, kRatio = 2;
 
 struct Screened {
     Lattice fine;
@@ -203,10 +203,10 @@ Screened screen(const SliceFunction& f, double w, const openvdb::math::Transform
         Lattice l = evaluateLattice(f, w, transform, box, levelStride, needed, last && withRates,
                                     evaluations, interrupter);
         if (last) return Screened{l, cellsNearZero(l, band, leastSlope, 0, candidate)};
-        // The next level tests the cells kept here grown by one (the test is not a bound), and
-        // evaluates its nodes one cell further (a cell's neighbours and the tricubic's stencil).
-        CellMask cells = cellsNearZero(l, band, leastSlope, 1, candidate);
-        nodesNear = cellsNearZero(l, band, leastSlope, 2, candidate); // before cellsNear changes
+        // The next level tests the cells kept here, and evaluates its nodes one cell further (a
+        // cell's neighbours and the tricubic's stencil).
+        CellMask cells = cellsNearZero(l, band, leastSlope, 0, candidate);
+        nodesNear = cellsNearZero(l, band, leastSlope, 1, candidate); // before cellsNear changes
         cellsNear = std::move(cells);
         needed = [&nodesNear](int a, int b, int c) { return nodesNear.holds(a, b, c, kRatio); };
         candidate = [&cellsNear](int a, int b, int c) { return cellsNear.holds(a, b, c, kRatio); };
