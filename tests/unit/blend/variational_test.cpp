@@ -117,6 +117,25 @@ TEST(Variational, GradientIsTheDerivative)
     }
 }
 
+// The AVX2 build of the sums and the SSE2 one give the same bits (frames do not depend on the
+// machine's vector unit).
+TEST(Variational, BothBuildsOfTheSumsAgreeBitForBit)
+{
+    if (!__builtin_cpu_supports("avx2")) GTEST_SKIP() << "no AVX2 here: one build only";
+    std::mt19937 rng(5);
+    std::uniform_real_distribution<double> u(-1.0, 1.0);
+    std::vector<Constraint> c;
+    for (int i = 0; i < 203; ++i) c.push_back({Point4(u(rng), u(rng), u(rng), u(rng)), u(rng)});
+    const Interpolant f = Interpolant::solveDense(c);
+    for (int i = 0; i < 1000; ++i) {
+        const Point4 p(u(rng), u(rng), u(rng), u(rng));
+        Point4 g, h;
+        ASSERT_EQ(f.evaluate(p, &g), f.evaluateBaseline(p, &h));
+        for (int k = 0; k < 4; ++k) ASSERT_EQ(g[k], h[k]);
+        ASSERT_EQ(f.evaluate(p, nullptr), f.evaluateBaseline(p, nullptr));
+    }
+}
+
 TEST(Variational, ConstraintsLieOnTheSurfaceEvenly)
 {
     const double voxel = 0.02, radius = 0.5;

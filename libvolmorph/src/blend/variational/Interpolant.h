@@ -51,16 +51,21 @@ public:
     double operator()(const Point4& x) const;
     /// (df/dx, df/dy, df/dz, df/dt'), t' = t * time_scale.
     Point4 gradient(const Point4& x) const;
-    /// f(x), and its gradient into `gradient` when not null: one pass for both.
+    /// f(x), and its gradient into `gradient` when not null: one pass for both, with AVX2 where
+    /// the machine has it.
     double evaluate(const Point4& x, Point4* gradient) const;
+    /// The same through the SSE2 build alone: the test that both give the same bits calls it.
+    double evaluateBaseline(const Point4& x, Point4* gradient) const;
 
     size_t size() const { return size_t(mWeights.size()); }
     const Eigen::VectorXd& weights() const { return mWeights; }
     const Eigen::Matrix<double, 5, 1>& polynomial() const { return mPolynomial; }
 
 private:
+    double sum(const Point4& x, Point4* gradient, bool avx2) const;
+
     /// The centres by coordinate (x, y, z, t'), and the weights again beside them, each padded to
-    /// an even count (a zero weight) for the two-lane loop.
+    /// a multiple of 4 (a zero weight) for the four-lane loop.
     std::array<std::vector<double>, 4> mCentres;
     std::vector<double> mPaddedWeights;
     Eigen::VectorXd mWeights;
