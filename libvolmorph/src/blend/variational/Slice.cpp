@@ -125,8 +125,11 @@ Lattice evaluateLattice(const SliceFunction& f, double w, const openvdb::math::T
 }
 
 /// Whether lattice cell (a, b, c) can hold the zero set within `band` voxels of it: its corners
-/// change sign, or the smallest is within reach at the steepest slope between them (never taken
-/// under `leastSlope` per voxel, about a distance's: f is flat between the shapes in places).
+/// change sign, or the smallest is within a stride and the band at the steepest slope between
+/// them (never taken under `leastSlope` per voxel, about a distance's: f is flat between the
+/// shapes in places). Were f linear across the cell its smallest |f| would be at a corner; the
+/// stride is the allowance for its curvature (the cell's diagonal kept 30% more values, and no
+/// voxel more within 1.5 voxels of the zero set, BENCHMARKS.md).
 bool nearZero(const Lattice& l, int a, int b, int c, double band, double leastSlope)
 {
     float lo = 1e30f, hi = -1e30f, smallest = 1e30f, steepest = 0.0f;
@@ -141,7 +144,7 @@ bool nearZero(const Lattice& l, int a, int b, int c, double band, double leastSl
     if (lo <= 0.0f && hi >= 0.0f) return true;
     // The steepest edge's slope per voxel, over the cell's diagonal and the band.
     const double slope = std::max(double(steepest) / l.stride, leastSlope);
-    return smallest <= slope * (std::sqrt(3.0) * l.stride + band);
+    return smallest <= slope * (l.stride + band);
 }
 
 /// A mask over a lattice's cells.

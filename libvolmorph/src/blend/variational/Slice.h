@@ -35,14 +35,15 @@ struct NearZeroSlice {
 
 /// The slice near its zero set only, from exact values on a lattice every `stride` voxels: a
 /// lattice cell is kept when its corners' values change sign, or when the smallest of them is
-/// within `bandVoxels` of zero at the steepest slope between its corners (f grows about as the
-/// distance near the shapes, its normal constraints' values being their offsets); kept cells and
-/// their neighbours get every voxel, tricubic (Catmull-Rom) between the lattice's values: at a
-/// stride of 2, within 0.01 voxel of the exact values on a sphere becoming two (4: 0.15; trilinear
-/// at 2: 0.15, at 4: 0.95). The lattice is screened first, coarsest first: 16 strides apart over
-/// the box, then 4 strides apart in the cells the same test keeps (grown by two), then every
-/// stride in theirs. With `withRates`, df/dw is taken at the same lattice points and interpolated
-/// the same way. Throws Interrupted when `interrupter` asks to stop.
+/// within one stride and `bandVoxels` of zero at the steepest slope between its corners (never
+/// under a distance's; f grows about as the distance near the shapes, its constraints' values
+/// being distances); kept cells and their neighbours get every voxel, tricubic (Catmull-Rom)
+/// between the lattice's values: at a stride of 2, within 0.013 voxel of the exact values on a
+/// sphere becoming two (4: 0.15; trilinear at 2: 0.15, at 4: 0.95). The lattice is screened
+/// coarsest first: 16 strides apart over the box, then halving, each level testing only the cells
+/// its parent kept and evaluating its nodes one parent cell further (a kept cell's neighbours and
+/// the tricubic's stencil). With `withRates`, df/dw is taken at the same lattice points and
+/// interpolated the same way. Throws Interrupted when `interrupter` asks to stop.
 NearZeroSlice sliceNearZero(const SliceFunction& f, double w,
                             const openvdb::math::Transform::Ptr& transform,
                             const openvdb::CoordBBox& box, int stride, double bandVoxels,
