@@ -2,13 +2,18 @@
 // the zero set's motion, an influence shape steers the middle, the memory guard refuses before the
 // solve, and frames do not depend on the thread count.
 #include "support/WarpFixtures.h"
+#include "support/ZeroSetTopology.h"
 
 #include <volmorph/core/Diagnostics.h>
 #include <volmorph/SceneVolumes.h>
 
+#include <openvdb/tools/Composite.h>
+#include <openvdb/tools/LevelSetSphere.h>
 #include <tbb/global_control.h>
 
 #include <gtest/gtest.h>
+
+#include <tuple>
 
 using namespace volmorph;
 using namespace volmorph::test;
@@ -29,6 +34,25 @@ double iou(const openvdb::FloatGrid& a, const openvdb::FloatGrid& b)
         either += p || q;
     }
     return either ? double(both) / double(either) : 0.0;
+}
+
+/// A shape from its level set as voxelize() gives it: the fog, a grey Cd.
+VolumeSet fromLevelSet(openvdb::FloatGrid::Ptr sdf)
+{
+    VolumeSet v;
+    v.density = fogFromLevelSet(*sdf, 1.5f * float(sdf->voxelSize()[0]));
+    v.density->setTransform(sdf->transformPtr());
+    v.color = openvdb::Vec3SGrid::create(openvdb::Vec3s(0.5f));
+    v.color->setTransform(sdf->transformPtr());
+    v.sdf = sdf;
+    return v;
+}
+
+openvdb::FloatGrid::Ptr sphereAt(double radius, double x, double voxel)
+{
+    openvdb::initialize();
+    return openvdb::tools::createLevelSetSphere<openvdb::FloatGrid>(
+        float(radius), openvdb::Vec3f(float(x), 0.0f, 0.0f), float(voxel), 3.0f);
 }
 
 BlendSpec variational(int constraints)
@@ -97,6 +121,28 @@ TEST(VariationalBlend, TheVelocityIsTheZeroSetsMotion)
     EXPECT_LT(worst, 0.05 * rate);                       // measured 1.3%
 }
 
+// A sphere (radius 0.25) into a concentric one of 0.5 grows monotonically, frame by frame, from
+// one end's radius to the other's (the equivalent radius of the frame's fog).
+TEST(VariationalBlend, ASphereIntoALargerOneGrowsMonotonically)
+{
+    const double voxel = 0.02;
+    const VolumeSet small = voxelized("sphere.obj", voxel, placed(Vec3d(0.0), 0.5)),
+                    big = voxelized("sphere.obj", voxel);
+    const Morpher morpher(small, big, {}, WarpSpec{}, variational(1500));
+    double previous = 0.0;
+    for (int k = 0; k <= 10; ++k) {
+        const double r = equivalentRadius(*morpher.frame(0.1 * k).density);
+        std::printf("t %.1f: radius %.4f\n", 0.1 * k, r);
+        if (k == 0) {
+            EXPECT_NEAR(r, equivalentRadius(*small.density), 0.1 * voxel);
+        } else if (k == 10) {
+            EXPECT_NEAR(r, equivalentRadius(*big.density), 0.1 * voxel);
+        }
+        EXPECT_GT(r, previous + 0.005) << "t = " << 0.1 * k;
+        previous = r;
+    }
+}
+
 // A sphere into itself, with a cube (edge 0.9) placed at t = 0.5: the middle frame is closer to
 // the cube than without it (IoU), and the ends stay the sphere.
 TEST(VariationalBlend, AnInfluenceShapeSteersTheMiddle)
@@ -163,5 +209,38 @@ TEST(VariationalBlend, FramesDoNotDependOnTheThreadCount)
         ASSERT_EQ(*it, a.getValue(it.getCoord()));
         ASSERT_EQ(all.velocity->tree().getValue(it.getCoord()), va.getValue(it.getCoord()));
         ASSERT_EQ(all.color->tree().getValue(it.getCoord()), ca.getValue(it.getCoord()));
+    }
+}
+
+// Issue 40's topology checks through the whole mode (the partition of unity, the sliced frame,
+// its redistanced band), each frame's zero set meshed and counted at t = 0, 0.05, ..., 1 (the
+// default time scale): a sphere into two separate spheres is one closed shell, then two, never
+// another piece; a sphere into a torus goes from Euler characteristic 2 to 0 at one frame.
+TEST(VariationalBlend, FramesChangeTopologyOnce)
+{
+    const double voxel = 0.02;
+    auto two = sphereAt(0.25, -0.35, voxel);
+    openvdb::tools::csgUnion(*two, *sphereAt(0.25, 0.35, voxel));
+    auto torus = torusLevelSet(0.35, 0.12, voxel);
+    torus->setTransform(two->transformPtr());
+    const VolumeSet one = fromLevelSet(sphereAt(0.3, 0.0, voxel));
+    for (const auto& [name, target, first, last] :
+         {std::tuple{"two spheres", two, 2L, 4L}, std::tuple{"a torus", torus, 2L, 0L}}) {
+        const Morpher m(one, fromLevelSet(target), {}, WarpSpec{}, variational(1500));
+        long previous = first;
+        int changes = 0;
+        for (int k = 0; k <= 20; ++k) {
+            const Topology topology = topologyOf(*m.frame(0.05 * k).sdf);
+            std::printf("%s, t %.2f: %d shells, Euler %ld\n", name, 0.05 * k, topology.components,
+                        topology.euler);
+            const int shells = topology.euler == 4 ? 2 : 1;
+            EXPECT_EQ(topology.components, shells) << name << ", t = " << 0.05 * k;
+            EXPECT_TRUE(topology.euler == first || topology.euler == last)
+                << name << ", t = " << 0.05 * k;
+            changes += topology.euler != previous;
+            previous = topology.euler;
+        }
+        EXPECT_EQ(previous, last) << name;
+        EXPECT_EQ(changes, 1) << name;
     }
 }

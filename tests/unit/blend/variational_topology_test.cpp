@@ -6,11 +6,11 @@
 #include "blend/variational/Constraints.h"
 #include "blend/variational/Interpolant.h"
 #include "blend/variational/Slice.h"
+#include "support/ZeroSetTopology.h"
 
 #include <gtest/gtest.h>
 #include <openvdb/tools/Composite.h>
 #include <openvdb/tools/LevelSetSphere.h>
-#include <openvdb/tools/VolumeToMesh.h>
 
 #include <cmath>
 #include <array>
@@ -31,23 +31,9 @@ openvdb::FloatGrid::Ptr sphere(double radius, double x = 0.0)
         float(radius), openvdb::Vec3f(float(x), 0.0f, 0.0f), float(kVoxel), 3.0f);
 }
 
-/// A torus about the y axis (major radius R, tube radius r): its exact signed distance in a band.
 openvdb::FloatGrid::Ptr torus(double R, double r)
 {
-    const float band = float(3.0 * kVoxel);
-    auto grid = openvdb::FloatGrid::create(band);
-    grid->setTransform(openvdb::math::Transform::createLinearTransform(kVoxel));
-    grid->setGridClass(openvdb::GRID_LEVEL_SET);
-    auto acc = grid->getAccessor();
-    const int n = int(std::ceil((R + r) / kVoxel)) + 4;
-    for (int i = -n; i <= n; ++i)
-        for (int j = -n; j <= n; ++j)
-            for (int k = -n; k <= n; ++k) {
-                const double x = i * kVoxel, y = j * kVoxel, z = k * kVoxel;
-                const double d = std::hypot(std::hypot(x, z) - R, y) - r;
-                if (std::abs(d) < band) acc.setValue(openvdb::Coord(i, j, k), float(d));
-            }
-    return grid;
+    return volmorph::test::torusLevelSet(R, r, kVoxel);
 }
 
 Interpolant morph(const openvdb::FloatGrid& from, const openvdb::FloatGrid& to)
@@ -58,10 +44,7 @@ Interpolant morph(const openvdb::FloatGrid& from, const openvdb::FloatGrid& to)
     return Interpolant::solveDense(c);
 }
 
-struct Topology {
-    int components = 0;
-    long euler = 0; ///< V - E + F of the triangulated zero set
-};
+using volmorph::test::Topology;
 
 Topology topologyAt(const Interpolant& f, double t)
 {
@@ -69,33 +52,7 @@ Topology topologyAt(const Interpolant& f, double t)
     const openvdb::CoordBBox box(openvdb::Coord(-18), openvdb::Coord(18)); // +-0.72 world units
     const auto grid =
         sliceOverBox([&](const Point4& p) { return f(p); }, t * kTimeScale, transform, box);
-    std::vector<openvdb::Vec3s> points;
-    std::vector<openvdb::Vec3I> triangles;
-    std::vector<openvdb::Vec4I> quads;
-    openvdb::tools::volumeToMesh(*grid, points, triangles, quads, 0.0);
-    std::vector<std::array<uint32_t, 3>> faces;
-    for (const auto& tri : triangles) faces.push_back({tri[0], tri[1], tri[2]});
-    for (const auto& q : quads) {
-        faces.push_back({q[0], q[1], q[2]});
-        faces.push_back({q[0], q[2], q[3]});
-    }
-    std::vector<uint32_t> parent(points.size());
-    std::iota(parent.begin(), parent.end(), 0u);
-    const auto root = [&](uint32_t v) {
-        while (parent[v] != v) v = parent[v] = parent[parent[v]];
-        return v;
-    };
-    std::set<std::pair<uint32_t, uint32_t>> edges;
-    for (const auto& face : faces)
-        for (int e = 0; e < 3; ++e) {
-            const uint32_t a = face[e], b = face[(e + 1) % 3];
-            edges.insert({std::min(a, b), std::max(a, b)});
-            parent[root(a)] = root(b);
-        }
-    Topology topology;
-    for (uint32_t v = 0; v < parent.size(); ++v) topology.components += root(v) == v;
-    topology.euler = long(points.size()) - long(edges.size()) + long(faces.size());
-    return topology;
+    return volmorph::test::topologyOf(*grid);
 }
 
 } // namespace
