@@ -5,7 +5,9 @@
 #   2. render-vdb while its shadow maps are built (--verbose names each stage as it starts: fails
 #      unless the signal landed after "render: shadows" began and before "render: pixels" did);
 #   3. render, morph and preview of a scene during a frame's morph (the exact warp on fine voxels,
-#      seconds per frame; fails unless it landed after "frame 1: morph" and before the next stage).
+#      seconds per frame; fails unless it landed after "frame 1: morph" and before the next stage);
+#   4. morph of a variational scene during its solve (two seconds in, fails if the frame had begun)
+#      and during its frame (after "frame 1: morph").
 # usage: render_interrupt.sh VOLMORPH SOURCE_DIR [LIMIT [COARSEN]]
 #        LIMIT: the longest stop allowed, in seconds (default 1, the promise; sanitizer builds, which
 #        run 5-40 times slower, pass more)
@@ -97,4 +99,22 @@ for command in render morph preview; do
     stop "$signal" "$command during a frame's morph"
     grep -q "render: empty-space mask" "$dir/err" && fail "$command: the morph was done before the signal"
 done
+# 4. The variational method: dino-to-eight-variational at 320 voxels across divided by COARSEN (its
+#    solve takes seconds, and so does a frame).
+sed "s|meshes/|$source_dir/scenes/meshes/|; s|^resolution = 128 |resolution = $((320 / coarsen)) |" \
+    "$source_dir/scenes/dino-to-eight-variational.toml" >"$dir/variational.toml"
+rm -f "$dir/err"
+"$volmorph" morph "$dir/variational.toml" --frames 15 -o "$dir/out/v.####.vdb" -v --no-cache \
+    2>"$dir/err" >/dev/null &
+pid=$!
+wait_for "voxelize"
+sleep 1.5
+stop INT "morph during the variational solve"
+grep -q "frame 15: morph" "$dir/err" && fail "the variational solve was done before the signal"
+rm -f "$dir/err"
+"$volmorph" morph "$dir/variational.toml" --frames 15 -o "$dir/out/v.####.vdb" -v 2>"$dir/err" >/dev/null &
+pid=$!
+wait_for "frame 15: morph"
+sleep 0.3
+stop TERM "morph during a variational frame"
 echo "every interrupt stopped within $limit s with exit 130 and no file"
