@@ -1,5 +1,6 @@
 #include "blend/VariationalBlend.h"
 
+#include "blend/Abandonable.h"
 #include "blend/ExtendedDistance.h"
 #include "blend/Redistance.h"
 #include "blend/variational/Constraints.h"
@@ -124,15 +125,14 @@ public:
         // The in-betweens lie near the shapes' box: a margin of an eighth, at least 8 voxels.
         const Coord margin(8 + dim.x() / 8, 8 + dim.y() / 8, 8 + dim.z() / 8);
         mBox = CoordBBox(shapesBox.min() - margin, shapesBox.max() + margin);
-        tbb::parallel_invoke(
-            [&] {
-                mFarSource =
-                    std::make_unique<const ExtendedDistance>(mSource.sdf, mBox, setup.interrupter);
-            },
-            [&] {
-                mFarTarget =
-                    std::make_unique<const ExtendedDistance>(mTarget.sdf, mBox, setup.interrupter);
-            });
+        // OpenVDB's fast sweeping takes no interrupter (about a second at 320 across): abandonable.
+        const auto extend = [&](const openvdb::FloatGrid::Ptr& sdf) {
+            return abandonable(
+                [sdf, box = mBox] { return std::make_unique<const ExtendedDistance>(sdf, box); },
+                setup.interrupter);
+        };
+        tbb::parallel_invoke([&] { mFarSource = extend(mSource.sdf); },
+                             [&] { mFarTarget = extend(mTarget.sdf); });
         const openvdb::math::Transform& xform = mSource.density->transform();
         std::vector<Constraint> constraints = exteriorConstraints(mBox, xform, *mFarSource, 0.0);
         const std::vector<Constraint> far =

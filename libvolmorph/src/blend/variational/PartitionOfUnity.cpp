@@ -1,5 +1,6 @@
 #include "blend/variational/PartitionOfUnity.h"
 
+#include "blend/Abandonable.h"
 #include "blend/variational/Constraints.h"
 
 #include <tbb/parallel_for.h>
@@ -112,12 +113,16 @@ PartitionOfUnity PartitionOfUnity::solve(const std::vector<Constraint>& constrai
     PartitionOfUnity pu;
     if (options.leading > constraints.size())
         throw std::invalid_argument("PartitionOfUnity: more leading constraints than constraints");
+    // The dense solves take about a second at 2000 and Eigen's LU takes no interrupter: they run
+    // abandonable, so that a stop request is answered at once.
+    const auto dense = [interrupter](std::vector<Constraint> c) {
+        return abandonable([c = std::move(c)] { return Interpolant::solveDense(c); }, interrupter);
+    };
     if (constraints.size() <= options.coarse + options.leading) {
-        pu.mCoarse = Interpolant::solveDense(constraints); // exact: no local level
+        pu.mCoarse = dense(constraints); // exact: no local level
         return pu;
     }
-    pu.mCoarse =
-        Interpolant::solveDense(coarseSubset(constraints, options.coarse, options.leading));
+    pu.mCoarse = dense(coarseSubset(constraints, options.coarse, options.leading));
     std::vector<Constraint> residual = constraints;
     for (Constraint& c : residual) c.value -= pu.mCoarse(c.point);
 

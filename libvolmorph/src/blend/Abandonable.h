@@ -1,0 +1,58 @@
+// Work that cannot be interrupted (an OpenVDB tool without an interrupter, Eigen's dense LU) run so
+// that a stop request is still answered at once: the work runs on a thread of its own, owning
+// everything it reads (capture by value or shared_ptr, never a reference or the interrupter), and
+// the caller polls the interrupter meanwhile. Asked to stop, the caller throws Interrupted and
+// abandons the work: its thread finishes it (or the process exits first) and frees it alone.
+#pragma once
+
+#include <volmorph/core/Interrupter.h>
+
+#include <chrono>
+#include <condition_variable>
+#include <exception>
+#include <memory>
+#include <mutex>
+#include <optional>
+#include <thread>
+#include <utility>
+
+namespace volmorph::detail {
+
+/// work() (which must own what it reads), returned; Interrupted as soon as `interrupter` asks to
+/// stop (polled every 10 ms); work's own exception rethrown. Without an interrupter, work() here.
+template <typename Work>
+auto abandonable(Work work, Interrupter* interrupter) -> decltype(work())
+{
+    using Result = decltype(work());
+    if (!interrupter) return work();
+    struct Shared {
+        std::mutex mutex;
+        std::condition_variable done;
+        std::optional<Result> result;
+        std::exception_ptr error;
+        bool finished = false;
+    };
+    auto shared = std::make_shared<Shared>();
+    std::thread([shared, work = std::move(work)]() mutable {
+        std::optional<Result> result;
+        std::exception_ptr error;
+        try {
+            result.emplace(work());
+        } catch (...) {
+            error = std::current_exception();
+        }
+        std::lock_guard<std::mutex> lock(shared->mutex);
+        shared->result = std::move(result);
+        shared->error = error;
+        shared->finished = true;
+        shared->done.notify_all();
+    }).detach();
+    std::unique_lock<std::mutex> lock(shared->mutex);
+    while (!shared->done.wait_for(lock, std::chrono::milliseconds(10),
+                                  [&] { return shared->finished; }))
+        if (interrupter->wasInterrupted()) throw Interrupted();
+    if (shared->error) std::rethrow_exception(shared->error);
+    return std::move(*shared->result);
+}
+
+} // namespace volmorph::detail
