@@ -9,6 +9,10 @@
 
 namespace volmorph::detail {
 
+/// sdf and variational modes: the fog rises from 0 to 1 across this many voxels around the
+/// surface.
+inline constexpr float kSdfRampVoxels = 1.5f;
+
 struct RedistanceBands {
     float voxel = 1.0f; ///< world units
     float width = 0.0f; ///< the output band's half width, world units; the grid's background

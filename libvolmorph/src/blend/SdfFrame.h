@@ -7,6 +7,7 @@
 #include "blend/ColorBlend.h"
 #include "blend/ExtendedDistance.h"
 #include "blend/IdentityDistances.h"
+#include "blend/Redistance.h"
 #include "warp/AdaptiveWarp.h"
 
 #include <volmorph/Voxelize.h>
@@ -21,9 +22,6 @@
 #include <vector>
 
 namespace volmorph::detail {
-
-/// sdf mode: the fog rises from 0 to 1 across this many voxels around the surface.
-inline constexpr float kSdfRampVoxels = 1.5f;
 
 inline constexpr float kSqrt3 = 1.7320508f;
 /// The farthest a voxel of a 2^3 block can be from the mean of the block's voxels under a map

@@ -36,8 +36,6 @@ using Sampler = openvdb::tools::BoxSampler;
 /// The frame's exact values lie on a lattice this many voxels apart, tricubic between: within
 /// 0.01 voxel of the exact slice near its zero set (Slice.h).
 constexpr int kStride = 2;
-/// The fog's ramp across the surface, voxels (as sdf mode's).
-constexpr float kRampVoxels = 1.5f;
 /// Exterior constraints per edge of the box (kExterior^3 - (kExterior - 2)^3 on its faces).
 constexpr int kExterior = 9;
 /// |grad f| is taken no smaller than this (world units of f per world unit) in the velocity: where
@@ -249,7 +247,7 @@ private:
         openvdb::tools::signedFloodFill(values->tree());
         const RedistanceBands bands{float(mVoxel), mWidth,
                                     [](const Coord&) { return std::numeric_limits<float>::max(); }};
-        out.grids.density = redistance(*values, bands, kRampVoxels * float(mVoxel));
+        out.grids.density = redistance(*values, bands, kSdfRampVoxels * float(mVoxel));
         colorBand(*values, float(scheduleValue(mSpec.color, r.t)), *out.grids.color);
         if (velocity) {
             motion->tree().topologyIntersection(values->tree());

@@ -1,6 +1,7 @@
 // blend.mode = "variational" through the Morpher: the end frames are the inputs, the velocity is
 // the zero set's motion, an influence shape steers the middle, the memory guard refuses before the
 // solve, and frames do not depend on the thread count.
+#include "support/VoxelizeChecks.h"
 #include "support/WarpFixtures.h"
 #include "support/ZeroSetTopology.h"
 
@@ -19,22 +20,6 @@ using namespace volmorph;
 using namespace volmorph::test;
 
 namespace {
-
-/// IoU of the insides (density above 1/2) of two fogs, over both boxes.
-double iou(const openvdb::FloatGrid& a, const openvdb::FloatGrid& b)
-{
-    openvdb::CoordBBox box = a.evalActiveVoxelBoundingBox();
-    box.expand(b.evalActiveVoxelBoundingBox());
-    auto x = a.getConstAccessor();
-    auto y = b.getConstAccessor();
-    size_t both = 0, either = 0;
-    for (auto it = box.begin(); it; ++it) {
-        const bool p = x.getValue(*it) > 0.5f, q = y.getValue(*it) > 0.5f;
-        both += p && q;
-        either += p || q;
-    }
-    return either ? double(both) / double(either) : 0.0;
-}
 
 /// A shape from its level set as voxelize() gives it: the fog, a grey Cd.
 VolumeSet fromLevelSet(openvdb::FloatGrid::Ptr sdf)
@@ -77,8 +62,8 @@ TEST(VariationalBlend, TheEndFramesAreTheInputs)
     ASSERT_GE(scene.blend.variational.constraints, 5000);
     const SceneVolumes v = voxelizeScene(scene);
     const Morpher morpher(v.source, v.target, scene.pairs, scene.warp, scene.blend);
-    const double first = iou(*morpher.frame(0.0).density, *v.source.density);
-    const double last = iou(*morpher.frame(1.0).density, *v.target.density);
+    const double first = insideIoU(*morpher.frame(0.0).density, *v.source.density);
+    const double last = insideIoU(*morpher.frame(1.0).density, *v.target.density);
     std::printf("IoU at t = 0: %.4f, at t = 1: %.4f\n", first, last);
     EXPECT_GE(first, 0.97);
     EXPECT_GE(last, 0.97);
@@ -154,9 +139,9 @@ TEST(VariationalBlend, AnInfluenceShapeSteersTheMiddle)
     MorphOptions options;
     options.influences = {TimedVolume{cube, 0.5}};
     const Morpher steered(sphere, sphere, {}, WarpSpec{}, variational(1500), options);
-    const double without = iou(*plain.frame(0.5).density, *cube.density);
-    const double with = iou(*steered.frame(0.5).density, *cube.density);
-    const double end = iou(*steered.frame(0.0).density, *sphere.density);
+    const double without = insideIoU(*plain.frame(0.5).density, *cube.density);
+    const double with = insideIoU(*steered.frame(0.5).density, *cube.density);
+    const double end = insideIoU(*steered.frame(0.0).density, *sphere.density);
     std::printf("IoU with the cube at t = 0.5: %.4f without it, %.4f with it; at t = 0 with the "
                 "sphere %.4f\n",
                 without, with, end);

@@ -24,7 +24,8 @@ constexpr double kNullWeight = 1e-3;
 
 double wendland(double d)
 {
-    return d >= 1.0 ? 0.0 : std::pow(1.0 - d, 4) * (4.0 * d + 1.0);
+    const double e = 1.0 - d, e2 = e * e;
+    return d >= 1.0 ? 0.0 : e2 * e2 * (4.0 * d + 1.0);
 }
 
 Eigen::Vector3d spatial(const Point4& p)
@@ -232,7 +233,8 @@ double PartitionOfUnity::local(const Point4& x, Point4* gradient) const
         Point4 gradW = Point4::Zero();
         if (d > 0.0)
             gradW.head<3>() =
-                (-20.0 * std::pow(1.0 - d, 3) / (patch.radius * patch.radius)) * offset;
+                (-20.0 * (1.0 - d) * (1.0 - d) * (1.0 - d) / (patch.radius * patch.radius)) *
+                offset;
         gradSum += gradW * r + w * gradR;
         gradWeights += gradW;
     }

@@ -142,7 +142,7 @@ bool nearZero(const Lattice& l, int a, int b, int c, double band, double leastSl
         if (k > c) steepest = std::max(steepest, std::abs(v - l.at(i, j, c)));
     }
     if (lo <= 0.0f && hi >= 0.0f) return true;
-    // The steepest edge's slope per voxel, over the cell's diagonal and the band.
+    // The steepest edge's slope per voxel, over a stride and the band.
     const double slope = std::max(double(steepest) / l.stride, leastSlope);
     return smallest <= slope * (l.stride + band);
 }
@@ -162,9 +162,8 @@ struct CellMask {
     }
 };
 
-/// Cells of `l` near the zero set (nearZero) among those `candidate` allows, grown by `grow`
-/// cells each way.
-CellMask cellsNearZero(const Lattice& l, double band, double leastSlope, int grow,
+/// Cells of `l` near the zero set (nearZero) among those `candidate` allows.
+CellMask cellsNearZero(const Lattice& l, double band, double leastSlope,
                        const std::function<bool(int, int, int)>& candidate)
 {
     CellMask m{l.cells(), {}};
@@ -172,14 +171,27 @@ CellMask cellsNearZero(const Lattice& l, double band, double leastSlope, int gro
     m.on.assign(size_t(n.x()) * n.y() * n.z(), 0);
     for (int a = 0; a < n.x(); ++a)
         for (int b = 0; b < n.y(); ++b)
-            for (int c = 0; c < n.z(); ++c) {
-                if (!candidate(a, b, c) || !nearZero(l, a, b, c, band, leastSlope)) continue;
-                for (int i = std::max(0, a - grow); i <= std::min(n.x() - 1, a + grow); ++i)
-                    for (int j = std::max(0, b - grow); j <= std::min(n.y() - 1, b + grow); ++j)
-                        for (int k = std::max(0, c - grow); k <= std::min(n.z() - 1, c + grow); ++k)
-                            m.on[(size_t(i) * n.y() + j) * n.z() + k] = 1;
-            }
+            for (int c = 0; c < n.z(); ++c)
+                m.on[(size_t(a) * n.y() + b) * n.z() + c] =
+                    candidate(a, b, c) && nearZero(l, a, b, c, band, leastSlope);
     return m;
+}
+
+/// `m` with every cell's neighbours on too.
+CellMask grown(const CellMask& m)
+{
+    CellMask g{m.cells, std::vector<char>(m.on.size(), 0)};
+    const Coord& n = m.cells;
+    for (int a = 0; a < n.x(); ++a)
+        for (int b = 0; b < n.y(); ++b)
+            for (int c = 0; c < n.z(); ++c) {
+                if (!m.at(a, b, c)) continue;
+                for (int i = std::max(0, a - 1); i <= std::min(n.x() - 1, a + 1); ++i)
+                    for (int j = std::max(0, b - 1); j <= std::min(n.y() - 1, b + 1); ++j)
+                        for (int k = std::max(0, c - 1); k <= std::min(n.z() - 1, c + 1); ++k)
+                            g.on[(size_t(i) * n.y() + j) * n.z() + k] = 1;
+            }
+    return g;
 }
 
 /// The fine lattice's values (and rates) where the screening keeps cells: levels `kRatio` times
@@ -205,19 +217,19 @@ Screened screen(const SliceFunction& f, double w, const openvdb::math::Transform
         const bool last = level == kLevels - 1;
         Lattice l = evaluateLattice(f, w, transform, box, levelStride, needed, last && withRates,
                                     evaluations, interrupter);
-        if (last) return Screened{l, cellsNearZero(l, band, leastSlope, 0, candidate)};
+        CellMask cells = cellsNearZero(l, band, leastSlope, candidate);
+        if (last) return Screened{l, std::move(cells)};
         // The next level tests the cells kept here, and evaluates its nodes one cell further (a
         // cell's neighbours and the tricubic's stencil).
-        CellMask cells = cellsNearZero(l, band, leastSlope, 0, candidate);
-        nodesNear = cellsNearZero(l, band, leastSlope, 1, candidate); // before cellsNear changes
+        nodesNear = grown(cells);
         cellsNear = std::move(cells);
         needed = [&nodesNear](int a, int b, int c) { return nodesNear.holds(a, b, c, kRatio); };
         candidate = [&cellsNear](int a, int b, int c) { return cellsNear.holds(a, b, c, kRatio); };
     }
 }
 
-/// The leaves (their origins, in order) holding voxels of the kept cells and their neighbours.
-std::vector<Coord> leavesWritten(const Lattice& l, const CellMask& kept,
+/// The leaves (their origins, in order) holding voxels of the `written` cells.
+std::vector<Coord> leavesWritten(const Lattice& l, const CellMask& written,
                                  const openvdb::CoordBBox& box)
 {
     const Coord lo(box.min().x() >> 3, box.min().y() >> 3, box.min().z() >> 3);
@@ -228,13 +240,13 @@ std::vector<Coord> leavesWritten(const Lattice& l, const CellMask& kept,
     for (int a = 0; a < cells.x(); ++a)
         for (int b = 0; b < cells.y(); ++b)
             for (int c = 0; c < cells.z(); ++c) {
-                if (!kept.at(a, b, c)) continue;
-                // The voxels of the cell and its neighbours, clipped to the box, in leaves.
+                if (!written.at(a, b, c)) continue;
+                // The cell's voxels, clipped to the box, in leaves.
                 Coord first, last;
                 const int abc[3] = {a, b, c};
                 for (int axis = 0; axis < 3; ++axis) {
-                    const int v0 = l.origin[axis] + (abc[axis] - 1) * l.stride;
-                    const int v1 = l.origin[axis] + (abc[axis] + 2) * l.stride - 1;
+                    const int v0 = l.origin[axis] + abc[axis] * l.stride;
+                    const int v1 = l.origin[axis] + (abc[axis] + 1) * l.stride - 1;
                     first[axis] = (std::max(v0, box.min()[axis]) >> 3) - lo[axis];
                     last[axis] = (std::min(v1, box.max()[axis]) >> 3) - lo[axis];
                 }
@@ -265,14 +277,8 @@ NearZeroSlice sliceNearZero(const SliceFunction& f, double w,
     const Lattice& l = s.fine;
     const Coord cells = l.cells();
     // A voxel is written when its cell or a neighbour is kept; leaf by leaf, in parallel.
-    const auto written = [&](int a, int b, int c) {
-        for (int i = std::max(0, a - 1); i <= std::min(cells.x() - 1, a + 1); ++i)
-            for (int j = std::max(0, b - 1); j <= std::min(cells.y() - 1, b + 1); ++j)
-                for (int k = std::max(0, c - 1); k <= std::min(cells.z() - 1, c + 1); ++k)
-                    if (s.kept.at(i, j, k)) return true;
-        return false;
-    };
-    const std::vector<Coord> origins = leavesWritten(l, s.kept, box);
+    const CellMask written = grown(s.kept);
+    const std::vector<Coord> origins = leavesWritten(l, written, box);
     using Leaf = openvdb::FloatTree::LeafNodeType;
     std::vector<std::unique_ptr<Leaf>> values(origins.size()), rates(origins.size());
     const float background = float(bandVoxels * transform->voxelSize()[0]);
@@ -283,7 +289,8 @@ NearZeroSlice sliceNearZero(const SliceFunction& f, double w,
             const Coord v = origins[n] + Leaf::offsetToLocalCoord(i) - l.origin;
             if (!box.isInside(v + l.origin)) continue;
             const int a = v.x() / stride, b = v.y() / stride, c = v.z() / stride;
-            if (a >= cells.x() || b >= cells.y() || c >= cells.z() || !written(a, b, c)) continue;
+            if (a >= cells.x() || b >= cells.y() || c >= cells.z() || !written.at(a, b, c))
+                continue;
             const std::array<std::array<double, 4>, 3> weights{
                 catmullRom(double(v.x() - a * stride) / stride),
                 catmullRom(double(v.y() - b * stride) / stride),
