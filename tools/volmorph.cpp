@@ -5,6 +5,7 @@
 #include <volmorph/core/Version.h>
 
 #include <cstdio>
+#include <cstdlib>
 #include <vector>
 
 int main(int argc, char** argv)
@@ -32,6 +33,12 @@ int main(int argc, char** argv)
             if (c.app->parsed()) return c.run();
     } catch (const volmorph::Interrupted&) {
         std::fprintf(stderr, "volmorph: interrupted; no output written for the current item\n");
+        // Work left running on a stop request (an OpenVDB tool or a dense solve that takes no
+        // interrupter) still uses OpenVDB's and TBB's state: exit without destroying it.
+        if (volmorph::abandonedWorkRunning() > 0) {
+            std::fflush(nullptr);
+            std::_Exit(kExitInterrupted);
+        }
         return kExitInterrupted;
     } catch (const volmorph::UserError& e) {
         for (const volmorph::Diagnostic& d : e.diagnostics())

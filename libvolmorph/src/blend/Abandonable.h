@@ -2,7 +2,8 @@
 // that a stop request is still answered at once: the work runs on a thread of its own, owning
 // everything it reads (capture by value or shared_ptr, never a reference or the interrupter), and
 // the caller polls the interrupter meanwhile. Asked to stop, the caller throws Interrupted and
-// abandons the work: its thread finishes it (or the process exits first) and frees it alone.
+// abandons the work: its thread finishes it and frees it alone, counted meanwhile by
+// abandonedWorkRunning() (a program that exits before it is done must skip static destructors).
 #pragma once
 
 #include <volmorph/core/Interrupter.h>
@@ -30,27 +31,40 @@ auto abandonable(Work work, Interrupter* interrupter) -> decltype(work())
         std::condition_variable done;
         std::optional<Result> result;
         std::exception_ptr error;
-        bool finished = false;
+        bool finished = false, abandoned = false;
     };
     auto shared = std::make_shared<Shared>();
     std::thread([shared, work = std::move(work)]() mutable {
-        std::optional<Result> result;
-        std::exception_ptr error;
-        try {
-            result.emplace(work());
-        } catch (...) {
-            error = std::current_exception();
+        bool abandoned = false;
+        {
+            Work job = std::move(work); // what the work owns is freed at the end of this scope
+            std::optional<Result> result;
+            std::exception_ptr error;
+            try {
+                result.emplace(job());
+            } catch (...) {
+                error = std::current_exception();
+            }
+            std::lock_guard<std::mutex> lock(shared->mutex);
+            abandoned = shared->abandoned;
+            if (!abandoned) {
+                shared->result = std::move(result);
+                shared->error = error;
+                shared->finished = true;
+                shared->done.notify_all();
+            }
         }
-        std::lock_guard<std::mutex> lock(shared->mutex);
-        shared->result = std::move(result);
-        shared->error = error;
-        shared->finished = true;
-        shared->done.notify_all();
+        shared.reset();
+        if (abandoned) countAbandonedWork(-1); // the last thing this thread does with it
     }).detach();
     std::unique_lock<std::mutex> lock(shared->mutex);
     while (!shared->done.wait_for(lock, std::chrono::milliseconds(10),
                                   [&] { return shared->finished; }))
-        if (interrupter->wasInterrupted()) throw Interrupted();
+        if (interrupter->wasInterrupted()) {
+            shared->abandoned = true;
+            countAbandonedWork(+1);
+            throw Interrupted();
+        }
     if (shared->error) std::rethrow_exception(shared->error);
     return std::move(*shared->result);
 }

@@ -3,6 +3,19 @@
 #include <cstdio>
 
 namespace volmorph {
+namespace {
+std::atomic<int> gAbandoned{0};
+} // namespace
+
+int abandonedWorkRunning()
+{
+    return gAbandoned.load();
+}
+
+void detail::countAbandonedWork(int change)
+{
+    gAbandoned += change;
+}
 
 void Interrupter::start(const char* name)
 {

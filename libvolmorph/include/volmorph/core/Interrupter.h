@@ -42,6 +42,17 @@ struct Interrupted : std::exception {
     const char* what() const noexcept override { return "interrupted"; }
 };
 
+/// Work abandoned on a stop request (blend/Abandonable.h: an OpenVDB tool or a dense solve that
+/// takes no interrupter, left to finish on its own thread) and still running. While it runs, the
+/// process must not run its static destructors (OpenVDB's and TBB's state is still in use there):
+/// a program that caught Interrupted ends with std::_Exit when this is not zero.
+int abandonedWorkRunning();
+
+namespace detail {
+/// Abandonable's bookkeeping: +1 when work is abandoned, -1 when its thread is done with it.
+void countAbandonedWork(int change);
+} // namespace detail
+
 /// Throws Interrupted when `interrupter` (may be null) asks to stop; `percent` is the progress.
 inline void throwIfInterrupted(Interrupter* interrupter, int percent = -1)
 {
