@@ -2,9 +2,9 @@
 // side in one run (the same voxelized sides, the same frames), with each mode's one-time setup and
 // the process's peak resident size. Prints a table for BENCHMARKS.md.
 //
-//   volmorph_bench_variational [SCENE] [RESOLUTION] [RUNS]
+//   volmorph_bench_variational [SCENE] [RESOLUTION] [RUNS] [TIMES]
 //   (default: scenes/dino-to-eight-variational.toml at 256 voxels across, 3 runs of t = 0.25,
-//   0.5, 0.75 per mode)
+//   0.5, 0.75 per mode; TIMES a comma-separated list of t in their place)
 #include <volmorph/Morph.h>
 #include <volmorph/Scene.h>
 #include <volmorph/SceneVolumes.h>
@@ -53,6 +53,16 @@ int main(int argc, char** argv)
                  : std::string(VOLMORPH_SOURCE_DIR) + "/scenes/dino-to-eight-variational.toml";
     const int resolution = argc > 2 ? std::atoi(argv[2]) : 256;
     const int runs = argc > 3 ? std::atoi(argv[3]) : 3;
+    std::vector<double> times{0.25, 0.5, 0.75};
+    if (argc > 4) {
+        times.clear();
+        for (const char* p = argv[4]; *p;) {
+            char* end = nullptr;
+            times.push_back(std::strtod(p, &end));
+            if (end == p) break;
+            p = *end == ',' ? end + 1 : end;
+        }
+    }
     Scene scene = loadScene(file);
     scene.volume.voxelSize.reset();
     scene.volume.resolution = resolution;
@@ -81,7 +91,7 @@ int main(int argc, char** argv)
         "| t | sdf frame (s) | variational frame (s) | ratio | variational exact values |\n");
     std::printf("|---:|---:|---:|---:|---:|\n");
     std::vector<double> ratios;
-    for (double t : {0.25, 0.5, 0.75}) {
+    for (double t : times) {
         std::vector<double> a, b;
         MorphStats stats;
         for (int run = 0; run < runs; ++run) {

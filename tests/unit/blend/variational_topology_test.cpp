@@ -99,8 +99,8 @@ TEST(VariationalTopology, ASphereIntoATorusOpensItsHoleOnce)
 // The slice near its zero set from exact values every 2 voxels, tricubic between (sliceNearZero),
 // against the slice evaluated at every voxel: every voxel within 1.5 voxels of the zero set is
 // there, and its value is the exact one to 0.1 voxel (of the distance the local slope gives:
-// measured 0.0016 at t = 0.5 and 0.0084 at 0.8, just after the split; every 4 voxels gave 0.026
-// and 0.15, trilinear 0.14 and 0.95), from an eighth of the evaluations.
+// measured 0.0027 at t = 0.5 and 0.0127 at 0.8, just after the split; every 4 voxels gave 0.026
+// and 0.15, trilinear 0.14 and 0.95), from a thirtieth of the evaluations (11,038 and 12,414).
 TEST(VariationalTopology, TheSliceNearItsZeroSetFromACoarseLatticeIsTheExactOne)
 {
     auto two = sphere(0.25, -0.35);
@@ -139,6 +139,6 @@ TEST(VariationalTopology, TheSliceNearItsZeroSetFromACoarseLatticeIsTheExactOne)
                     (unsigned long long)near->activeVoxelCount());
         EXPECT_GT(checked, 1000u);
         EXPECT_LT(worst, 0.1);
-        EXPECT_LT(evaluations * 7, size_t(box.volume()));
+        EXPECT_LT(evaluations * 20, size_t(box.volume()));
     }
 }

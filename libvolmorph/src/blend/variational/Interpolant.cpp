@@ -79,8 +79,11 @@ Point4 Interpolant::gradient(const Point4& x) const
 
 namespace {
 
-/// The sums over the centres of w r^3 (sums[0]) and of 3 w r (x - c) (sums[1..4], when
-/// `gradient`), as four lanes each: centre j goes to lane j % 4. Both builds below add the same
+/// What the sums take: f alone, f and df/dt' (sums[4] only), or f and its whole gradient.
+enum Wanted { kValue, kRate, kGradient };
+
+/// The sums over the centres of w r^3 (sums[0]) and of 3 w r (x - c) (sums[1..4], as `wanted`
+/// says), as four lanes each: centre j goes to lane j % 4. Both builds below add the same
 /// numbers in the same order (IEEE operations round lane by lane alike), so every x86-64 machine
 /// gets the same bits.
 struct Lanes {
@@ -88,7 +91,7 @@ struct Lanes {
 };
 
 /// Four centres a step as two SSE2 halves (every x86-64 has SSE2).
-void sumsSse2(const std::array<const double*, 5>& c, size_t n, const double* x, bool gradient,
+void sumsSse2(const std::array<const double*, 5>& c, size_t n, const double* x, Wanted wanted,
               Lanes& out)
 {
     const __m128d x0 = _mm_set1_pd(x[0]), x1 = _mm_set1_pd(x[1]), x2 = _mm_set1_pd(x[2]),
@@ -106,12 +109,13 @@ void sumsSse2(const std::array<const double*, 5>& c, size_t n, const double* x, 
                                           _mm_add_pd(_mm_mul_pd(d2, d2), _mm_mul_pd(d3, d3)));
             const __m128d wr = _mm_mul_pd(_mm_loadu_pd(c[4] + k), _mm_sqrt_pd(r2));
             acc[0][h] = _mm_add_pd(acc[0][h], _mm_mul_pd(wr, r2));
-            if (!gradient) continue;
+            if (wanted == kValue) continue;
             const __m128d s = _mm_mul_pd(three, wr);
+            acc[4][h] = _mm_add_pd(acc[4][h], _mm_mul_pd(s, d3));
+            if (wanted == kRate) continue;
             acc[1][h] = _mm_add_pd(acc[1][h], _mm_mul_pd(s, d0));
             acc[2][h] = _mm_add_pd(acc[2][h], _mm_mul_pd(s, d1));
             acc[3][h] = _mm_add_pd(acc[3][h], _mm_mul_pd(s, d2));
-            acc[4][h] = _mm_add_pd(acc[4][h], _mm_mul_pd(s, d3));
         }
     for (int i = 0; i < 5; ++i) {
         _mm_store_pd(out.sums[i], acc[i][0]);
@@ -121,7 +125,7 @@ void sumsSse2(const std::array<const double*, 5>& c, size_t n, const double* x, 
 
 /// The same with AVX2's four lanes (no FMA: the same roundings).
 __attribute__((target("avx2"))) void sumsAvx2(const std::array<const double*, 5>& c, size_t n,
-                                              const double* x, bool gradient, Lanes& out)
+                                              const double* x, Wanted wanted, Lanes& out)
 {
     const __m256d x0 = _mm256_set1_pd(x[0]), x1 = _mm256_set1_pd(x[1]), x2 = _mm256_set1_pd(x[2]),
                   x3 = _mm256_set1_pd(x[3]), three = _mm256_set1_pd(3.0);
@@ -137,12 +141,13 @@ __attribute__((target("avx2"))) void sumsAvx2(const std::array<const double*, 5>
                           _mm256_add_pd(_mm256_mul_pd(d2, d2), _mm256_mul_pd(d3, d3)));
         const __m256d wr = _mm256_mul_pd(_mm256_loadu_pd(c[4] + j), _mm256_sqrt_pd(r2));
         acc[0] = _mm256_add_pd(acc[0], _mm256_mul_pd(wr, r2));
-        if (!gradient) continue;
+        if (wanted == kValue) continue;
         const __m256d s = _mm256_mul_pd(three, wr);
+        acc[4] = _mm256_add_pd(acc[4], _mm256_mul_pd(s, d3));
+        if (wanted == kRate) continue;
         acc[1] = _mm256_add_pd(acc[1], _mm256_mul_pd(s, d0));
         acc[2] = _mm256_add_pd(acc[2], _mm256_mul_pd(s, d1));
         acc[3] = _mm256_add_pd(acc[3], _mm256_mul_pd(s, d2));
-        acc[4] = _mm256_add_pd(acc[4], _mm256_mul_pd(s, d3));
     }
     for (int i = 0; i < 5; ++i) _mm256_store_pd(out.sums[i], acc[i]);
 }
@@ -158,25 +163,32 @@ double sumLanes(const double* lanes)
 
 double Interpolant::evaluate(const Point4& x, Point4* gradient) const
 {
-    return sum(x, gradient, kAvx2);
+    return sum(x, gradient, nullptr, kAvx2);
+}
+
+double Interpolant::evaluateWithRate(const Point4& x, double* rate) const
+{
+    return sum(x, nullptr, rate, kAvx2);
 }
 
 double Interpolant::evaluateBaseline(const Point4& x, Point4* gradient) const
 {
-    return sum(x, gradient, false);
+    return sum(x, gradient, nullptr, false);
 }
 
-double Interpolant::sum(const Point4& x, Point4* gradient, bool avx2) const
+double Interpolant::sum(const Point4& x, Point4* gradient, double* rate, bool avx2) const
 {
     // The frame's hottest loop: four centres a step (sumsSse2, sumsAvx2), d(r^3)/dx = 3 r (x - c).
     const std::array<const double*, 5> c{mCentres[0].data(), mCentres[1].data(), mCentres[2].data(),
                                          mCentres[3].data(), mPaddedWeights.data()};
     Lanes lanes;
-    (avx2 ? sumsAvx2 : sumsSse2)(c, mPaddedWeights.size(), x.data(), gradient != nullptr, lanes);
+    const Wanted wanted = gradient ? kGradient : rate ? kRate : kValue;
+    (avx2 ? sumsAvx2 : sumsSse2)(c, mPaddedWeights.size(), x.data(), wanted, lanes);
     if (gradient)
         *gradient =
             mPolynomial.tail<4>() + Point4(sumLanes(lanes.sums[1]), sumLanes(lanes.sums[2]),
                                            sumLanes(lanes.sums[3]), sumLanes(lanes.sums[4]));
+    if (rate) *rate = mPolynomial[4] + sumLanes(lanes.sums[4]);
     return mPolynomial[0] + mPolynomial.tail<4>().dot(x) + sumLanes(lanes.sums[0]);
 }
 

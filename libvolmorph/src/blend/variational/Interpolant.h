@@ -54,6 +54,9 @@ public:
     /// f(x), and its gradient into `gradient` when not null: one pass for both, with AVX2 where
     /// the machine has it.
     double evaluate(const Point4& x, Point4* gradient) const;
+    /// f(x), and df/dt' into `rate` when not null (the gradient's last component, the same bits,
+    /// for a fifth of the gradient's extra sums).
+    double evaluateWithRate(const Point4& x, double* rate) const;
     /// The same through the SSE2 build alone: the test that both give the same bits calls it.
     double evaluateBaseline(const Point4& x, Point4* gradient) const;
 
@@ -62,7 +65,7 @@ public:
     const Eigen::Matrix<double, 5, 1>& polynomial() const { return mPolynomial; }
 
 private:
-    double sum(const Point4& x, Point4* gradient, bool avx2) const;
+    double sum(const Point4& x, Point4* gradient, double* rate, bool avx2) const;
 
     /// The centres by coordinate (x, y, z, t'), and the weights again beside them, each padded to
     /// a multiple of 4 (a zero weight) for the four-lane loop.

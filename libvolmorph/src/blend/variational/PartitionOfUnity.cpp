@@ -207,7 +207,7 @@ void PartitionOfUnity::listBallsPerCell()
     }
 }
 
-double PartitionOfUnity::local(const Point4& x, Point4* gradient) const
+double PartitionOfUnity::local(const Point4& x, Point4* gradient, double* rate) const
 {
     const Eigen::Vector3d p = spatial(x);
     const Eigen::Array3d u = (p - mLo).array() / mCell;
@@ -216,7 +216,7 @@ double PartitionOfUnity::local(const Point4& x, Point4* gradient) const
     const Eigen::Array3i c = u.floor().cast<int>().max(0).min(mCells - 1);
     const size_t cell = size_t((c.x() * mCells.y() + c.y()) * mCells.z() + c.z());
     // f = S / W with S = sum w_k r_k, W = sum w_k; grad f = (grad S - f grad W) / W.
-    double sum = 0.0, weights = 0.0;
+    double sum = 0.0, weights = 0.0, rateSum = 0.0;
     Point4 gradSum = Point4::Zero(), gradWeights = Point4::Zero();
     for (uint32_t n = mCellStart[cell]; n < mCellStart[cell + 1]; ++n) {
         const Patch& patch = mPatches[mCellPatches[n]];
@@ -225,9 +225,12 @@ double PartitionOfUnity::local(const Point4& x, Point4* gradient) const
         const double w = wendland(d);
         if (w <= 0.0) continue;
         Point4 gradR;
-        const double r = patch.f.evaluate(x, gradient ? &gradR : nullptr);
+        double rateR = 0.0;
+        const double r = gradient ? patch.f.evaluate(x, &gradR)
+                                  : patch.f.evaluateWithRate(x, rate ? &rateR : nullptr);
         sum += w * r;
         weights += w;
+        if (rate) rateSum += w * rateR;
         if (!gradient) continue;
         // psi'(d) = -20 d (1 - d)^3; d's gradient is offset / (|offset| R).
         Point4 gradW = Point4::Zero();
@@ -241,6 +244,7 @@ double PartitionOfUnity::local(const Point4& x, Point4* gradient) const
     // The null weight: 0 beyond every ball, continuously.
     const double value = sum / (weights + kNullWeight);
     if (gradient) *gradient = (gradSum - value * gradWeights) / (weights + kNullWeight);
+    if (rate) *rate = rateSum / (weights + kNullWeight);
     return value;
 }
 
@@ -254,6 +258,15 @@ Point4 PartitionOfUnity::gradient(const Point4& x) const
     Point4 g;
     evaluate(x, &g);
     return g;
+}
+
+double PartitionOfUnity::evaluateLocal(const Point4& x, double* rate) const
+{
+    if (mPatches.empty()) {
+        if (rate) *rate = 0.0;
+        return 0.0;
+    }
+    return local(x, nullptr, rate);
 }
 
 double PartitionOfUnity::evaluate(const Point4& x, Point4* gradient) const

@@ -59,6 +59,14 @@ public:
     Point4 gradient(const Point4& x) const;
     /// f(x), and its gradient into `gradient` when not null: one pass for both.
     double evaluate(const Point4& x, Point4* gradient) const;
+    /// The coarse level alone (smooth in space away from the shapes' times: its centres are a
+    /// few thousand, spread over the shapes), and the balls' level alone: evaluate() is their sum.
+    /// With `rate`, df/dt' there too (evaluate()'s gradient's last component, the same bits).
+    double evaluateCoarse(const Point4& x, double* rate) const
+    {
+        return mCoarse.evaluateWithRate(x, rate);
+    }
+    double evaluateLocal(const Point4& x, double* rate) const;
     size_t patchCount() const { return mPatches.size(); }
 
 private:
@@ -67,8 +75,9 @@ private:
         double radius = 0.0;
         Interpolant f;
     };
-    /// The local level's value, and its gradient when `gradient` is given.
-    double local(const Point4& x, Point4* gradient = nullptr) const;
+    /// The local level's value, and its gradient when `gradient` is given, or only df/dt' when
+    /// `rate` is (the weights do not depend on t).
+    double local(const Point4& x, Point4* gradient, double* rate = nullptr) const;
     /// mCellStart and mCellPatches from the patches.
     void listBallsPerCell();
 

@@ -55,25 +55,40 @@ struct Lattice {
     float at(int a, int b, int c) const { return values[node(a, b, c)]; }
     Coord cells() const { return nodes - Coord(1); }
 
-    /// Catmull-Rom in `v` between the nodes around cell (a, b, c) at (u, v, s) in [0, 1)^3 (nodes
-    /// beyond the lattice clamped to its edge): exact for cubics along each axis, its error the
-    /// function's fourth derivatives times stride^4.
+    /// Catmull-Rom in `field` between the nodes around cell (a, b, c), with weights `w` per axis
+    /// (nodes beyond the lattice clamped to its edge): exact for cubics along each axis, its error
+    /// the function's fourth derivatives times stride^4. Nodes of zero weight (all but one along
+    /// an axis where the point is on a node) are not read.
     double tricubic(const std::vector<float>& field, int a, int b, int c,
                     const std::array<std::array<double, 4>, 3>& w) const
     {
         const auto clampTo = [](int i, int n) { return std::clamp(i, 0, n - 1); };
         double value = 0.0;
-        for (int i = 0; i < 4; ++i)
+        for (int i = 0; i < 4; ++i) {
+            if (w[0][i] == 0.0) continue;
             for (int j = 0; j < 4; ++j) {
+                if (w[1][j] == 0.0) continue;
                 double row = 0.0;
                 const size_t base = (size_t(clampTo(a + i - 1, nodes.x())) * nodes.y() +
                                      size_t(clampTo(b + j - 1, nodes.y()))) *
                                     nodes.z();
                 for (int k = 0; k < 4; ++k)
-                    row += w[2][k] * field[base + size_t(clampTo(c + k - 1, nodes.z()))];
+                    if (w[2][k] != 0.0)
+                        row += w[2][k] * field[base + size_t(clampTo(c + k - 1, nodes.z()))];
                 value += w[0][i] * w[1][j] * row;
             }
+        }
         return value;
+    }
+
+    /// The cell holding voxel `v` (index space relative to the origin, inside the lattice) and
+    /// the voxel's Catmull-Rom weights in it.
+    std::pair<Coord, std::array<std::array<double, 4>, 3>> cellOf(const Coord& v) const;
+    /// Catmull-Rom in `field` at voxel `v` (relative to the origin, inside the lattice).
+    double interpolate(const std::vector<float>& field, const Coord& v) const
+    {
+        const auto [cell, weights] = cellOf(v);
+        return tricubic(field, cell.x(), cell.y(), cell.z(), weights);
     }
 };
 
@@ -83,11 +98,22 @@ std::array<double, 4> catmullRom(double x)
             0.5 * (-3 * x * x * x + 4 * x * x + x), 0.5 * (x * x * x - x * x)};
 }
 
-/// The lattice's values where `needed(a, b, c)` says; `evaluations` counts them.
-Lattice evaluateLattice(const SliceFunction& f, double w, const openvdb::math::Transform& transform,
-                        const openvdb::CoordBBox& box, int stride,
-                        const std::function<bool(int, int, int)>& needed, bool withRates,
-                        size_t& evaluations, Interrupter* interrupter)
+std::pair<Coord, std::array<std::array<double, 4>, 3>> Lattice::cellOf(const Coord& v) const
+{
+    Coord cell;
+    std::array<std::array<double, 4>, 3> weights;
+    for (int axis = 0; axis < 3; ++axis) {
+        cell[axis] = std::max(0, std::min(v[axis] / stride, nodes[axis] - 2));
+        weights[axis] = catmullRom(double(v[axis] - cell[axis] * stride) / stride);
+    }
+    return {cell, weights};
+}
+
+/// f at a lattice node: its voxel (index space, relative to the lattice's origin) and its point.
+using NodeFunction = std::function<double(const Coord& voxel, const Point4& p, double* rate)>;
+
+/// A lattice over `box` at `stride`, no node evaluated yet (NaN).
+Lattice emptyLattice(const openvdb::CoordBBox& box, int stride, bool withRates)
 {
     Lattice l;
     l.origin = box.min();
@@ -97,6 +123,16 @@ Lattice evaluateLattice(const SliceFunction& f, double w, const openvdb::math::T
     const size_t count = size_t(l.nodes.x()) * l.nodes.y() * l.nodes.z();
     l.values.assign(count, std::numeric_limits<float>::quiet_NaN());
     if (withRates) l.rates.assign(count, 0.0f);
+    return l;
+}
+
+/// -f (and -df/dw, when the lattice holds rates) at the nodes `needed` marks and not yet
+/// evaluated; `evaluations` counts them.
+void evaluateNodes(Lattice& l, const NodeFunction& f, double w,
+                   const openvdb::math::Transform& transform, const std::vector<char>& needed,
+                   size_t& evaluations, Interrupter* interrupter)
+{
+    const bool withRates = !l.rates.empty();
     std::atomic<size_t> taken{0};
     std::atomic<bool> stopped{false};
     tbb::parallel_for(0, l.nodes.x(), [&](int a) {
@@ -107,13 +143,13 @@ Lattice evaluateLattice(const SliceFunction& f, double w, const openvdb::math::T
         size_t here = 0;
         for (int b = 0; b < l.nodes.y(); ++b)
             for (int c = 0; c < l.nodes.z(); ++c) {
-                if (!needed(a, b, c)) continue;
-                const openvdb::Vec3d p =
-                    transform.indexToWorld(l.origin + Coord(a * stride, b * stride, c * stride));
-                double rate = 0.0;
                 const size_t n = l.node(a, b, c);
+                if (!needed[n] || !std::isnan(l.values[n])) continue;
+                const Coord v(a * l.stride, b * l.stride, c * l.stride);
+                const openvdb::Vec3d p = transform.indexToWorld(l.origin + v);
+                double rate = 0.0;
                 l.values[n] =
-                    float(-f(Point4(p.x(), p.y(), p.z(), w), withRates ? &rate : nullptr));
+                    float(-f(v, Point4(p.x(), p.y(), p.z(), w), withRates ? &rate : nullptr));
                 if (withRates) l.rates[n] = float(-rate);
                 ++here;
             }
@@ -121,15 +157,18 @@ Lattice evaluateLattice(const SliceFunction& f, double w, const openvdb::math::T
     });
     if (stopped) throw Interrupted();
     evaluations += taken;
-    return l;
 }
 
 /// Whether lattice cell (a, b, c) can hold the zero set within `band` voxels of it: its corners
-/// change sign, or the smallest is within a stride and the band at the steepest slope between
+/// change sign, or the smallest is within the band and an allowance at the steepest slope between
 /// them (never taken under `leastSlope` per voxel, about a distance's: f is flat between the
 /// shapes in places). Were f linear across the cell its smallest |f| would be at a corner; the
-/// stride is the allowance for its curvature (the cell's diagonal kept 30% more values, and no
-/// voxel more within 1.5 voxels of the zero set, BENCHMARKS.md).
+/// allowance is for its curvature: across a cell of side s, f leaves its multilinear interpolant
+/// by about s^2 / 8 times its second derivative, which for a distance is one over the radius of
+/// curvature, and the grid resolves no radius under a voxel: s^2 / 8 voxels, and never over a
+/// stride (the stride alone, at every level, kept 16% more values on dino-to-eight-variational at
+/// 256 across and no voxel more within 4 voxels of the zero set; no allowance lost 69,628 of them
+/// at t = 0.25, BENCHMARKS.md).
 bool nearZero(const Lattice& l, int a, int b, int c, double band, double leastSlope)
 {
     float lo = 1e30f, hi = -1e30f, smallest = 1e30f, steepest = 0.0f;
@@ -142,9 +181,10 @@ bool nearZero(const Lattice& l, int a, int b, int c, double band, double leastSl
         if (k > c) steepest = std::max(steepest, std::abs(v - l.at(i, j, c)));
     }
     if (lo <= 0.0f && hi >= 0.0f) return true;
-    // The steepest edge's slope per voxel, over a stride and the band.
+    // The steepest edge's slope per voxel, over the band and the allowance.
     const double slope = std::max(double(steepest) / l.stride, leastSlope);
-    return smallest <= slope * (l.stride + band);
+    const double allowance = std::min(double(l.stride), l.stride * l.stride / 8.0);
+    return smallest <= slope * (band + allowance);
 }
 
 /// A mask over a lattice's cells.
@@ -162,19 +202,50 @@ struct CellMask {
     }
 };
 
-/// Cells of `l` near the zero set (nearZero) among those `candidate` allows.
-CellMask cellsNearZero(const Lattice& l, double band, double leastSlope,
-                       const std::function<bool(int, int, int)>& candidate)
+/// The cells of a lattice with `cells` cells per axis where `on(a, b, c)` holds.
+template <typename On>
+CellMask cellsWhere(const Coord& cells, On on)
 {
-    CellMask m{l.cells(), {}};
-    const Coord& n = m.cells;
-    m.on.assign(size_t(n.x()) * n.y() * n.z(), 0);
-    for (int a = 0; a < n.x(); ++a)
-        for (int b = 0; b < n.y(); ++b)
-            for (int c = 0; c < n.z(); ++c)
-                m.on[(size_t(a) * n.y() + b) * n.z() + c] =
-                    candidate(a, b, c) && nearZero(l, a, b, c, band, leastSlope);
+    CellMask m{cells, std::vector<char>(size_t(cells.x()) * cells.y() * cells.z(), 0)};
+    for (int a = 0; a < cells.x(); ++a)
+        for (int b = 0; b < cells.y(); ++b)
+            for (int c = 0; c < cells.z(); ++c)
+                m.on[(size_t(a) * cells.y() + b) * cells.z() + c] = on(a, b, c);
     return m;
+}
+
+/// Cells of `l` near the zero set (nearZero) among the `candidates`.
+CellMask cellsNearZero(const Lattice& l, double band, double leastSlope, const CellMask& candidates)
+{
+    return cellsWhere(l.cells(), [&](int a, int b, int c) {
+        return candidates.at(a, b, c) && nearZero(l, a, b, c, band, leastSlope);
+    });
+}
+
+/// The nodes (a mask over them) of the cells of `m` and, with `reach` 1, of each one's
+/// Catmull-Rom stencil too (a node further on each side).
+std::vector<char> nodesOf(const CellMask& m, int reach)
+{
+    const Coord n = m.cells + Coord(1);
+    std::vector<char> nodes(size_t(n.x()) * n.y() * n.z(), 0);
+    for (int a = 0; a < m.cells.x(); ++a)
+        for (int b = 0; b < m.cells.y(); ++b)
+            for (int c = 0; c < m.cells.z(); ++c) {
+                if (!m.at(a, b, c)) continue;
+                for (int i = std::max(0, a - reach); i <= std::min(n.x() - 1, a + 1 + reach); ++i)
+                    for (int j = std::max(0, b - reach); j <= std::min(n.y() - 1, b + 1 + reach);
+                         ++j)
+                        for (int k = std::max(0, c - reach);
+                             k <= std::min(n.z() - 1, c + 1 + reach); ++k)
+                            nodes[(size_t(i) * n.y() + j) * n.z() + k] = 1;
+            }
+    return nodes;
+}
+
+/// The cells of lattice `l` inside the cells of `parent` (a lattice `ratio` times coarser).
+CellMask children(const CellMask& parent, const Lattice& l, int ratio)
+{
+    return cellsWhere(l.cells(), [&](int a, int b, int c) { return parent.holds(a, b, c, ratio); });
 }
 
 /// `m` with every cell's neighbours on too.
@@ -203,28 +274,61 @@ struct Screened {
     CellMask kept; ///< the fine lattice's cells near the zero set
 };
 
-Screened screen(const SliceFunction& f, double w, const openvdb::math::Transform& transform,
-                const openvdb::CoordBBox& box, int stride, double band, bool withRates,
-                size_t& evaluations, Interrupter* interrupter)
+/// f.smooth on a lattice at `stride`, exact at the nodes of the stencils of the `cells` and
+/// their neighbours (which hold every node of the finer levels).
+Lattice smoothLattice(const SplitFunction& f, double w, const openvdb::math::Transform& transform,
+                      const openvdb::CoordBBox& box, int stride, const CellMask& cells,
+                      bool withRates, size_t& evaluations, Interrupter* interrupter)
+{
+    Lattice smooth = emptyLattice(box, stride, withRates);
+    const NodeFunction exact = [&f](const Coord&, const Point4& p, double* rate) {
+        return f.smooth(p, rate);
+    };
+    evaluateNodes(smooth, exact, w, transform, nodesOf(grown(cells), 1), evaluations, interrupter);
+    return smooth;
+}
+
+Screened screen(const SplitFunction& f, double w, const openvdb::math::Transform& transform,
+                const openvdb::CoordBBox& box, int stride, int smoothStride, double band,
+                bool withRates, size_t& evaluations, Interrupter* interrupter)
 {
     const double leastSlope = transform.voxelSize()[0]; // a distance's, per voxel
     int levelStride = stride;
     for (int level = 1; level < kLevels; ++level) levelStride *= kRatio;
-    std::function<bool(int, int, int)> needed = [](int, int, int) { return true; };
-    std::function<bool(int, int, int)> candidate = needed;
-    CellMask nodesNear, cellsNear;
+    // f exact, until the levels finer than smoothStride read f.smooth from `smooth`.
+    NodeFunction value = [&f](const Coord&, const Point4& p, double* rate) {
+        if (!f.smooth) return f.detail(p, rate);
+        double smoothRate = 0.0;
+        const double v = f.smooth(p, rate ? &smoothRate : nullptr) + f.detail(p, rate);
+        if (rate) *rate += smoothRate;
+        return v;
+    };
+    Lattice smooth;
+    CellMask kept;
     for (int level = 0;; ++level, levelStride /= kRatio) {
         const bool last = level == kLevels - 1;
-        Lattice l = evaluateLattice(f, w, transform, box, levelStride, needed, last && withRates,
-                                    evaluations, interrupter);
-        CellMask cells = cellsNearZero(l, band, leastSlope, candidate);
-        if (last) return Screened{l, std::move(cells)};
-        // The next level tests the cells kept here, and evaluates its nodes one cell further (a
-        // cell's neighbours and the tricubic's stencil).
-        nodesNear = grown(cells);
-        cellsNear = std::move(cells);
-        needed = [&nodesNear](int a, int b, int c) { return nodesNear.holds(a, b, c, kRatio); };
-        candidate = [&cellsNear](int a, int b, int c) { return cellsNear.holds(a, b, c, kRatio); };
+        Lattice l = emptyLattice(box, levelStride, last && withRates);
+        // The cells tested: every one at first, then those inside the cells kept a level up.
+        CellMask candidates = level == 0 ? cellsWhere(l.cells(), [](int, int, int) { return true; })
+                                         : children(kept, l, kRatio);
+        evaluateNodes(l, value, w, transform, nodesOf(candidates, 0), evaluations, interrupter);
+        kept = cellsNearZero(l, band, leastSlope, candidates);
+        if (last) {
+            // The kept cells' voxels are interpolated: their stencils' nodes too.
+            evaluateNodes(l, value, w, transform, nodesOf(kept, 1), evaluations, interrupter);
+            return Screened{l, std::move(kept)};
+        }
+        if (f.smooth && levelStride == smoothStride) {
+            smooth = smoothLattice(f, w, transform, box, levelStride, kept, withRates, evaluations,
+                                   interrupter);
+            value = [&f, &smooth](const Coord& v, const Point4& p, double* rate) {
+                const double detail = f.detail(p, rate);
+                double g = -smooth.interpolate(smooth.values, v);
+                if (std::isnan(g)) g = f.smooth(p, nullptr); // never, by the stencils taken
+                if (rate && !smooth.rates.empty()) *rate -= smooth.interpolate(smooth.rates, v);
+                return g + detail;
+            };
+        }
     }
 }
 
@@ -271,17 +375,29 @@ NearZeroSlice sliceNearZero(const SliceFunction& f, double w,
                             const openvdb::CoordBBox& box, int stride, double bandVoxels,
                             bool withRates, Interrupter* interrupter)
 {
+    return sliceNearZero(SplitFunction{nullptr, f}, w, transform, box, stride, bandVoxels,
+                         withRates, interrupter);
+}
+
+NearZeroSlice sliceNearZero(const SplitFunction& f, double w,
+                            const openvdb::math::Transform::Ptr& transform,
+                            const openvdb::CoordBBox& box, int stride, double bandVoxels,
+                            bool withRates, Interrupter* interrupter, int smoothStride)
+{
     NearZeroSlice out;
-    const Screened s =
-        screen(f, w, *transform, box, stride, bandVoxels, withRates, out.evaluations, interrupter);
+    const Screened s = screen(f, w, *transform, box, stride, smoothStride, bandVoxels, withRates,
+                              out.evaluations, interrupter);
     const Lattice& l = s.fine;
     const Coord cells = l.cells();
-    // A voxel is written when its cell or a neighbour is kept; leaf by leaf, in parallel.
-    const CellMask written = grown(s.kept);
+    // A voxel is written when its cell is kept; leaf by leaf, in parallel.
+    const CellMask& written = s.kept;
     const std::vector<Coord> origins = leavesWritten(l, written, box);
     using Leaf = openvdb::FloatTree::LeafNodeType;
     std::vector<std::unique_ptr<Leaf>> values(origins.size()), rates(origins.size());
     const float background = float(bandVoxels * transform->voxelSize()[0]);
+    // Catmull-Rom weights by a voxel's offset in its cell.
+    std::vector<std::array<double, 4>> weightsAt(static_cast<size_t>(stride));
+    for (int k = 0; k < stride; ++k) weightsAt[size_t(k)] = catmullRom(double(k) / stride);
     tbb::parallel_for(size_t(0), origins.size(), [&](size_t n) {
         auto value = std::make_unique<Leaf>(origins[n], background, false);
         auto rate = withRates ? std::make_unique<Leaf>(origins[n], 0.0f, false) : nullptr;
@@ -292,9 +408,8 @@ NearZeroSlice sliceNearZero(const SliceFunction& f, double w,
             if (a >= cells.x() || b >= cells.y() || c >= cells.z() || !written.at(a, b, c))
                 continue;
             const std::array<std::array<double, 4>, 3> weights{
-                catmullRom(double(v.x() - a * stride) / stride),
-                catmullRom(double(v.y() - b * stride) / stride),
-                catmullRom(double(v.z() - c * stride) / stride)};
+                weightsAt[size_t(v.x() - a * stride)], weightsAt[size_t(v.y() - b * stride)],
+                weightsAt[size_t(v.z() - c * stride)]};
             value->setValueOn(i, float(l.tricubic(l.values, a, b, c, weights)));
             if (rate) rate->setValueOn(i, float(l.tricubic(l.rates, a, b, c, weights)));
         }

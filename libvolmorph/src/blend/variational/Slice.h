@@ -17,6 +17,14 @@ namespace volmorph::detail::variational {
 /// null, its derivative along w there.
 using SliceFunction = std::function<double(const Point4&, double* rate)>;
 
+/// A function split in two, f = smooth + detail: `smooth` varies slowly in space and is read from a
+/// lattice of its own, tricubic between its nodes; `detail` is taken exactly. `smooth` may be
+/// empty (f is `detail`).
+struct SplitFunction {
+    SliceFunction smooth;
+    SliceFunction detail;
+};
+
 /// -f(x, y, z, w) at every voxel of `box` (index space of `transform`), so negative inside as
 /// volmorph's signed distances are (not a distance: the function's own values), every voxel
 /// active, background +|largest value|; a level set grid class so OpenVDB's tools read it.
@@ -35,15 +43,27 @@ struct NearZeroSlice {
 
 /// The slice near its zero set only, from exact values on a lattice every `stride` voxels: a
 /// lattice cell is kept when its corners' values change sign, or when the smallest of them is
-/// within one stride and `bandVoxels` of zero at the steepest slope between its corners (never
-/// under a distance's; f grows about as the distance near the shapes, its constraints' values
-/// being distances); kept cells and their neighbours get every voxel, tricubic (Catmull-Rom)
-/// between the lattice's values: at a stride of 2, within 0.013 voxel of the exact values on a
-/// sphere becoming two (4: 0.15; trilinear at 2: 0.15, at 4: 0.95). The lattice is screened
-/// coarsest first: 16 strides apart over the box, then halving, each level testing only the cells
-/// its parent kept and evaluating its nodes one parent cell further (a kept cell's neighbours and
-/// the tricubic's stencil). With `withRates`, df/dw is taken at the same lattice points and
-/// interpolated the same way. Throws Interrupted when `interrupter` asks to stop.
+/// within `bandVoxels` of zero and an allowance for f's curvature (stride^2 / 8 voxels, at most a
+/// stride) at the steepest slope between its corners (never under a distance's; f grows about as
+/// the distance near the shapes, its constraints' values being distances); kept cells get every
+/// voxel, tricubic (Catmull-Rom) between the lattice's values: at a stride of 2, within 0.013
+/// voxel of the exact values on a sphere becoming two (4: 0.15; trilinear at 2: 0.15, at 4: 0.95).
+/// The lattice is screened coarsest first: 16 strides apart over the box, then halving, each level
+/// evaluating the corners of the cells inside those its parent kept, and the finest level the
+/// nodes of its kept cells' tricubic stencils too. With `withRates`, df/dw is taken at the same
+/// lattice points and interpolated the same way. Throws Interrupted when `interrupter` asks to
+/// stop.
+///
+/// With a split function, the levels finer than `smoothStride` voxels (a level's stride; 0 for
+/// none) take f.smooth from its own lattice at that stride (tricubic between exact values at the
+/// nodes around the cells the level kept, and their neighbours) and f.detail exactly at each node.
+NearZeroSlice sliceNearZero(const SplitFunction& f, double w,
+                            const openvdb::math::Transform::Ptr& transform,
+                            const openvdb::CoordBBox& box, int stride, double bandVoxels,
+                            bool withRates = false, Interrupter* interrupter = nullptr,
+                            int smoothStride = 8);
+
+/// sliceNearZero of f alone, every value exact at the lattice's nodes.
 NearZeroSlice sliceNearZero(const SliceFunction& f, double w,
                             const openvdb::math::Transform::Ptr& transform,
                             const openvdb::CoordBBox& box, int stride, double bandVoxels,
