@@ -31,6 +31,7 @@ namespace {
 using openvdb::Coord;
 using openvdb::CoordBBox;
 using variational::Constraint;
+using variational::Interpolant;
 using variational::PartitionOfUnity;
 using variational::Point4;
 using Sampler = openvdb::tools::BoxSampler;
@@ -38,13 +39,15 @@ using Sampler = openvdb::tools::BoxSampler;
 /// The frame's exact values lie on a lattice this many voxels apart, tricubic between: within
 /// 0.01 voxel of the exact slice near its zero set (Slice.h).
 constexpr int kStride = 2;
-/// The partition of unity's coarse level is read from a lattice h voxels apart (8 or 4, tricubic
-/// between) when the frame lies at least kSmoothReach * h voxels (in w = t * time_scale) from every
-/// shape's time: its centres lie at those times, and their r^3 are smooth in the slice at the
-/// scale of that distance, delta. Against the coarse level taken exactly, on
-/// dino-to-eight-variational at 256 across, the slice's largest difference within 4 voxels of its
-/// zero set: 0.41 voxel at delta = 1.6 h, 0.17 at 2.4 h, 0.058 at 3.9 h, 0.022 at 7.9 h (means
-/// 0.047, 0.028, 0.011, 0.004).
+/// The partition of unity's coarse level is read from lattices (tricubic between their nodes):
+/// its centres at least kSmoothReach steps of 8 voxels (along w = t * time_scale) from the frame
+/// from a lattice 8 voxels apart, those at least that many steps of 4 voxels from one 4 voxels
+/// apart, and the nearer ones exactly. The centres lie at the shapes' times, and each r^3 is smooth
+/// in the slice at the scale of its distance delta along w, but only C2 at its own time (read from
+/// a lattice at t = 0, the dino's IoU fell from 0.988 to 0.903). Against the coarse level taken
+/// exactly, on dino-to-eight-variational at 256 across, the slice's largest difference within 4
+/// voxels of its zero set with every centre delta away: 0.41 voxel at delta = 1.6 steps, 0.17 at
+/// 2.4, 0.058 at 3.9, 0.022 at 7.9 (means 0.047, 0.028, 0.011, 0.004; BENCHMARKS.md).
 constexpr double kSmoothReach = 3.5;
 /// Exterior constraints per edge of the box (kExterior^3 - (kExterior - 2)^3 on its faces).
 constexpr int kExterior = 9;
@@ -119,11 +122,9 @@ public:
         std::vector<Shape> shapes{{&mSource, 0.0}, {&mTarget, 1.0}};
         if (setup.influences)
             for (const TimedVolume& i : *setup.influences) shapes.push_back({&i.volume, i.t});
-        for (const Shape& s : shapes) {
+        for (const Shape& s : shapes)
             if (!s.volume->sdf)
                 throw std::invalid_argument("variational blending needs an sdf grid per shape");
-            mTimes.push_back(s.t);
-        }
         const VariationalSpec& spec = mSpec.variational;
         mVoxel = mSource.voxelSize();
         mWidth = std::min(mSource.sdf->background(), mTarget.sdf->background());
@@ -158,14 +159,26 @@ public:
     BlendedFrame frame(const BlendRequest& r, OutputLeaves& leaves) const override
     {
         const bool velocity = r.velocityScale > 0.0;
-        // The coarse level (smooth away from the shapes' times) read from a lattice, the balls'
-        // level exact.
-        const variational::SplitFunction f{
-            [this](const Point4& p, double* rate) { return mFunction.evaluateCoarse(p, rate); },
-            [this](const Point4& p, double* rate) { return mFunction.evaluateLocal(p, rate); }};
-        variational::NearZeroSlice slice = variational::sliceNearZero(
-            f, r.t * mTimeScale, mSource.density->transformPtr(), mBox, kStride,
-            mWidth / mVoxel + 1.0, velocity, r.interrupter, smoothStrideAt(r.t));
+        // The coarse level's centres far from the frame's time read from lattices; the nearest
+        // ones and the balls' level exact.
+        const double w = r.t * mTimeScale, step = kSmoothReach * mVoxel;
+        const auto [near, rest] = mFunction.coarse().splitByTime(w, 4 * step);
+        const auto [middle, far] = rest.splitByTime(w, 8 * step);
+        const auto part = [](const Interpolant& i) {
+            return [&i](const Point4& p, double* rate) { return i.evaluateWithRate(p, rate); };
+        };
+        variational::SplitFunction f{{{part(far), 8}}, nullptr};
+        if (middle.size() > 0) f.smooth.push_back({part(middle), 4});
+        f.detail = [this, &near = near](const Point4& p, double* rate) {
+            double nearRate = 0.0;
+            const double value = near.evaluateWithRate(p, rate ? &nearRate : nullptr) +
+                                 mFunction.evaluateLocal(p, rate);
+            if (rate) *rate += nearRate;
+            return value;
+        };
+        variational::NearZeroSlice slice =
+            variational::sliceNearZero(f, w, mSource.density->transformPtr(), mBox, kStride,
+                                       mWidth / mVoxel + 1.0, velocity, r.interrupter);
         std::vector<std::unique_ptr<openvdb::Vec3STree::LeafNodeType>> velocities;
         if (velocity) velocities = normalMotion(slice, r.velocityScale / mVoxel);
         std::vector<OutputLeaves::ValueLeaf*> values;
@@ -180,17 +193,6 @@ public:
     }
 
 private:
-    /// The coarse level's lattice stride (voxels) for a frame at t, 0 where it must be exact.
-    int smoothStrideAt(double t) const
-    {
-        double delta = std::numeric_limits<double>::max(); // voxels, along w
-        for (double time : mTimes)
-            delta = std::min(delta, std::abs(t - time) * mTimeScale / mVoxel);
-        for (int h : {8, 4})
-            if (delta >= kSmoothReach * h) return h;
-        return 0;
-    }
-
     /// Each shape's constraints at its time.
     std::vector<Constraint> sample(const std::vector<Shape>& shapes) const
     {
@@ -342,7 +344,6 @@ private:
     VolumeSet mSource, mTarget;
     BlendSpec mSpec;
     double mVoxel = 1.0, mTimeScale = 1.0;
-    std::vector<double> mTimes; ///< each shape's t
     float mWidth = 0.0f;
     CoordBBox mBox; ///< where the in-betweens are looked for (index space)
     PartitionOfUnity mFunction;

@@ -65,6 +65,25 @@ Interpolant::Interpolant(std::vector<Point4> centres, Eigen::VectorXd weights,
     for (size_t j = 0; j < centres.size(); ++j) mPaddedWeights[j] = mWeights[Eigen::Index(j)];
 }
 
+std::pair<Interpolant, Interpolant> Interpolant::splitByTime(double w, double reach) const
+{
+    std::vector<Point4> centres[2];
+    std::vector<double> weights[2];
+    for (size_t j = 0; j < size(); ++j) {
+        const Point4 c(mCentres[0][j], mCentres[1][j], mCentres[2][j], mCentres[3][j]);
+        const int far = std::abs(c[3] - w) >= reach ? 1 : 0;
+        centres[far].push_back(c);
+        weights[far].push_back(mWeights[Eigen::Index(j)]);
+    }
+    const auto make = [&](int k, const Eigen::Matrix<double, 5, 1>& polynomial) {
+        return Interpolant(
+            std::move(centres[k]),
+            Eigen::Map<const Eigen::VectorXd>(weights[k].data(), Eigen::Index(weights[k].size())),
+            polynomial);
+    };
+    return {make(0, Eigen::Matrix<double, 5, 1>::Zero()), make(1, mPolynomial)};
+}
+
 double Interpolant::operator()(const Point4& x) const
 {
     return evaluate(x, nullptr);

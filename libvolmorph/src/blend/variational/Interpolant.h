@@ -19,6 +19,7 @@
 
 #include <array>
 #include <cstdint>
+#include <utility>
 #include <vector>
 
 namespace volmorph::detail::variational {
@@ -59,6 +60,10 @@ public:
     double evaluateWithRate(const Point4& x, double* rate) const;
     /// The same through the SSE2 build alone: the test that both give the same bits calls it.
     double evaluateBaseline(const Point4& x, Point4* gradient) const;
+
+    /// The centres within `reach` of `w` along t' (and their weights), and the others with the
+    /// polynomial: two interpolants whose sum is this one.
+    std::pair<Interpolant, Interpolant> splitByTime(double w, double reach) const;
 
     size_t size() const { return size_t(mWeights.size()); }
     const Eigen::VectorXd& weights() const { return mWeights; }

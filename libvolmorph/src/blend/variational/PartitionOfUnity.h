@@ -59,13 +59,10 @@ public:
     Point4 gradient(const Point4& x) const;
     /// f(x), and its gradient into `gradient` when not null: one pass for both.
     double evaluate(const Point4& x, Point4* gradient) const;
-    /// The coarse level alone (smooth in space away from the shapes' times: its centres are a
-    /// few thousand, spread over the shapes), and the balls' level alone: evaluate() is their sum.
-    /// With `rate`, df/dt' there too (evaluate()'s gradient's last component, the same bits).
-    double evaluateCoarse(const Point4& x, double* rate) const
-    {
-        return mCoarse.evaluateWithRate(x, rate);
-    }
+    /// The coarse level alone (its centres a few thousand, spread over the shapes at their
+    /// times), and the balls' level alone: evaluate() is their sum. evaluateLocal's `rate`, when
+    /// given, gets df/dt' there (evaluate()'s gradient's last component, the same bits).
+    const Interpolant& coarse() const { return mCoarse; }
     double evaluateLocal(const Point4& x, double* rate) const;
     size_t patchCount() const { return mPatches.size(); }
 

@@ -274,36 +274,54 @@ struct Screened {
     CellMask kept; ///< the fine lattice's cells near the zero set
 };
 
-/// f.smooth on a lattice at `stride`, exact at the nodes of the stencils of the `cells` and
+/// A smooth part on a lattice at `stride`, exact at the nodes of the stencils of the `cells` and
 /// their neighbours (which hold every node of the finer levels).
-Lattice smoothLattice(const SplitFunction& f, double w, const openvdb::math::Transform& transform,
+Lattice smoothLattice(const SliceFunction& f, double w, const openvdb::math::Transform& transform,
                       const openvdb::CoordBBox& box, int stride, const CellMask& cells,
                       bool withRates, size_t& evaluations, Interrupter* interrupter)
 {
     Lattice smooth = emptyLattice(box, stride, withRates);
     const NodeFunction exact = [&f](const Coord&, const Point4& p, double* rate) {
-        return f.smooth(p, rate);
+        return f(p, rate);
     };
     evaluateNodes(smooth, exact, w, transform, nodesOf(grown(cells), 1), evaluations, interrupter);
     return smooth;
 }
 
+/// f at a node: the detail and every smooth part exactly, but those whose lattice `lattices`
+/// holds (tricubic there).
+double splitValue(const SplitFunction& f, const std::vector<Lattice>& lattices, const Coord& v,
+                  const Point4& p, double* rate)
+{
+    double value = f.detail(p, rate);
+    for (size_t k = 0; k < f.smooth.size(); ++k) {
+        const Lattice& l = lattices[k];
+        double partRate = 0.0;
+        double part = l.values.empty() ? std::numeric_limits<double>::quiet_NaN()
+                                       : -l.interpolate(l.values, v);
+        if (std::isnan(part)) { // not read from a lattice (yet), or (never) off its stencils
+            part = f.smooth[k].f(p, rate ? &partRate : nullptr);
+        } else if (rate && !l.rates.empty()) {
+            partRate = -l.interpolate(l.rates, v);
+        }
+        value += part;
+        if (rate) *rate += partRate;
+    }
+    return value;
+}
+
 Screened screen(const SplitFunction& f, double w, const openvdb::math::Transform& transform,
-                const openvdb::CoordBBox& box, int stride, int smoothStride, double band,
-                bool withRates, size_t& evaluations, Interrupter* interrupter)
+                const openvdb::CoordBBox& box, int stride, double band, bool withRates,
+                size_t& evaluations, Interrupter* interrupter)
 {
     const double leastSlope = transform.voxelSize()[0]; // a distance's, per voxel
     int levelStride = stride;
     for (int level = 1; level < kLevels; ++level) levelStride *= kRatio;
-    // f exact, until the levels finer than smoothStride read f.smooth from `smooth`.
-    NodeFunction value = [&f](const Coord&, const Point4& p, double* rate) {
-        if (!f.smooth) return f.detail(p, rate);
-        double smoothRate = 0.0;
-        const double v = f.smooth(p, rate ? &smoothRate : nullptr) + f.detail(p, rate);
-        if (rate) *rate += smoothRate;
-        return v;
+    // Each smooth part exact until the levels finer than its stride read it from its lattice.
+    std::vector<Lattice> lattices(f.smooth.size());
+    const NodeFunction value = [&](const Coord& v, const Point4& p, double* rate) {
+        return splitValue(f, lattices, v, p, rate);
     };
-    Lattice smooth;
     CellMask kept;
     for (int level = 0;; ++level, levelStride /= kRatio) {
         const bool last = level == kLevels - 1;
@@ -318,17 +336,10 @@ Screened screen(const SplitFunction& f, double w, const openvdb::math::Transform
             evaluateNodes(l, value, w, transform, nodesOf(kept, 1), evaluations, interrupter);
             return Screened{l, std::move(kept)};
         }
-        if (f.smooth && levelStride == smoothStride) {
-            smooth = smoothLattice(f, w, transform, box, levelStride, kept, withRates, evaluations,
-                                   interrupter);
-            value = [&f, &smooth](const Coord& v, const Point4& p, double* rate) {
-                const double detail = f.detail(p, rate);
-                double g = -smooth.interpolate(smooth.values, v);
-                if (std::isnan(g)) g = f.smooth(p, nullptr); // never, by the stencils taken
-                if (rate && !smooth.rates.empty()) *rate -= smooth.interpolate(smooth.rates, v);
-                return g + detail;
-            };
-        }
+        for (size_t k = 0; k < f.smooth.size(); ++k)
+            if (f.smooth[k].stride == levelStride)
+                lattices[k] = smoothLattice(f.smooth[k].f, w, transform, box, levelStride, kept,
+                                            withRates, evaluations, interrupter);
     }
 }
 
@@ -375,18 +386,18 @@ NearZeroSlice sliceNearZero(const SliceFunction& f, double w,
                             const openvdb::CoordBBox& box, int stride, double bandVoxels,
                             bool withRates, Interrupter* interrupter)
 {
-    return sliceNearZero(SplitFunction{nullptr, f}, w, transform, box, stride, bandVoxels,
-                         withRates, interrupter);
+    return sliceNearZero(SplitFunction{{}, f}, w, transform, box, stride, bandVoxels, withRates,
+                         interrupter);
 }
 
 NearZeroSlice sliceNearZero(const SplitFunction& f, double w,
                             const openvdb::math::Transform::Ptr& transform,
                             const openvdb::CoordBBox& box, int stride, double bandVoxels,
-                            bool withRates, Interrupter* interrupter, int smoothStride)
+                            bool withRates, Interrupter* interrupter)
 {
     NearZeroSlice out;
-    const Screened s = screen(f, w, *transform, box, stride, smoothStride, bandVoxels, withRates,
-                              out.evaluations, interrupter);
+    const Screened s =
+        screen(f, w, *transform, box, stride, bandVoxels, withRates, out.evaluations, interrupter);
     const Lattice& l = s.fine;
     const Coord cells = l.cells();
     // A voxel is written when its cell is kept; leaf by leaf, in parallel.

@@ -10,6 +10,7 @@
 #include <openvdb/openvdb.h>
 
 #include <functional>
+#include <vector>
 
 namespace volmorph::detail::variational {
 
@@ -17,11 +18,16 @@ namespace volmorph::detail::variational {
 /// null, its derivative along w there.
 using SliceFunction = std::function<double(const Point4&, double* rate)>;
 
-/// A function split in two, f = smooth + detail: `smooth` varies slowly in space and is read from a
-/// lattice of its own, tricubic between its nodes; `detail` is taken exactly. `smooth` may be
-/// empty (f is `detail`).
+/// A function split into parts, f = sum of smooth[k].f + detail: each smooth part varies slowly in
+/// space at the scale of its `stride` (voxels, one of the screening's strides) and the levels finer
+/// than that stride read it from a lattice of its own at that stride, tricubic between exact
+/// values at its nodes; `detail` is taken exactly.
 struct SplitFunction {
-    SliceFunction smooth;
+    struct Smooth {
+        SliceFunction f;
+        int stride = 8;
+    };
+    std::vector<Smooth> smooth;
     SliceFunction detail;
 };
 
@@ -54,14 +60,12 @@ struct NearZeroSlice {
 /// lattice points and interpolated the same way. Throws Interrupted when `interrupter` asks to
 /// stop.
 ///
-/// With a split function, the levels finer than `smoothStride` voxels (a level's stride; 0 for
-/// none) take f.smooth from its own lattice at that stride (tricubic between exact values at the
-/// nodes around the cells the level kept, and their neighbours) and f.detail exactly at each node.
+/// With a split function, each smooth part's lattice holds exact values at the nodes around the
+/// cells its level kept and their neighbours (where every finer level's nodes lie).
 NearZeroSlice sliceNearZero(const SplitFunction& f, double w,
                             const openvdb::math::Transform::Ptr& transform,
                             const openvdb::CoordBBox& box, int stride, double bandVoxels,
-                            bool withRates = false, Interrupter* interrupter = nullptr,
-                            int smoothStride = 8);
+                            bool withRates = false, Interrupter* interrupter = nullptr);
 
 /// sliceNearZero of f alone, every value exact at the lattice's nodes.
 NearZeroSlice sliceNearZero(const SliceFunction& f, double w,
