@@ -37,6 +37,7 @@ void SceneMorph::load(int frame)
     MorphOptions options = mOptions;
     options.setupInterrupter = &mInterrupter;
     options.influences = std::move(volumes.influences);
+    mInterrupter.start("morph setup");
     mMorpher.emplace(std::move(volumes.source), std::move(volumes.target), scene.pairs, scene.warp,
                      scene.blend, options);
     mLoaded = inputs;

@@ -5,7 +5,9 @@
 #   2. render-vdb while its shadow maps are built (--verbose names each stage as it starts: fails
 #      unless the signal landed after "render: shadows" began and before "render: pixels" did);
 #   3. render, morph and preview of a scene during a frame's morph (the exact warp on fine voxels,
-#      seconds per frame; fails unless it landed after "frame 1: morph" and before the next stage);
+#      seconds per frame; fails unless it landed after "frame 1: morph" and before the next stage),
+#      and morph during its setup (each side's extended distance: fails unless it landed after
+#      "morph setup" and before "frame 1: morph");
 #   4. morph of a variational scene during its solve (two seconds in, fails if the frame had begun)
 #      and during its frame (after "frame 1: morph").
 # usage: render_interrupt.sh VOLMORPH SOURCE_DIR [LIMIT [COARSEN]]
@@ -99,6 +101,13 @@ for command in render morph preview; do
     stop "$signal" "$command during a frame's morph"
     grep -q "render: empty-space mask" "$dir/err" && fail "$command: the morph was done before the signal"
 done
+rm -f "$dir/err"
+"$volmorph" morph "$dir/scene.toml" --frames 1 -o "$dir/out/f.####.vdb" -v 2>"$dir/err" >/dev/null &
+pid=$!
+wait_for "morph setup"
+sleep 0.3
+stop INT "morph during its setup"
+grep -q "frame 1: morph" "$dir/err" && fail "the setup was done before the signal"
 # 4. The variational method: dino-to-eight-variational at 320 voxels across divided by COARSEN (its
 #    solve takes seconds, and so does a frame).
 sed "s|meshes/|$source_dir/scenes/meshes/|; s|^resolution = 128 |resolution = $((320 / coarsen)) |" \

@@ -35,14 +35,8 @@ public:
         const CoordBBox box = ExtendedDistance::boxFor(*mSource.sdf, *mTarget.sdf, setup.pairCount);
         // Both at once: fast sweeping is partly serial.
         tbb::parallel_invoke(
-            [&] {
-                mFarSource =
-                    std::make_unique<const ExtendedDistance>(mSource.sdf, box, setup.interrupter);
-            },
-            [&] {
-                mFarTarget =
-                    std::make_unique<const ExtendedDistance>(mTarget.sdf, box, setup.interrupter);
-            });
+            [&] { mFarSource = ExtendedDistance::make(mSource.sdf, box, setup.interrupter); },
+            [&] { mFarTarget = ExtendedDistance::make(mTarget.sdf, box, setup.interrupter); });
         if (setup.pairCount == 0)
             mIdentity = std::make_unique<IdentityDistances>(
                 setup.candidates,

@@ -136,14 +136,9 @@ public:
         // The in-betweens lie near the shapes' box: a margin of an eighth, at least 8 voxels.
         const Coord margin(8 + dim.x() / 8, 8 + dim.y() / 8, 8 + dim.z() / 8);
         mBox = CoordBBox(shapesBox.min() - margin, shapesBox.max() + margin);
-        // OpenVDB's fast sweeping takes no interrupter (about a second at 320 across): abandonable.
-        const auto extend = [&](const openvdb::FloatGrid::Ptr& sdf) {
-            return abandonable(
-                [sdf, box = mBox] { return std::make_unique<const ExtendedDistance>(sdf, box); },
-                setup.interrupter);
-        };
-        tbb::parallel_invoke([&] { mFarSource = extend(mSource.sdf); },
-                             [&] { mFarTarget = extend(mTarget.sdf); });
+        tbb::parallel_invoke(
+            [&] { mFarSource = ExtendedDistance::make(mSource.sdf, mBox, setup.interrupter); },
+            [&] { mFarTarget = ExtendedDistance::make(mTarget.sdf, mBox, setup.interrupter); });
         const openvdb::math::Transform& xform = mSource.density->transform();
         std::vector<Constraint> constraints = exteriorConstraints(mBox, xform, *mFarSource, 0.0);
         const std::vector<Constraint> far =
