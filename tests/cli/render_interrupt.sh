@@ -41,6 +41,18 @@ wait_for() {
     done
 }
 
+# start PATTERN ARGS...: runs volmorph ARGS -v in the background until its log ($dir/err) shows
+# PATTERN. The last command's log goes first: wait_for could otherwise read it before the shell
+# truncates the file for this one, and signal a process that has no handler yet (exit 143).
+start() {
+    pattern=$1
+    shift
+    rm -f "$dir/err"
+    "$volmorph" "$@" -v 2>"$dir/err" >/dev/null &
+    pid=$!
+    wait_for "$pattern"
+}
+
 # stop SIGNAL WHAT: sends SIGNAL, waits, and checks the exit status, the delay and the output folder.
 stop() {
     t0=$(now)
@@ -70,11 +82,8 @@ kill -0 "$pid" 2>/dev/null || fail "render-vdb had finished before the signal; n
 stop TERM "render-vdb at 1920x1080, 256 samples"
 
 # 2. While the shadow maps are built.
-rm -f "$dir/err"
-"$volmorph" render-vdb "$dir/bunny.vdb" --grid density -o "$dir/out/frame.exr" --res 64x36 --samples 1 \
-    --shadow-cache 1 -v 2>"$dir/err" >/dev/null &
-pid=$!
-wait_for "render: shadows"
+start "render: shadows" render-vdb "$dir/bunny.vdb" --grid density -o "$dir/out/frame.exr" \
+    --res 64x36 --samples 1 --shadow-cache 1
 stop TERM "render-vdb during its shadow maps"
 grep -q "render: pixels" "$dir/err" && fail "the shadow maps were done before the signal; nothing tested"
 
@@ -90,21 +99,13 @@ for command in render morph preview; do
         morph) set -- morph "$dir/scene.toml" --frames 1 -o "$dir/out/f.####.vdb" ;;
         preview) set -- preview "$dir/scene.toml" --frame 1 -o "$dir/out/preview.png" ;;
     esac
-    # The last command's log goes first: wait_for could otherwise read it before the shell truncates
-    # the file for this one, and signal a process that has no handler yet (exit 143).
-    rm -f "$dir/err"
-    "$volmorph" "$@" -v 2>"$dir/err" >/dev/null &
-    pid=$!
-    wait_for "frame 1: morph"
+    start "frame 1: morph" "$@"
     signal=TERM
     [ "$command" = morph ] && signal=INT
     stop "$signal" "$command during a frame's morph"
     grep -q "render: empty-space mask" "$dir/err" && fail "$command: the morph was done before the signal"
 done
-rm -f "$dir/err"
-"$volmorph" morph "$dir/scene.toml" --frames 1 -o "$dir/out/f.####.vdb" -v 2>"$dir/err" >/dev/null &
-pid=$!
-wait_for "morph setup"
+start "morph setup" morph "$dir/scene.toml" --frames 1 -o "$dir/out/f.####.vdb"
 sleep 0.3
 stop INT "morph during its setup"
 grep -q "frame 1: morph" "$dir/err" && fail "the setup was done before the signal"
@@ -112,18 +113,11 @@ grep -q "frame 1: morph" "$dir/err" && fail "the setup was done before the signa
 #    solve takes seconds, and so does a frame).
 sed "s|meshes/|$source_dir/scenes/meshes/|; s|^resolution = 128 |resolution = $((320 / coarsen)) |" \
     "$source_dir/scenes/dino-to-eight-variational.toml" >"$dir/variational.toml"
-rm -f "$dir/err"
-"$volmorph" morph "$dir/variational.toml" --frames 15 -o "$dir/out/v.####.vdb" -v --no-cache \
-    2>"$dir/err" >/dev/null &
-pid=$!
-wait_for "voxelize"
+start voxelize morph "$dir/variational.toml" --frames 15 -o "$dir/out/v.####.vdb" --no-cache
 sleep 1.5
 stop INT "morph during the variational solve"
 grep -q "frame 15: morph" "$dir/err" && fail "the variational solve was done before the signal"
-rm -f "$dir/err"
-"$volmorph" morph "$dir/variational.toml" --frames 15 -o "$dir/out/v.####.vdb" -v 2>"$dir/err" >/dev/null &
-pid=$!
-wait_for "frame 15: morph"
+start "frame 15: morph" morph "$dir/variational.toml" --frames 15 -o "$dir/out/v.####.vdb"
 sleep 0.3
 stop TERM "morph during a variational frame"
 echo "every interrupt stopped within $limit s with exit 130 and no file"
