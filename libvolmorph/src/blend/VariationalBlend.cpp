@@ -1,6 +1,5 @@
 #include "blend/VariationalBlend.h"
 
-#include "blend/Abandonable.h"
 #include "blend/ExtendedDistance.h"
 #include "blend/Redistance.h"
 #include "blend/variational/Constraints.h"
@@ -18,8 +17,8 @@
 #include <tbb/parallel_invoke.h>
 
 #include <algorithm>
-#include <cmath>
 #include <array>
+#include <cmath>
 #include <cstdio>
 #include <limits>
 #include <stdexcept>

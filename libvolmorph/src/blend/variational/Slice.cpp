@@ -84,12 +84,6 @@ struct Lattice {
     /// The cell holding voxel `v` (index space relative to the origin, inside the lattice) and
     /// the voxel's Catmull-Rom weights in it.
     std::pair<Coord, std::array<std::array<double, 4>, 3>> cellOf(const Coord& v) const;
-    /// Catmull-Rom in `field` at voxel `v` (relative to the origin, inside the lattice).
-    double interpolate(const std::vector<float>& field, const Coord& v) const
-    {
-        const auto [cell, weights] = cellOf(v);
-        return tricubic(field, cell.x(), cell.y(), cell.z(), weights);
-    }
 };
 
 std::array<double, 4> catmullRom(double x)
@@ -222,8 +216,8 @@ CellMask cellsNearZero(const Lattice& l, double band, double leastSlope, const C
     });
 }
 
-/// The nodes (a mask over them) of the cells of `m` and, with `reach` 1, of each one's
-/// Catmull-Rom stencil too (a node further on each side).
+/// The nodes (a mask over them) of the cells of `m` and `reach` nodes further on each side (1: each
+/// cell's Catmull-Rom stencil; 2: the stencils of the cells and their neighbours).
 std::vector<char> nodesOf(const CellMask& m, int reach)
 {
     const Coord n = m.cells + Coord(1);
@@ -248,23 +242,6 @@ CellMask children(const CellMask& parent, const Lattice& l, int ratio)
     return cellsWhere(l.cells(), [&](int a, int b, int c) { return parent.holds(a, b, c, ratio); });
 }
 
-/// `m` with every cell's neighbours on too.
-CellMask grown(const CellMask& m)
-{
-    CellMask g{m.cells, std::vector<char>(m.on.size(), 0)};
-    const Coord& n = m.cells;
-    for (int a = 0; a < n.x(); ++a)
-        for (int b = 0; b < n.y(); ++b)
-            for (int c = 0; c < n.z(); ++c) {
-                if (!m.at(a, b, c)) continue;
-                for (int i = std::max(0, a - 1); i <= std::min(n.x() - 1, a + 1); ++i)
-                    for (int j = std::max(0, b - 1); j <= std::min(n.y() - 1, b + 1); ++j)
-                        for (int k = std::max(0, c - 1); k <= std::min(n.z() - 1, c + 1); ++k)
-                            g.on[(size_t(i) * n.y() + j) * n.z() + k] = 1;
-            }
-    return g;
-}
-
 /// The fine lattice's values (and rates) where the screening keeps cells: levels `kRatio` times
 /// coarser each, the coarsest over the whole box.
 constexpr int kLevels = 5, kRatio = 2;
@@ -284,7 +261,7 @@ Lattice smoothLattice(const SliceFunction& f, double w, const openvdb::math::Tra
     const NodeFunction exact = [&f](const Coord&, const Point4& p, double* rate) {
         return f(p, rate);
     };
-    evaluateNodes(smooth, exact, w, transform, nodesOf(grown(cells), 1), evaluations, interrupter);
+    evaluateNodes(smooth, exact, w, transform, nodesOf(cells, 2), evaluations, interrupter);
     return smooth;
 }
 
@@ -296,14 +273,15 @@ double splitValue(const SplitFunction& f, const std::vector<Lattice>& lattices, 
     double value = f.detail(p, rate);
     for (size_t k = 0; k < f.smooth.size(); ++k) {
         const Lattice& l = lattices[k];
-        double partRate = 0.0;
-        double part = l.values.empty() ? std::numeric_limits<double>::quiet_NaN()
-                                       : -l.interpolate(l.values, v);
-        if (std::isnan(part)) { // not read from a lattice (yet), or (never) off its stencils
-            part = f.smooth[k].f(p, rate ? &partRate : nullptr);
-        } else if (rate && !l.rates.empty()) {
-            partRate = -l.interpolate(l.rates, v);
+        double part = std::numeric_limits<double>::quiet_NaN(), partRate = 0.0;
+        if (!l.values.empty()) {
+            const auto [cell, weights] = l.cellOf(v);
+            part = -l.tricubic(l.values, cell.x(), cell.y(), cell.z(), weights);
+            if (rate && !l.rates.empty())
+                partRate = -l.tricubic(l.rates, cell.x(), cell.y(), cell.z(), weights);
         }
+        // Not read from a lattice (yet), or (never) off its stencils: exact.
+        if (std::isnan(part)) part = f.smooth[k].f(p, rate ? &partRate : nullptr);
         value += part;
         if (rate) *rate += partRate;
     }
