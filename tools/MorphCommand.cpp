@@ -72,6 +72,11 @@ int runMorph(const MorphArgs& args)
                             "expected a pattern ending in .ply or .obj, got \"" + args.mesh + "\"");
     }
     if (args.exact) scene.warp.toleranceVoxels = 0.0;
+    if (!args.side.empty() && scene.blend.mode == BlendMode::Variational)
+        throw UserError(SourceLocation{"--side"},
+                        "blend.mode = \"variational\" warps neither side (its in-betweens are "
+                        "slices of one function, the pairs are not used); --side shows how a side "
+                        "bends under the warp, in density and sdf modes");
     if (!args.side.empty()) keepOneSide(scene.blend, args.side == "target");
 
     Interrupter interrupter(false, args.verbose);
@@ -128,7 +133,7 @@ Command addMorphCommand(CLI::App& app)
     sub->add_flag("--half", args->half, "store float and vec3 grids as 16-bit floats");
     sub->add_option("--side", args->side,
                     "write one side alone, warped at each frame's t: source or target (how each "
-                    "side bends; every schedule held at 0 or 1)")
+                    "side bends; every schedule held at 0 or 1; density and sdf modes)")
         ->check(CLI::IsMember({"source", "target"}));
     addCacheOptions(sub, args->cache);
     sub->add_flag("-q,--quiet", args->quiet, "print nothing on success");

@@ -87,6 +87,21 @@ std::vector<PlacedError> place(const UserError& error,
     return placed;
 }
 
+FeaturePairSpec pairFromJson(const json& body)
+{
+    if (!body.is_object() || !body.contains("source") || !body.contains("target"))
+        throw BadRequest("expected {\"type\", \"source\", \"target\"}");
+    FeaturePairSpec pair;
+    const std::string type = tomlValue("type", body.value("type", json()));
+    pair.type = type == "\"point\""     ? FeatureType::Point
+                : type == "\"segment\"" ? FeatureType::Segment
+                : type == "\"box\""     ? FeatureType::Box
+                                        : FeatureType::Rectangle;
+    pair.source = elementFromJson(body["source"]);
+    pair.target = elementFromJson(body["target"]);
+    return pair;
+}
+
 bool sameElement(const FeatureElement& a, const FeatureElement& b)
 {
     return a.origin == b.origin && a.xAxis == b.xAxis && a.yAxis == b.yAxis && a.scale == b.scale;
@@ -179,11 +194,7 @@ void EditDocument::set(const json& body, SceneDocument& next) const
         throw BadRequest("no pair " + std::to_string(pair) + " (the scene has " +
                          std::to_string(count) + ")");
     if (!body.contains("value")) throw BadRequest("expected a \"value\"");
-    try {
-        next.set(key, tomlValue(field, body["value"]));
-    } catch (const std::invalid_argument& e) {
-        throw BadRequest(e.what());
-    }
+    next.set(key, tomlValue(field, body["value"]));
 }
 
 void EditDocument::apply(const std::string& name, const json& body)
@@ -199,28 +210,23 @@ void EditDocument::apply(const std::string& name, const json& body)
         return;
     }
     SceneDocument next = mDocument;
-    if (name == "set") {
-        set(body, next);
-    } else if (name == "add") {
-        if (!body.is_object() || !body.contains("source") || !body.contains("target"))
-            throw BadRequest("expected {\"type\", \"source\", \"target\"}");
-        FeaturePairSpec pair;
-        const std::string type = tomlValue("type", body.value("type", json()));
-        pair.type = type == "\"point\""     ? FeatureType::Point
-                    : type == "\"segment\"" ? FeatureType::Segment
-                    : type == "\"box\""     ? FeatureType::Box
-                                            : FeatureType::Rectangle;
-        pair.source = elementFromJson(body["source"]);
-        pair.target = elementFromJson(body["target"]);
-        next.appendPair(pairTableLines(pair));
-    } else if (name == "duplicate") {
-        const int index = pairIndex(body, next.pairCount());
-        if (!valid()) throw Conflict("the scene has errors: fix or undo them before duplicating");
-        next.appendPair(pairTableLines(mScene.pairs.at(size_t(index) - 1)));
-    } else if (name == "delete") {
-        next.removePair(pairIndex(body, next.pairCount()));
-    } else {
-        throw BadRequest("unknown edit \"" + name.substr(0, 40) + "\"");
+    try {
+        if (name == "set") {
+            set(body, next);
+        } else if (name == "add") {
+            next.appendPair(pairTableLines(pairFromJson(body)));
+        } else if (name == "duplicate") {
+            const int index = pairIndex(body, next.pairCount());
+            if (!valid())
+                throw Conflict("the scene has errors: fix or undo them before duplicating");
+            next.appendPair(pairTableLines(mScene.pairs.at(size_t(index) - 1)));
+        } else if (name == "delete") {
+            next.removePair(pairIndex(body, next.pairCount()));
+        } else {
+            throw BadRequest("unknown edit \"" + name.substr(0, 40) + "\"");
+        }
+    } catch (const std::invalid_argument& e) {
+        throw BadRequest(e.what()); // the edit would leave a file TOML cannot read
     }
     commit(std::move(next));
 }

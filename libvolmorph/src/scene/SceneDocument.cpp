@@ -289,6 +289,9 @@ std::string tomlArray(const std::vector<double>& values)
 
 std::string tomlRounded(double value)
 {
+    // Past 2^53 / 1e4 a fourth decimal is not held, and "%.4f" would write every digit of the
+    // integer part (a hundred for 1e92, more than a TOML reader takes): the exact shortest form.
+    if (!(std::abs(value) < 1e11)) return tomlNumber(value);
     char text[64];
     std::snprintf(text, sizeof text, "%.4f", std::round(value * 1e4) / 1e4 + 0.0);
     std::string s(text);

@@ -202,6 +202,22 @@ TEST(EditApi, MalformedRequestsAre400AndChangeNothing)
     EXPECT_FALSE(doc.state()["canUndo"].get<bool>());
 }
 
+TEST(EditApi, AHugeNumberIsWrittenSoTheFileStillReads)
+{
+    // The editor's fuzzer: an axis of 99e91 was written as a hundred-digit decimal, the file could
+    // not be read back, and the refusal escaped as std::invalid_argument rather than a 400.
+    const auto scene = copyScene("bunny-to-knot.toml");
+    EditDocument doc(scene);
+    doc.apply("add", json::parse(R"({"type": "box", "source": {"origin": [0, 0, 0],
+        "axes": [[1, 0, 0], [99e91, 1, 0]], "scale": 5.5}, "target": {"origin": [0, 0, 0]}})"));
+    EXPECT_NE(doc.text().find("[9.9e+92, 1.0, 0.0]"), std::string::npos);
+    EXPECT_FALSE(doc.valid()); // the axes are not at right angles: a validator error, placed
+    ASSERT_FALSE(doc.errors().empty());
+    EXPECT_EQ(doc.errors().front().pair, 4);
+    doc.apply("undo", json::object());
+    EXPECT_TRUE(doc.valid());
+}
+
 TEST(EditApi, SaveRefusesAFileChangedOnDisk)
 {
     const auto scene = copyScene("bunny-to-knot.toml");

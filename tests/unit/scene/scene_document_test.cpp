@@ -5,6 +5,7 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <fstream>
 #include <sstream>
 
@@ -148,6 +149,19 @@ TEST(SceneDocument, NumbersAreWrittenToReadBackExactly)
     }
     EXPECT_EQ(tomlNumber(3.0), "3.0");
     EXPECT_EQ(tomlArray({1.0, 0.25}), "[1.0, 0.25]");
+}
+
+TEST(SceneDocument, RoundedNumbersOfAnySizeReadBack)
+{
+    EXPECT_EQ(tomlRounded(0.123456), "0.1235");
+    EXPECT_EQ(tomlRounded(-0.00001), "0.0");
+    EXPECT_EQ(tomlRounded(2.0), "2.0");
+    // Found by the editor's fuzzer: "%.4f" wrote 1e92's hundred digits, which no TOML reader takes.
+    for (const double v : {123456789.125, 1e11, -3.5e15, 9.9e92, 1.7e308, -4e200}) {
+        SceneDocument doc("[a]\nb = 1.0\n");
+        ASSERT_NO_THROW(doc.set("a.b", tomlRounded(v))) << tomlRounded(v);
+        EXPECT_EQ(std::stod(tomlRounded(v)), std::abs(v) < 1e11 ? std::round(v * 1e4) / 1e4 : v);
+    }
 }
 
 TEST(SceneDocument, AFileWithWindowsLineEndingsKeepsThem)
