@@ -4,7 +4,7 @@
 # and s(t) = 1 - 0.2 t): the source side at t = 0 is the full morph's frame 0 value for value, the
 # target side at t = 1 the full morph's last frame; the source side at each t carries the sphere's
 # density mass times s(t)^3 with its centroid at c(t) (a closed form), and the target side at t = 0 the
-# cube's mass over 0.8^3 at the origin.
+# cube's mass over 0.8^3 at the origin. In variational mode (no warp) --side is refused.
 # usage: morph_side.sh VOLMORPH SOURCE_DIR
 set -eu
 volmorph=$1
@@ -61,3 +61,10 @@ assert abs(mass / cube - 0.8 ** -3) < 0.01 * 0.8 ** -3, (mass / cube, 0.8 ** -3)
 assert all(abs(c) < 0.01 for c in centroid), centroid
 print("morph --side: each side alone, as the affine map carries it")
 PY
+# The variational mode warps no side: a clear refusal naming --side, and no file.
+status=0
+"$volmorph" morph "$2/scenes/dino-to-eight-variational.toml" --side source --frames 1 \
+    -o "$out/variational.####.vdb" -q 2>"$out/err" || status=$?
+[ "$status" -ne 0 ] || { echo "morph --side in variational mode did not fail" >&2; exit 1; }
+grep -q -- "--side.*variational" "$out/err" || { cat "$out/err" >&2; exit 1; }
+[ ! -e "$out/variational.0001.vdb" ] || { echo "a file was written" >&2; exit 1; }
