@@ -43,7 +43,7 @@ SideExtent printVolumeInput(const char* label, const ObjectSpec& spec, int first
     ObjectSpec first = spec;
     first.volume = spec.volumeAt(firstFrame);
     first.volumeFrames.clear();
-    const VolumeFileInfo info = inspectVolume(first);
+    const VolumeFileInfo info = inspectVolume(first.volumeSource());
     auto name = [](const std::string& n, const char* otherwise) {
         return n.empty() ? std::string(otherwise) : "'" + n + "'";
     };
@@ -185,7 +185,7 @@ void printSettings(const Scene& scene)
                     v.constraints, fmt(v.normalOffsetVoxels).c_str(),
                     v.timeScale ? (fmt(*v.timeScale) + " world units").c_str()
                                 : "from the shapes' size");
-        for (const InfluenceSpec& i : v.influence)
+        for (const InfluenceSpec& i : scene.influences)
             std::printf("        influence at t = %s: %s\n", fmt(i.t).c_str(),
                         i.object.file().string().c_str());
     }

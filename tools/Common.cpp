@@ -175,10 +175,9 @@ void checkFilmMemory(int width, int height, double limitGiB, bool layers)
     char text[300];
     std::snprintf(text, sizeof text,
                   "a %dx%d image needs about %.1f GiB, more than the memory limit of %.1f GiB; "
-                  "render fewer pixels "
-                  "or raise --memory-limit (default: half the machine's memory)",
+                  "render fewer pixels or raise the memory limit",
                   width, height, bytes / double(1ull << 30), limit / double(1ull << 30));
-    throw UserError(SourceLocation{"render"}, text);
+    throw MemoryLimitExceeded(SourceLocation{"render"}, text, uint64_t(bytes), uint64_t(limit));
 }
 
 double secondsSince(std::chrono::steady_clock::time_point start)

@@ -29,7 +29,7 @@ int runFrames(const FramesArgs& args)
                                 .c_str());
         return 0;
     }
-    const std::vector<int> frames = selectFrames(scene.frames, args.frames);
+    const std::vector<int> frames = selectFrames(scene.frames, args.frames, "--frames");
     const int size = args.chunk > 0 ? args.chunk : int(frames.size());
     const int chunks = chunkCount(frames, size);
     if (args.count) {

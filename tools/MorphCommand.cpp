@@ -51,7 +51,7 @@ void writeFrame(const VolumeSet& v, const std::filesystem::path& file, const Mor
 int runMorph(const MorphArgs& args)
 {
     Scene scene = loadScene(args.scene);
-    const std::vector<int> frames = selectFrames(scene.frames, args.frames);
+    const std::vector<int> frames = selectFrames(scene.frames, args.frames, "--frames");
     // Default: the scene's output pattern with .vdb for .exr, relative to the scene's folder.
     std::string pattern = args.output;
     if (pattern.empty())

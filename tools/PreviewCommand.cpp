@@ -105,9 +105,9 @@ int runPreview(const PreviewArgs& args)
         throw UserError(SourceLocation{"preview"}, "give either --frame N or --contact-sheet");
     std::vector<int> frames;
     if (args.frame)
-        frames = selectFrames(scene.frames, std::to_string(*args.frame));
+        frames = selectFrames(scene.frames, std::to_string(*args.frame), "--frame");
     else
-        frames = selectFrames(scene.frames, args.frames);
+        frames = selectFrames(scene.frames, args.frames, "--frames");
     const bool drawPairs = args.contactSheet ? args.features : !args.noFeatures;
     const int width = args.contactSheet ? args.tileWidth : args.width;
 

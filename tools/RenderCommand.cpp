@@ -283,7 +283,7 @@ std::string writeFrameImage(const render::Image& image, const SceneRender& rende
 int runRenderScene(const RenderSceneArgs& args)
 {
     const Scene scene = loadScene(args.scene);
-    const std::vector<int> frames = selectFrames(scene.frames, args.frames);
+    const std::vector<int> frames = selectFrames(scene.frames, args.frames, "--frames");
     const std::string pattern =
         args.output.empty() ? (scene.folder / scene.frames.output).string() : args.output;
     if (const std::string why = checkFramePattern(pattern); !why.empty())

@@ -24,7 +24,12 @@ generator=""
 if command -v ninja >/dev/null 2>&1 && [ ! -f "$build/Makefile" ]; then generator="-G Ninja"; fi
 # shellcheck disable=SC2086
 cmake -S . -B "$build" $generator -DCMAKE_BUILD_TYPE=Release -DVOLMORPH_BUILD_TESTS=ON >/dev/null
-cmake --build "$build" --parallel "$jobs"
+# The demo builds only what it runs (the program and the editor's page); the tests build the rest.
+if [ "$mode" = demo ]; then
+    cmake --build "$build" --parallel "$jobs" --target volmorph_cli
+else
+    cmake --build "$build" --parallel "$jobs"
+fi
 
 case "$mode" in
 demo)

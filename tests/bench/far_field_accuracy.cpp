@@ -108,7 +108,9 @@ int main(int argc, char** argv)
     const double voxel = volumes.source.voxelSize();
     const openvdb::CoordBBox box = detail::ExtendedDistance::boxFor(
         *volumes.source.sdf, *volumes.target.sdf, scene.pairs.size());
-    const detail::ExtendedDistance farS(volumes.source.sdf, box), farT(volumes.target.sdf, box);
+    const auto madeS = detail::ExtendedDistance::make(volumes.source.sdf, box, nullptr);
+    const auto madeT = detail::ExtendedDistance::make(volumes.target.sdf, box, nullptr);
+    const detail::ExtendedDistance &farS = *madeS, &farT = *madeT;
     std::printf("default scene at %d voxels across (voxel %.5g); reference over %d x %d x %d\n",
                 across, voxel, box.dim().x(), box.dim().y(), box.dim().z());
     const auto refS = exactDistances(volumes.meshes.source, voxel, box);

@@ -17,13 +17,18 @@ if (!url || !out) fail('usage: node editor_test.mjs URL OUT_DIR [DRAGS]');
 
 const pairCount = (page) => page.evaluate(() => window.volmorphEditor.state().pairs.length);
 
-/** Waits for the state to satisfy `test` (a function of the state, run in the page). */
+/** Waits for the state to satisfy `test` (a function of the state, or its source), polled here: a
+ * predicate given as text would be evaluated in the page, which its Content-Security-Policy forbids. */
 async function stateWhere(page, test, what) {
-  try {
-    await page.waitForFunction(`(${test})(window.volmorphEditor.state())`, null, { timeout: 30000 });
-  } catch (e) {
-    fail(`${what}: ${JSON.stringify(await page.evaluate(() => window.volmorphEditor.state()))}`);
+  const check = typeof test === 'string' ? new Function('s', `return (${test})(s);`) : test;
+  const deadline = Date.now() + 30000;
+  let state;
+  while (Date.now() < deadline) {
+    state = await page.evaluate(() => window.volmorphEditor.state());
+    if (check(state)) return;
+    await new Promise((resolve) => setTimeout(resolve, 50));
   }
+  fail(`${what}: ${JSON.stringify(state)}`);
 }
 
 /** After the save (the file is checked as saved): the validator's error shown at its element and
@@ -83,6 +88,8 @@ try {
   page.on('console', (m) => { if (m.type() === 'error') problems.push(`console: ${m.text()}`); });
   page.on('response', (r) => { if (r.status() >= 400) problems.push(`${r.status()}: ${r.url()}`); });
   await page.goto(url);
+  // The printed URL's token went into the session's cookie: the page's own URL carries none.
+  if (new URL(page.url()).search !== '') fail(`the page's URL still carries the token: ${page.url()}`);
   await page.waitForFunction(() => window.volmorphEditor && window.volmorphEditor.ready, null, { timeout: 120000 });
   const webgl = await page.evaluate(() => {
     const gl = document.querySelector('#view canvas').getContext('webgl2');

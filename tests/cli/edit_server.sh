@@ -3,7 +3,9 @@
 # wrong one (403), a foreign Host (403), a path outside the page's files (404, never a file from
 # disk), a 10 MB body (413), malformed JSON (400); it answers the API with the token, listens on
 # 127.0.0.1 only, writes nothing (the scene byte for byte as it was), and stops on SIGINT within
-# LIMIT seconds with status 0.
+# LIMIT seconds with status 0. The printed URL sets a per-session cookie and redirects to the page
+# without the token; every answer, refusals too, carries nosniff and a Content-Security-Policy, and
+# every error is JSON.
 # usage: edit_server.sh VOLMORPH SOURCE_DIR [LIMIT]
 set -eu
 . "$(dirname "$0")/lib.sh"
@@ -29,7 +31,28 @@ expect 403 "$base/api/state?token=${token%?}"
 expect 403 -H "$H" -H "Host: attacker.example:80" "$base/api/state"
 expect 200 -H "$H" "$base/api/state"
 grep -q '"pairs"' "$out/body" || { echo "no pairs in the state"; exit 1; }
-expect 200 "$base/?token=$token"
+# The printed URL: the token into a cookie named for this session, then a redirect without it.
+expect 303 -D "$out/headers" "$base/?token=$token"
+grep -qi '^location: /\s*$' "$out/headers" || { echo "no redirect to /:"; cat "$out/headers"; exit 1; }
+cookie=$(grep -i '^set-cookie:' "$out/headers" | sed 's/^[^:]*: *//; s/;.*//' | tr -d '\r')
+case "$cookie" in volmorph_edit_[0-9]*_????????=$token) ;; *) echo "cookie: $cookie"; exit 1 ;; esac
+grep -i '^set-cookie:' "$out/headers" | grep -qi 'HttpOnly; SameSite=Strict; Path=/' ||
+    { echo "cookie attributes:"; cat "$out/headers"; exit 1; }
+expect 200 -D "$out/headers" -H "Cookie: $cookie" "$base/"
+nonce=$(sed -n 's/.*<script type="importmap" nonce="\([0-9a-f]*\)".*/\1/p' "$out/body")
+[ -n "$nonce" ] || { echo "the page's import map has no nonce"; exit 1; }
+grep -qi "^content-security-policy: default-src 'none'; script-src 'self' 'nonce-$nonce';" "$out/headers" ||
+    { echo "CSP of the page:"; cat "$out/headers"; exit 1; }
+expect 200 -H "Cookie: $cookie" "$base/api/state"
+expect 403 -H "Cookie: ${cookie%?}0" "$base/api/state"
+# Every answer, refusals included: nosniff, one CSP, and JSON errors.
+for request in "$base/api/state" "-H Cookie:$cookie $base/nothing" "-H Cookie:$cookie $base/api/nothing"; do
+    # shellcheck disable=SC2086
+    curl -s -D "$out/headers" -o "$out/body" $request
+    grep -qi '^x-content-type-options: nosniff' "$out/headers" || { echo "no nosniff: $request"; cat "$out/headers"; exit 1; }
+    [ "$(grep -ci '^content-security-policy:' "$out/headers")" = 1 ] || { echo "CSP: $request"; cat "$out/headers"; exit 1; }
+    grep -q '^{"error":' "$out/body" || { echo "not a JSON error: $request"; cat "$out/body"; exit 1; }
+done
 expect 200 -H "$H" "$base/assets/three.module.js"
 # Paths outside the page's files.
 expect 404 -H "$H" "$base/assets/..%2F..%2F..%2Fetc%2Fpasswd"

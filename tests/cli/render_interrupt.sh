@@ -1,6 +1,7 @@
 #!/bin/sh
-# SIGTERM (what Slurm sends before a job's time limit) or SIGINT stops a run within 1 s, with exit
-# status 130 and no file at the final name, wherever it lands:
+# SIGTERM (what Slurm sends before a job's time limit) or SIGINT stops a run, with exit status 130
+# and no file at the final name, wherever it lands, before the work would have finished (the log's
+# next stage never comes):
 #   1. render-vdb at 1920x1080 with 256 samples, two seconds in (fails if the frame had finished);
 #   2. render-vdb while its shadow maps are built (--verbose names each stage as it starts: fails
 #      unless the signal landed after "render: shadows" began and before "render: pixels" did);
@@ -10,9 +11,12 @@
 #      "morph setup" and before "frame 1: morph");
 #   4. morph of a variational scene during its solve (two seconds in, fails if the frame had begun)
 #      and during its frame (after "frame 1: morph").
+# The test asserts no time: how soon a run stops (the promise: within 1 s) is measured by
+# tests/bench/stop_latency.sh, on an idle machine, from the latencies this script records in
+# $STOP_LATENCY_LOG when that is set. A run still going LIMIT x 30 s after the signal has hung.
 # usage: render_interrupt.sh VOLMORPH SOURCE_DIR [LIMIT [COARSEN]]
-#        LIMIT: the longest stop allowed, in seconds (default 1, the promise; sanitizer builds, which
-#        run 5-40 times slower, pass more)
+#        LIMIT: how much slower than a release build this one is (default 1; sanitizer builds, which
+#        run 5-40 times slower, pass more): it scales the waits
 #        COARSEN: voxels this many times larger (default 1; sanitizer builds pass 2), so that each
 #        interrupted stage still lasts seconds and the test not minutes
 set -u
@@ -53,16 +57,24 @@ start() {
     wait_for "$pattern"
 }
 
-# stop SIGNAL WHAT: sends SIGNAL, waits, and checks the exit status, the delay and the output folder.
+# stop SIGNAL WHAT: sends SIGNAL, waits, and checks the exit status and the output folder; records
+# the delay (never asserted: a loaded machine may take longer) and fails only on a hang.
+hang=$(awk -v l="$limit" 'BEGIN { printf "%d", 3000 * (l > 1 ? l : 1) }') # polls 10 ms apart
 stop() {
     t0=$(now)
     kill -s "$1" "$pid"
+    i=0
+    while kill -0 "$pid" 2>/dev/null && [ "$(awk '/^State:/ { print $2 }' "/proc/$pid/status" 2>/dev/null)" != Z ]; do
+        i=$((i + 1))
+        [ $i -lt "$hang" ] || { kill -9 "$pid"; fail "$2: still running $((hang / 100)) s after SIG$1 (hung)"; }
+        sleep 0.01
+    done
     wait "$pid"
     status=$?
     t1=$(now)
     elapsed=$(awk -v a="$t0" -v b="$t1" 'BEGIN { printf "%.3f", b - a }')
+    [ -n "${STOP_LATENCY_LOG:-}" ] && echo "$elapsed $2" >>"$STOP_LATENCY_LOG"
     [ "$status" -eq 130 ] || fail "$2: exit status $status after SIG$1, expected 130"
-    awk -v e="$elapsed" -v l="$limit" 'BEGIN { exit !(e < l) }' || fail "$2: took $elapsed s to stop, more than $limit s"
     grep -q "interrupted; no output written" "$dir/err" || fail "$2: no message"
     left=$(ls "$dir/out" 2>/dev/null || true)
     [ -z "$left" ] || fail "$2: left files: $left"
@@ -120,4 +132,4 @@ grep -q "frame 15: morph" "$dir/err" && fail "the variational solve was done bef
 start "frame 15: morph" morph "$dir/variational.toml" --frames 15 -o "$dir/out/v.####.vdb"
 sleep 0.3
 stop TERM "morph during a variational frame"
-echo "every interrupt stopped within $limit s with exit 130 and no file"
+echo "every interrupt stopped with exit 130 and no file"

@@ -7,6 +7,7 @@
 #include <volmorph/core/Interrupter.h>
 
 #include <httplib.h>
+#include <nlohmann/json.hpp>
 #include <sys/socket.h>
 
 #include <atomic>
@@ -98,19 +99,48 @@ struct Gate {
 void refuse(httplib::Response& response, int status, const std::string& message)
 {
     response.status = status;
-    response.set_content("{\"error\": \"" + message + "\"}", "application/json");
+    response.set_content(nlohmann::json{{"error", message}}.dump(), "application/json");
+}
+
+/// This origin's scripts, styles and requests only; `nonce` admits the page's inline import map.
+std::string contentSecurityPolicy(const std::string& nonce = "")
+{
+    return "default-src 'none'; script-src 'self'" +
+           (nonce.empty() ? "" : " 'nonce-" + nonce + "'") +
+           "; style-src 'self'; img-src 'self' data:; connect-src 'self'; base-uri 'none'; "
+           "form-action 'none'; frame-ancestors 'none'";
+}
+
+void setHeader(httplib::Response& response, const std::string& name, const std::string& value)
+{
+    response.headers.erase(name);
+    response.set_header(name, value);
+}
+
+/// The page with a fresh nonce on its inline import map (the one inline script it has).
+std::string withNonce(std::string page, const std::string& nonce)
+{
+    const std::string tag = "<script type=\"importmap\"";
+    const size_t at = page.find(tag);
+    if (at != std::string::npos) page.insert(at + tag.size(), " nonce=\"" + nonce + "\"");
+    return page;
 }
 
 void route(httplib::Server& server, EditorSession& session, const Gate& gate,
            const std::map<std::string, Asset>& assets)
 {
     server.Get("/", [&](const httplib::Request& request, httplib::Response& response) {
-        const Asset& page = assets.at("index.html");
-        if (request.has_param("token"))
+        response.set_header("Cache-Control", "no-store");
+        if (request.has_param("token")) { // the printed URL: the token into the cookie, then away
             response.set_header("Set-Cookie", gate.cookieName + "=" + gate.token +
                                                   "; HttpOnly; SameSite=Strict; Path=/");
-        response.set_header("Cache-Control", "no-store");
-        response.set_content(page.bytes, page.type);
+            response.set_redirect("/", 303);
+            return;
+        }
+        const std::string nonce = randomToken();
+        setHeader(response, "Content-Security-Policy", contentSecurityPolicy(nonce));
+        const Asset& page = assets.at("index.html");
+        response.set_content(withNonce(page.bytes, nonce), page.type);
     });
     server.Get("/assets/([A-Za-z0-9_.-]+)",
                [&](const httplib::Request& request, httplib::Response& response) {
@@ -163,9 +193,12 @@ void serve(EditorSession& session, const ServerOptions& options, Interrupter& in
                         "cannot listen on 127.0.0.1:" + std::to_string(options.port) +
                             " (in use?): choose another port");
     const Gate gate{options.token.empty() ? randomToken() : options.token,
-                    "volmorph_edit_" + std::to_string(port), port};
+                    "volmorph_edit_" + std::to_string(port) + "_" + randomToken().substr(0, 8),
+                    port};
     server.set_pre_routing_handler(
         [&gate](const httplib::Request& request, httplib::Response& response) {
+            setHeader(response, "X-Content-Type-Options", "nosniff");
+            setHeader(response, "Content-Security-Policy", contentSecurityPolicy());
             if (!gate.hostAllowed(request)) {
                 refuse(response, 403, "unexpected Host");
                 return httplib::Server::HandlerResponse::Handled;
@@ -176,7 +209,19 @@ void serve(EditorSession& session, const ServerOptions& options, Interrupter& in
             }
             return httplib::Server::HandlerResponse::Unhandled;
         });
+    // What cpp-httplib refuses itself (no route, a body over the limit): JSON and the same headers.
+    server.set_error_handler([](const httplib::Request&, httplib::Response& response) {
+        setHeader(response, "X-Content-Type-Options", "nosniff");
+        if (!response.has_header("Content-Security-Policy"))
+            setHeader(response, "Content-Security-Policy", contentSecurityPolicy());
+        if (response.body.empty())
+            refuse(response, response.status,
+                   response.status == 404   ? "no such page"
+                   : response.status == 413 ? "request body too large"
+                                            : "refused");
+    });
     route(server, session, gate, assets);
+    throwIfInterrupted(&interrupter);
     std::printf("http://127.0.0.1:%d/?token=%s\n", port, gate.token.c_str());
     std::fflush(stdout);
     std::atomic<bool> ended{false};
@@ -186,7 +231,16 @@ void serve(EditorSession& session, const ServerOptions& options, Interrupter& in
     });
     while (!interrupter.stopRequested() && !ended)
         std::this_thread::sleep_for(std::chrono::milliseconds(100));
-    server.stop();
+    // cpp-httplib's stop() does nothing until listen_after_bind() has set the server running: a
+    // stop request that came first would leave the listener in accept() for good. So wait for it
+    // to run (or end), then stop it.
+    while (!ended) {
+        if (server.is_running()) {
+            server.stop();
+            break;
+        }
+        std::this_thread::sleep_for(std::chrono::milliseconds(5));
+    }
     listener.join();
 }
 

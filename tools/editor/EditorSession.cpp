@@ -91,7 +91,7 @@ std::string surfaceOf(const VolumeSet& volumes)
 
 EditorSession::EditorSession(const std::filesystem::path& scene, int resolution,
                              Interrupter* interrupter)
-    : mDocument(scene)
+    : mInterrupter(interrupter), mDocument(scene)
 {
     Scene preview = mDocument.scene();
     preview.volume.voxelSize.reset();
@@ -106,20 +106,7 @@ EditorSession::EditorSession(const std::filesystem::path& scene, int resolution,
 
 EditorSession::~EditorSession() = default;
 
-const Morpher& EditorSession::morpher()
-{
-    const Scene& scene = mDocument.scene();
-    if (!mMorpher) {
-        MorphOptions options;
-        options.influences = mInfluences;
-        mMorpher.emplace(mSource, mTarget, scene.pairs, scene.warp, scene.blend, options);
-    } else if (mMorpherVersion != mDocument.pairsVersion())
-        mMorpher = mMorpher->withPairs(scene.pairs);
-    mMorpherVersion = mDocument.pairsVersion();
-    return *mMorpher;
-}
-
-Reply EditorSession::mesh(const std::map<std::string, std::string>& query)
+Reply EditorSession::sideMesh(const std::map<std::string, std::string>& query)
 {
     const auto of = query.find("of");
     const std::string which = of == query.end() ? "" : of->second;
@@ -132,22 +119,53 @@ Reply EditorSession::mesh(const std::map<std::string, std::string>& query)
     if (tText != query.end() && (end == tText->second.c_str() || *end != '\0'))
         throw BadRequest("mesh: t is not a number");
     if (!(t >= 0.0 && t <= 1.0)) throw BadRequest("mesh: t must lie in [0, 1]");
-    if (mMorphVersion != mDocument.pairsVersion() || mMorphT != t || !mMorpher) {
-        mMorphMesh = surfaceOf(morpher().frame(t));
-        mMorphVersion = mDocument.pairsVersion();
-        mMorphT = t;
+    return morphMesh(t);
+}
+
+Reply EditorSession::morphMesh(double t)
+{
+    std::lock_guard<std::mutex> one(mMorphMutex);
+    std::shared_ptr<const Morpher> last;
+    std::vector<FeaturePairSpec> pairs;
+    WarpSpec warp;
+    BlendSpec blend;
+    uint64_t version = 0, lastVersion = 0;
+    {
+        std::lock_guard<std::mutex> lock(mMutex);
+        version = mDocument.pairsVersion();
+        if (mMorphVersion == version && mMorphT == t)
+            return {200, "application/octet-stream", mMorphMesh};
+        const Scene& scene = mDocument.scene();
+        pairs = scene.pairs, warp = scene.warp, blend = scene.blend;
+        last = mMorpher;
+        lastVersion = mMorpherVersion;
     }
-    return {200, "application/octet-stream", mMorphMesh};
+    std::shared_ptr<const Morpher> morpher = last;
+    if (!last) {
+        MorphOptions options;
+        options.influences = mInfluences;
+        options.setupInterrupter = mInterrupter;
+        morpher = std::make_shared<const Morpher>(mSource, mTarget, pairs, warp, blend, options);
+    } else if (lastVersion != version) {
+        morpher = std::make_shared<const Morpher>(last->withPairs(pairs));
+    }
+    std::string surface = surfaceOf(morpher->frame(t, nullptr, mInterrupter));
+    std::lock_guard<std::mutex> lock(mMutex);
+    mMorpher = morpher;
+    mMorpherVersion = version;
+    mMorphMesh = surface;
+    mMorphVersion = version;
+    mMorphT = t;
+    return {200, "application/octet-stream", std::move(surface)};
 }
 
 Reply EditorSession::route(const std::string& method, const std::string& route,
-                           const std::map<std::string, std::string>& query, const std::string& body)
+                           const std::string& body)
 {
     if (route.rfind("/api/", 0) != 0) return error(404, "no such page");
     const std::string name = route.substr(5);
     if (method == "GET") {
         if (name == "state") return stateReply(mDocument);
-        if (name == "mesh") return mesh(query);
         return error(404, "no such API call: GET " + route.substr(0, 80));
     }
     if (method != "POST") return error(405, "only GET and POST");
@@ -169,9 +187,12 @@ Reply EditorSession::handle(const std::string& method, const std::string& path,
                             const std::map<std::string, std::string>& query,
                             const std::string& body)
 {
-    std::lock_guard<std::mutex> lock(mMutex);
     try {
-        return route(method, path, query, body);
+        if (method == "GET" && path == "/api/mesh") return sideMesh(query);
+        std::lock_guard<std::mutex> lock(mMutex);
+        return route(method, path, body);
+    } catch (const Interrupted&) {
+        return error(503, "the editor is stopping");
     } catch (const BadRequest& e) {
         return error(400, e.what());
     } catch (const Conflict& e) {

@@ -4,7 +4,16 @@
 // surface are made anew. handle() answers the page's JSON API; the server (EditorServer.h) adds
 // the token, the size bounds and the page's files.
 //
-// API (every answer JSON but the meshes'; an error is {"error": message} with 400 or 409):
+// The document is held under one lock for as long as a request reads or edits it, never while an
+// in-between is morphed: a morph takes a copy of the pairs and settings under the lock, runs
+// without it (one morph at a time), and stores its mesh only if the pairs have not changed
+// meanwhile. So a save or an edit is answered during a slow frame, and the morph stops (503) when
+// the session's interrupter asks (SIGINT, SIGTERM).
+//
+// API (every answer JSON but the meshes'; an error is {"error": message}: 400 for a malformed or
+// refused request, 404 for no such call, 405 for a method other than GET and POST, 409 for an edit
+// that conflicts (undo with nothing to undo), 500 when the scene file cannot be written or the
+// morph fails, 503 when the editor is stopping):
 //   GET  /api/state                       EditDocument::state()
 //   GET  /api/mesh?of=source|target       a side's surface (encodeMesh)
 //   GET  /api/mesh?of=morph&t=T           the in-between's surface at t in [0, 1]
@@ -52,7 +61,8 @@ std::string surfaceOf(const VolumeSet& volumes);
 class EditorSession {
 public:
     /// Reads the scene (UserError when it is not valid) and voxelizes both sides at `resolution`
-    /// voxels across (the scene's own voxel size when that is coarser). Stops with Interrupted.
+    /// voxels across (the scene's own voxel size when that is coarser). Stops with Interrupted;
+    /// later, `interrupter` stops the in-betweens' morphs too (it must outlive the session).
     EditorSession(const std::filesystem::path& scene, int resolution, Interrupter* interrupter);
     ~EditorSession();
 
@@ -64,17 +74,21 @@ public:
     const EditDocument& document() const { return mDocument; }
 
 private:
-    Reply route(const std::string& method, const std::string& route,
-                const std::map<std::string, std::string>& query, const std::string& body);
-    Reply mesh(const std::map<std::string, std::string>& query);
-    const Morpher& morpher();
+    Reply route(const std::string& method, const std::string& route, const std::string& body);
+    Reply sideMesh(const std::map<std::string, std::string>& query);
+    /// The in-between's mesh at t, morphed outside mMutex (see the top of this file).
+    Reply morphMesh(double t);
 
-    std::mutex mMutex;
+    std::mutex mMutex;      ///< the document and the caches below
+    std::mutex mMorphMutex; ///< one morph at a time
+    Interrupter* mInterrupter;
     EditDocument mDocument;
+    // Set once by the constructor, read without a lock afterwards.
     VolumeSet mSource, mTarget;
     std::vector<TimedVolume> mInfluences; ///< variational mode's
     std::string mSourceMesh, mTargetMesh;
-    std::optional<Morpher> mMorpher;
+    /// The last Morpher, for the pairs of version mMorpherVersion (its blend setup is reused).
+    std::shared_ptr<const Morpher> mMorpher;
     uint64_t mMorpherVersion = 0;
     /// The last in-between's mesh, by the pairs' version and t.
     std::string mMorphMesh;

@@ -1,7 +1,7 @@
 // Feature elements of Lerios, Garfinkle and Levoy (1995), interpolated over the morph.
 #pragma once
 
-#include <volmorph/Scene.h>
+#include <volmorph/FeaturePair.h>
 
 #include <openvdb/math/Quat.h>
 

@@ -11,10 +11,10 @@ namespace volmorph {
 /// Frames picked by `spec` in OpenImageIO's sequence syntax ("1-10", "1-100x2", "1,5,10-20"),
 /// in the order given and without repeats; every one must lie in the scene's range (their t comes
 /// from that range, so a chunk renders exactly the frames a full run would). An empty spec picks
-/// the whole range. Throws UserError naming `what` (e.g. "--frames") when the spec is malformed,
-/// empty or outside the range.
+/// the whole range. Throws UserError naming `what` (the front end's name for the spec) when the
+/// spec is malformed, empty or outside the range.
 std::vector<int> selectFrames(const FramesSpec& frames, const std::string& spec,
-                              const std::string& what = "--frames");
+                              const std::string& what = "frames");
 
 /// `frames` written as a frame spec, consecutive runs as ranges: {1,2,3,5,7,8} -> "1-3,5,7-8".
 std::string formatFrames(const std::vector<int>& frames);

@@ -2,8 +2,9 @@
 // welded, placed in the world and checked.
 #pragma once
 
-#include <volmorph/Scene.h>
+#include <volmorph/core/Diagnostics.h>
 #include <volmorph/core/Math.h>
+#include <volmorph/core/ObjectTransform.h>
 
 #include <openvdb/math/Vec3.h>
 
@@ -49,15 +50,6 @@ struct Mesh {
 /// key); when its file is empty the mesh file itself is named.
 Mesh importMesh(const std::filesystem::path& file, const ObjectTransform& transform = {},
                 const SourceLocation& where = {});
-
-/// A scene's two meshes, imported with their transforms (empty for a side that is a volume).
-struct SceneMeshes {
-    Mesh source, target;
-};
-
-/// Imports both meshes of `scene`; problems with either are all reported in one UserError, each
-/// at the scene's `mesh` key.
-SceneMeshes importSceneMeshes(const Scene& scene);
 
 /// Recomputes the topology part of the report (edges, orientation, components) for `mesh`.
 void analyzeTopology(Mesh& mesh);

@@ -10,7 +10,9 @@
 #pragma once
 
 #include <volmorph/core/Interrupter.h>
-#include <volmorph/Scene.h>
+#include <volmorph/BlendSettings.h>
+#include <volmorph/FeaturePair.h>
+#include <volmorph/WarpSettings.h>
 #include <volmorph/VolumeSet.h>
 
 #include <openvdb/math/Coord.h>

@@ -13,7 +13,7 @@
 //   only.
 #pragma once
 
-#include <volmorph/Scene.h>
+#include <volmorph/FeaturePair.h>
 #include <volmorph/VolumeSet.h>
 
 #include <vector>

@@ -5,8 +5,13 @@
 // radians in code (only Camera::fovDegrees keeps degrees, as vdb_render's flag does, and says so).
 #pragma once
 
+#include <volmorph/BlendSettings.h>
+#include <volmorph/FeaturePair.h>
+#include <volmorph/VolumeSource.h>
+#include <volmorph/WarpSettings.h>
 #include <volmorph/core/Diagnostics.h>
 #include <volmorph/core/Math.h>
+#include <volmorph/core/ObjectTransform.h>
 
 #include <openvdb/math/Mat4.h>
 #include <openvdb/math/Vec3.h>
@@ -20,28 +25,6 @@
 #include <vector>
 
 namespace volmorph {
-
-/// Object-to-world placement of a mesh: scale, then rotate about X, then Y, then Z, then translate.
-struct ObjectTransform {
-    Vec3d translate{0.0, 0.0, 0.0}; ///< world units
-    Vec3d rotateRadians{0.0, 0.0, 0.0};
-    Vec3d scale{1.0, 1.0, 1.0}; ///< uniform or per axis; every component > 0
-
-    /// Column-vector convention p' = M p (OpenVDB stores it transposed: use transform() to apply).
-    Mat4d matrix() const;
-    Vec3d apply(const Vec3d& p) const;
-    bool isIdentity() const;
-};
-
-/// Which grids of a volume input play which part. An empty name: the first of the defaults
-/// (volmorph/VolumeInput.h) that the file holds.
-struct VolumeGridNames {
-    std::string density, sdf, color;
-    SourceLocation where; ///< the `grids` key, for a name the file lacks
-};
-
-/// Whether `file` is a NIfTI volume (.nii or .nii.gz), by its name.
-bool isNiftiFile(const std::filesystem::path& file);
 
 /// One side of the morph: a mesh file or a volume file, and how it is placed.
 struct ObjectSpec {
@@ -65,6 +48,16 @@ struct ObjectSpec {
     /// nearest before it on disk (held), the first before the sequence starts. Not a sequence:
     /// `volume`.
     std::filesystem::path volumeAt(int frame) const;
+    /// The volume stage's input for a single volume file (`volume` as it is: a sequence's pattern
+    /// is resolved first, by volumeAt or sceneAtFrame).
+    VolumeSource volumeSource() const;
+};
+
+/// An extra shape the variational function passes through at time t, steering the in-betweens
+/// near t toward it (Turk and O'Brien's intermediate shapes).
+struct InfluenceSpec {
+    ObjectSpec object; ///< a mesh or a single volume file (no sequence), placed as a side is
+    double t = 0.5;    ///< in (0, 1)
 };
 
 /// A [[prop]]: a mesh in the shot beside the morph, seen and lit by the renderer only.
@@ -81,91 +74,6 @@ struct PropSpec {
 struct VolumeSpec {
     std::optional<double> voxelSize; ///< world units
     std::optional<int> resolution;   ///< voxels across the longest side of the larger object
-};
-
-enum class FeatureType { Point, Segment, Rectangle, Box };
-const char* toString(FeatureType type);
-
-/// One feature element (Lerios et al. 1995): an origin, an orthonormal frame and scales.
-/// The type only chooses the distance function; a segment is scale.x long along xAxis, a rectangle
-/// scale.x by scale.y in the xAxis-yAxis plane, a box scale.x by scale.y by scale.z; all centred on
-/// origin.
-struct FeatureElement {
-    Vec3d origin{0.0, 0.0, 0.0}; ///< world units
-    Vec3d xAxis{1.0, 0.0, 0.0};  ///< unit length; the frame is orthonormal and right-handed
-    Vec3d yAxis{0.0, 1.0, 0.0};
-    Vec3d zAxis{0.0, 0.0, 1.0};
-    Vec3d scale{1.0, 1.0, 1.0}; ///< world units, every component > 0
-};
-
-struct FeaturePairSpec {
-    FeatureType type = FeatureType::Point;
-    FeatureElement source;
-    FeatureElement target;
-    SourceLocation where; ///< the [[pair]] header
-};
-
-enum class Weighting { InverseSquare, BeierNeely };
-
-struct WarpSpec {
-    double epsilon = 0.01;         ///< world units; w = (d + epsilon)^-2
-    double toleranceVoxels = 0.25; ///< approximation error bound; 0 = exact warp
-    Weighting weighting = Weighting::InverseSquare;
-    /// Beier-Neely weights w = (len^p / (a + d))^b, used only with Weighting::BeierNeely.
-    double a = 0.01, b = 2.0, p = 0.0;
-};
-
-/// tau(t) for one attribute. Points are (t, tau) pairs sorted by t, interpolated linearly.
-/// Evaluated by the blend stage (volmorph/Schedule.h).
-struct ScheduleSpec {
-    enum class Kind { Linear, Smoothstep, Sigmoid, Curve };
-    Kind kind = Kind::Linear;
-    double k = 8.0; ///< sigmoid steepness
-    std::vector<std::pair<double, double>> points;
-};
-
-enum class BlendMode { Density, Sdf, Variational };
-
-/// An extra shape the variational function passes through at time t, steering the in-betweens
-/// near t toward it (Turk and O'Brien's intermediate shapes).
-struct InfluenceSpec {
-    ObjectSpec object; ///< a mesh or a single volume file (no sequence), placed as a side is
-    double t = 0.5;    ///< in (0, 1)
-};
-
-/// [variational]: Turk and O'Brien's variational implicit morph (blend.mode = "variational").
-struct VariationalSpec {
-    int constraints = 5000;          ///< surface points per shape, each with an inward partner
-    double normalOffsetVoxels = 1.0; ///< the inward partners' depth, voxels
-    /// World units per unit of t (the fourth axis's scale); unset: kVariationalTimeScale times the
-    /// longest side of the shapes' bounds together.
-    std::optional<double> timeScale;
-    std::vector<InfluenceSpec> influence;
-    SourceLocation where; ///< the [variational] table, when given
-};
-
-/// The default time scale over the longest side of the shapes' bounds (BENCHMARKS.md: a sphere
-/// into itself bulges 1.8% mid-way at a quarter of its diameter, 20% at one diameter; a sphere into
-/// one twice its size grows monotonically up to 0.4 of the larger's diameter, not at 0.8).
-inline constexpr double kVariationalTimeScale = 0.2;
-
-struct BlendSpec {
-    BlendMode mode = BlendMode::Density;
-    ScheduleSpec density;
-    ScheduleSpec color;
-    ScheduleSpec sdf;
-    /// sdf mode: pieces of an in-between smaller than this many voxels, apart from its largest
-    /// piece, are dropped (dust that a distance blend leaves where the blended field has an
-    /// isolated minimum); 0 keeps everything.
-    int minIslandVoxels = 27;
-    /// Schedules of the other grids volume inputs carry (temperature, flame, ...), by grid name;
-    /// a grid not named here follows the density schedule.
-    struct GridSchedule {
-        ScheduleSpec schedule;
-        SourceLocation where;
-    };
-    std::map<std::string, GridSchedule> grids;
-    VariationalSpec variational; ///< variational mode only
 };
 
 enum class Projection { Perspective, Orthographic };
@@ -261,6 +169,7 @@ struct Scene {
     std::vector<FeaturePairSpec> pairs;
     WarpSpec warp;
     BlendSpec blend;
+    std::vector<InfluenceSpec> influences; ///< [variational] influence (variational mode only)
     RenderSpec render;
     std::vector<PropSpec> props;
     FramesSpec frames;

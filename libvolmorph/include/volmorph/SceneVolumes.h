@@ -1,5 +1,7 @@
-// A scene's two sides as voxels on one shared transform: each side's mesh voxelized (Voxelize.h)
-// or its volume file read and resampled (VolumeInput.h), at the scene's voxel size.
+// The sides stage: the adapter from a Scene to the stages that make volumes (mesh/, voxelize/,
+// volume/), which take their own options. A scene's two sides as voxels on one shared transform:
+// each side's mesh voxelized (Voxelize.h) or its volume file read and resampled (VolumeInput.h), at
+// the scene's voxel size.
 #pragma once
 
 #include <volmorph/core/Interrupter.h>
@@ -11,6 +13,15 @@
 #include <optional>
 
 namespace volmorph {
+
+/// A scene's two meshes, imported with their transforms (empty for a side that is a volume).
+struct SceneMeshes {
+    Mesh source, target;
+};
+
+/// Imports both meshes of `scene`; problems with either are all reported in one UserError, each
+/// at the scene's `mesh` key.
+SceneMeshes importSceneMeshes(const Scene& scene);
 
 /// One side's world bounds, and for a volume its finest voxel size (world units), known before
 /// voxelizing.

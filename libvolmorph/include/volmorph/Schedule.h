@@ -1,12 +1,20 @@
 // A blend schedule: tau(t), the target's weight at morph time t, for one attribute (density,
-// colour, distance). Its settings are Scene.h's ScheduleSpec; the blend stage evaluates it.
+// colour, distance); the blend stage evaluates it.
 #pragma once
 
-#include <volmorph/Scene.h>
-
 #include <string>
+#include <utility>
+#include <vector>
 
 namespace volmorph {
+
+/// tau(t) for one attribute. Points are (t, tau) pairs sorted by t, interpolated linearly.
+struct ScheduleSpec {
+    enum class Kind { Linear, Smoothstep, Sigmoid, Curve };
+    Kind kind = Kind::Linear;
+    double k = 8.0; ///< sigmoid steepness
+    std::vector<std::pair<double, double>> points;
+};
 
 /// tau at t (clamped to [0, 1]): linear, smoothstep, a logistic sigmoid rescaled to pass through
 /// (0, 0) and (1, 1), or the curve's points interpolated linearly (held beyond its ends).

@@ -25,7 +25,7 @@
 
 #include <volmorph/core/Interrupter.h>
 #include <volmorph/core/Math.h>
-#include <volmorph/Scene.h>
+#include <volmorph/VolumeSource.h>
 #include <volmorph/VolumeSet.h>
 
 #include <cstdint>
@@ -64,11 +64,11 @@ struct VolumeInputOptions {
 /// transform.
 class VolumeInput {
 public:
-    /// Reads `spec.volume`, picks the parts and checks them. Throws UserError naming the file (at
-    /// the scene's `volume` key) for a file that cannot be read (truncated or damaged), a named
+    /// Reads `source.file`, picks the parts and checks them. Throws UserError naming the file (at
+    /// `source.where`) for a file that cannot be read (truncated or damaged), a named
     /// grid it lacks (with a "did you mean" from its grid names), a part of the wrong type, a
     /// frustum transform, or neither a density nor a level set.
-    explicit VolumeInput(const ObjectSpec& spec);
+    explicit VolumeInput(const VolumeSource& source);
     ~VolumeInput();
     VolumeInput(VolumeInput&&) noexcept;
 
@@ -84,7 +84,7 @@ private:
     std::unique_ptr<detail::VolumeFile> mFile;
 };
 
-/// VolumeInput(spec).info().
-VolumeFileInfo inspectVolume(const ObjectSpec& spec);
+/// VolumeInput(source).info().
+VolumeFileInfo inspectVolume(const VolumeSource& source);
 
 } // namespace volmorph

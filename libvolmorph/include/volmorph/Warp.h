@@ -8,6 +8,7 @@
 #pragma once
 
 #include <volmorph/Feature.h>
+#include <volmorph/WarpSettings.h>
 
 #include <openvdb/math/Mat3.h>
 

@@ -1,9 +1,11 @@
-// Work that cannot be interrupted (an OpenVDB tool without an interrupter, Eigen's dense LU) run so
-// that a stop request is still answered at once: the work runs on a thread of its own, owning
-// everything it reads (capture by value or shared_ptr, never a reference or the interrupter), and
-// the caller polls the interrupter meanwhile. Asked to stop, the caller throws Interrupted and
-// abandons the work: its thread finishes it and frees it alone, counted meanwhile by
-// abandonedWorkRunning() (a program that exits before it is done must skip static destructors).
+// Work that cannot be interrupted throughout (an OpenVDB tool without an interrupter, Eigen's dense
+// LU) run so that a stop request is still answered at once: the work runs on a thread of its own,
+// owning everything it reads (capture by value or shared_ptr, never a reference or the caller's
+// interrupter), and the caller polls its interrupter meanwhile. Asked to stop, the caller throws
+// Interrupted and abandons the work. The work is handed an interrupter of its own, which asks it to
+// stop once it is abandoned: the parts of it that can stop (volmorph's own loops) end it early; the
+// rest finishes alone. Its thread frees it, counted meanwhile by abandonedWorkRunning() (a program
+// that exits before it is done must skip static destructors). This is the one way such work stops.
 #pragma once
 
 #include <volmorph/core/Interrupter.h>
@@ -19,14 +21,20 @@
 
 namespace volmorph::detail {
 
-/// work() (which must own what it reads), returned; Interrupted as soon as `interrupter` asks to
-/// stop (polled every 10 ms); work's own exception rethrown. Without an interrupter, work() here.
+/// work(stop) (which must own what it reads), returned; Interrupted as soon as `interrupter` asks
+/// to stop (polled every 10 ms), and then `stop` asks the abandoned work to stop; work's own
+/// exception rethrown. Without an interrupter, work(stop) here, with a `stop` that never asks.
 template <typename Work>
-auto abandonable(Work work, Interrupter* interrupter) -> decltype(work())
+auto abandonable(Work work, Interrupter* interrupter)
+    -> decltype(work(std::declval<Interrupter&>()))
 {
-    using Result = decltype(work());
-    if (!interrupter) return work();
+    using Result = decltype(work(std::declval<Interrupter&>()));
+    if (!interrupter) {
+        Interrupter never;
+        return work(never);
+    }
     struct Shared {
+        Interrupter stop; ///< the work's own: asks it to stop once it is abandoned
         std::mutex mutex;
         std::condition_variable done;
         std::optional<Result> result;
@@ -41,7 +49,7 @@ auto abandonable(Work work, Interrupter* interrupter) -> decltype(work())
             std::optional<Result> result;
             std::exception_ptr error;
             try {
-                result.emplace(job());
+                result.emplace(job(shared->stop));
             } catch (...) {
                 error = std::current_exception();
             }
@@ -62,6 +70,7 @@ auto abandonable(Work work, Interrupter* interrupter) -> decltype(work())
                                   [&] { return shared->finished; }))
         if (interrupter->wasInterrupted()) {
             shared->abandoned = true;
+            shared->stop.requestStop();
             countAbandonedWork(+1);
             throw Interrupted();
         }

@@ -10,7 +10,7 @@
 #include "warp/AdaptiveWarp.h"
 
 #include <volmorph/core/Interrupter.h>
-#include <volmorph/Scene.h>
+#include <volmorph/BlendSettings.h>
 #include <volmorph/VolumeSet.h>
 
 #include <openvdb/Types.h>

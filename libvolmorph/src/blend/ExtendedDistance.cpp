@@ -144,14 +144,13 @@ CoordBBox ExtendedDistance::boxFor(const openvdb::FloatGrid& sourceBand,
 }
 
 ExtendedDistance::ExtendedDistance(openvdb::FloatGrid::ConstPtr band, const CoordBBox& box,
-                                   Interrupter* interrupter)
+                                   Interrupter& stop)
     : mBand(std::move(band))
 {
     mVoxel = float(mBand->voxelSize()[0]);
     if (box.empty()) return;
-    const auto check = [interrupter] {
-        if (interrupter && interrupter->wasInterrupted()) throw Interrupted();
-    };
+    Interrupter* interrupter = &stop;
+    const auto check = [interrupter] { throwIfInterrupted(interrupter); };
     // The shell: the seeds' band dilated by kShellCells lattice cells, every way.
     const openvdb::FloatGrid::Ptr shell =
         openvdb::tools::dilateSdf(*shellSeeds(), kShellCells, openvdb::tools::NN_FACE_EDGE_VERTEX);

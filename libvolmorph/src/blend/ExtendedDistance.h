@@ -25,12 +25,10 @@
 // cross, at a medial axis), so each lattice point then takes the nearest of its neighbours' too,
 // a few passes (closest-point propagation, as jump flooding does): never under the distance. A read
 // beyond the box (a warped point may leave it) is the distance to the nearest lattice point's
-// surface point, not that point's value. Measured: 0.05 voxel in the shell and 0.20 beyond against
-// a sphere's closed form, 1.9 around its centre (a cone point, which no lattice 8 voxels apart
-// follows); against exact distances of the default scene's meshes at 250 voxels across, the blend
-// at the band's voxels is within 0.02 voxel on average and 0.3 to 0.5 at the 99.9th percentile,
-// the largest (about 1 voxel) at the bunny's inner medial axis, a ridge that trilinear reads of
-// the lattices cut off (tests/bench/far_field_accuracy.cpp).
+// surface point, not that point's value. Its accuracy against a sphere's closed form and against
+// exact distances of real meshes is in BENCHMARKS.md (tests/bench/far_field_accuracy.cpp measures
+// it); the largest errors sit at medial axes and cone points, which no lattice 8 voxels apart
+// follows.
 // Near the surface the band's own values are read: within kNear voxels, blended to kFar.
 #pragma once
 
@@ -65,27 +63,28 @@ public:
     /// a margin for warped points that leave it, an eighth of its size, at least 8 voxels. With
     /// no pairs the points are the output's voxels: the blend's zero set lies within the objects'
     /// box (the bands' active voxels), and 8 voxels more hold its compute band. A read beyond the
-    /// box measures to the nearest far lattice point's surface point (farAt). (A margin of 4
-    /// voxels: 15% more leaves evaluated, for a setup hardly cheaper.)
+    /// box measures to the nearest far lattice point's surface point (farAt).
     static openvdb::CoordBBox boxFor(const openvdb::FloatGrid& sourceBand,
                                      const openvdb::FloatGrid& targetBand, size_t pairCount);
 
     /// `band`: a level set; `box`: where to extend it (its index space). An empty box extends
-    /// nothing: reads are the band's. `interrupter`: asked between the steps and within
-    /// volmorph's own loops (OpenVDB 10's fast sweeping takes none), throws Interrupted.
-    ExtendedDistance(openvdb::FloatGrid::ConstPtr band, const openvdb::CoordBBox& box,
-                     Interrupter* interrupter = nullptr);
-
-    /// The same, built so that a stop request from `interrupter` is answered at once: OpenVDB's
-    /// fast sweeping takes no interrupter (about a second at 320 voxels across), so the work runs
-    /// abandonable (Abandonable.h) and is left to finish alone when asked to stop.
+    /// nothing: reads are the band's. A stop request from `interrupter` is answered at once
+    /// (Interrupted): OpenVDB 10's fast sweeping takes no interrupter (about a second at 320
+    /// voxels across), so the work runs abandonable (Abandonable.h); once abandoned, volmorph's
+    /// own loops in it stop it early, between and within the steps.
     static std::unique_ptr<const ExtendedDistance>
     make(openvdb::FloatGrid::ConstPtr band, const openvdb::CoordBBox& box, Interrupter* interrupter)
     {
         return abandonable(
-            [band, box] { return std::make_unique<const ExtendedDistance>(band, box); },
+            [band, box](Interrupter& stop) {
+                return std::make_unique<const ExtendedDistance>(band, box, stop);
+            },
             interrupter);
     }
+
+    /// What make() runs, on the work's own thread: `stop` is Abandonable's, never the caller's.
+    ExtendedDistance(openvdb::FloatGrid::ConstPtr band, const openvdb::CoordBBox& box,
+                     Interrupter& stop);
 
     /// The largest difference between the extended field and the band where the extended field
     /// is used, voxels.

@@ -11,7 +11,7 @@
 #include "blend/Sample.h"
 #include "warp/AdaptiveWarp.h"
 
-#include <volmorph/Scene.h>
+#include <volmorph/BlendSettings.h>
 #include <volmorph/VolumeSet.h>
 
 #include <openvdb/openvdb.h>

@@ -1,6 +1,7 @@
 #include "blend/OutputLeaves.h"
 
 #include <volmorph/core/Diagnostics.h>
+#include <volmorph/core/MemoryLimit.h>
 
 #include <algorithm>
 #include <cstdio>
@@ -9,7 +10,7 @@ namespace volmorph::detail {
 
 OutputLeaves::OutputLeaves(double t, uint64_t limitBytes, uint64_t residentBytes,
                            uint64_t bytesPerLeaf, Vec3f background)
-    : mT(t), mLimit(limitBytes), mResident(residentBytes),
+    : mT(t), mLimit(limitBytes), mResident(residentBytes), mBytesPerLeaf(bytesPerLeaf),
       mMaxLeaves(size_t(std::max<uint64_t>(
           1, (limitBytes > residentBytes ? limitBytes - residentBytes : 0) / bytesPerLeaf))),
       mBackground(background)
@@ -34,11 +35,12 @@ void OutputLeaves::keep(std::unique_ptr<ValueLeaf> value, std::unique_ptr<ColorL
         std::snprintf(text, sizeof text,
                       "the in-between at t = %.4f needs more than the memory limit of %.1f GiB "
                       "(%.1f GiB in use before it, and over %zu blocks of 8^3 voxels); use a "
-                      "larger voxel size, check the feature pairs' scales, or raise "
-                      "--memory-limit (default: half the machine's memory)",
+                      "larger voxel size, check the feature pairs' scales, or raise the memory "
+                      "limit",
                       mT, double(mLimit) / double(1ull << 30),
                       double(mResident) / double(1ull << 30), mMaxLeaves);
-        throw UserError(SourceLocation{"morph"}, text);
+        throw MemoryLimitExceeded(SourceLocation{"morph"}, text,
+                                  mResident + (mMaxLeaves + 1) * mBytesPerLeaf, mLimit);
     }
     mLeaves.push_back(Kept{std::move(value), std::move(color), std::move(extras)});
 }

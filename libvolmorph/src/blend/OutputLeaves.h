@@ -69,7 +69,7 @@ public:
 
 private:
     double mT;
-    uint64_t mLimit, mResident;
+    uint64_t mLimit, mResident, mBytesPerLeaf;
     size_t mMaxLeaves;
     Vec3f mBackground;
     std::mutex mMutex;

@@ -108,15 +108,15 @@ void checkMemory(const VariationalSpec& spec, size_t shapes, uint64_t limit)
     std::snprintf(text, sizeof text,
                   "variational.constraints: %d per shape (%zu constraints over %zu shapes) need "
                   "about %.2f GiB to solve, over the memory limit of %.2f GiB (%.2f GiB in use); "
-                  "lower variational.constraints or raise --memory-limit",
+                  "lower variational.constraints or raise the memory limit",
                   spec.constraints, count, shapes, gib(need), gib(limit), gib(resident));
-    throw variationalError(spec, text);
+    throw MemoryLimitExceeded(spec.where.line > 0 ? spec.where : SourceLocation{"variational"},
+                              text, resident + need, limit);
 }
 
-class VariationalBlend final : public BlendMethod {
+class VariationalBlend final : public TwoSidedBlend {
 public:
-    explicit VariationalBlend(const BlendSetup& setup)
-        : mSource(setup.source), mTarget(setup.target), mSpec(setup.spec)
+    explicit VariationalBlend(const BlendSetup& setup) : TwoSidedBlend(setup)
     {
         std::vector<Shape> shapes{{&mSource, 0.0}, {&mTarget, 1.0}};
         if (setup.influences)
@@ -335,8 +335,6 @@ private:
         return c.asVec3d() - g * (double(d(c)) / mVoxel / length);
     }
 
-    VolumeSet mSource, mTarget;
-    BlendSpec mSpec;
     double mVoxel = 1.0, mTimeScale = 1.0;
     float mWidth = 0.0f;
     CoordBBox mBox; ///< where the in-betweens are looked for (index space)

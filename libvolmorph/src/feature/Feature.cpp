@@ -5,8 +5,16 @@
 
 #include <algorithm>
 #include <cmath>
+#include <iterator>
 
 namespace volmorph {
+
+const char* toString(FeatureType type)
+{
+    static constexpr const char* kNames[] = {"point", "segment", "rectangle", "box"};
+    static_assert(std::size(kNames) == size_t(FeatureType::Box) + 1, "a name for each type");
+    return kNames[size_t(type)];
+}
 
 Feature Feature::fromElement(const FeatureElement& e, FeatureType type)
 {

@@ -407,22 +407,4 @@ Mesh importMesh(const std::filesystem::path& file, const ObjectTransform& transf
     return mesh;
 }
 
-SceneMeshes importSceneMeshes(const Scene& scene)
-{
-    SceneMeshes out;
-    std::vector<Diagnostic> problems;
-    const std::pair<const ObjectSpec*, Mesh*> sides[2] = {{&scene.source, &out.source},
-                                                          {&scene.target, &out.target}};
-    for (const auto& [spec, mesh] : sides) {
-        if (spec->isVolume()) continue;
-        try {
-            *mesh = importMesh(spec->mesh, spec->transform, spec->fileWhere);
-        } catch (const UserError& e) {
-            problems.insert(problems.end(), e.diagnostics().begin(), e.diagnostics().end());
-        }
-    }
-    if (!problems.empty()) throw UserError(problems);
-    return out;
-}
-
 } // namespace volmorph

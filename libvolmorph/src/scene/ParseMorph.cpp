@@ -152,7 +152,7 @@ void parseBlend(Reader& r, const toml::node& node, BlendSpec& b)
 }
 
 void parseVariational(Reader& r, const toml::node& node, const std::filesystem::path& folder,
-                      VariationalSpec& v)
+                      VariationalSpec& v, std::vector<InfluenceSpec>& influences)
 {
     const toml::table* t = r.table(node, "variational");
     if (!t) return;
@@ -190,7 +190,7 @@ void parseVariational(Reader& r, const toml::node& node, const std::filesystem::
                 } else {
                     r.missing(shape, path + ".t", "the time the shape is placed at, 0 < t < 1");
                 }
-                v.influence.push_back(std::move(influence));
+                influences.push_back(std::move(influence));
             });
 }
 

@@ -57,7 +57,8 @@ public:
         if (const toml::node* n = root.get("warp")) detail::parseWarp(r, *n, mScene.warp);
         if (const toml::node* n = root.get("blend")) detail::parseBlend(r, *n, mScene.blend);
         if (const toml::node* n = root.get("variational")) {
-            detail::parseVariational(r, *n, mScene.folder, mScene.blend.variational);
+            detail::parseVariational(r, *n, mScene.folder, mScene.blend.variational,
+                                     mScene.influences);
             if (mScene.blend.mode != BlendMode::Variational)
                 r.error(r.at(*n), "[variational]: only used with blend.mode = \"variational\"");
         }

@@ -33,7 +33,7 @@ void parseWarp(Reader& r, const toml::node& node, WarpSpec& warp);
 void parseBlend(Reader& r, const toml::node& node, BlendSpec& blend);
 /// [variational], its influence shapes' files resolved against `folder`.
 void parseVariational(Reader& r, const toml::node& node, const std::filesystem::path& folder,
-                      VariationalSpec& variational);
+                      VariationalSpec& variational, std::vector<InfluenceSpec>& influences);
 /// [render], its camera and lights (with their keys); a sky map's path resolved against `folder`.
 void parseRender(Reader& r, const toml::node& node, const std::filesystem::path& folder,
                  RenderSpec& render);

@@ -1,5 +1,7 @@
 #include "volume/NiftiFile.h"
 
+#include <volmorph/VolumeSource.h>
+
 #include <openvdb/tools/Dense.h>
 
 #include <nifti2_io.h>
@@ -11,7 +13,22 @@
 #include <string>
 #include <vector>
 
+namespace volmorph {
+
+bool isNiftiFile(const std::filesystem::path& file)
+{
+    const std::string name = file.filename().string();
+    auto endsWith = [&name](const std::string& end) {
+        return name.size() >= end.size() &&
+               name.compare(name.size() - end.size(), end.size(), end) == 0;
+    };
+    return endsWith(".nii") || endsWith(".nii.gz");
+}
+
+} // namespace volmorph
+
 namespace volmorph::detail {
+
 namespace {
 
 struct NiftiDeleter {

@@ -39,18 +39,18 @@ openvdb::math::Transform::Ptr placedTransform(const openvdb::math::Transform& gr
     return xf;
 }
 
-VolumeFile::VolumeFile(const ObjectSpec& spec) : mSpec(spec)
+VolumeFile::VolumeFile(const VolumeSource& source) : mSource(source)
 {
     try {
-        mGrids = isNiftiFile(spec.volume) ? readNiftiGrids(spec.volume, spec.window)
-                                          : readVdbGrids(spec.volume);
+        mGrids = isNiftiFile(source.file) ? readNiftiGrids(source.file, source.window)
+                                          : readVdbGrids(source.file);
     } catch (const std::exception& e) {
         throw error(std::string("cannot read volume file (") + e.what() + ")");
     }
     VolumeFileInfo& i = mInfo;
-    i.density = pick("density", spec.grids.density, {"density"}, false);
-    i.sdf = pick("sdf", spec.grids.sdf, {"surface", "sdf"}, false);
-    i.color = pick("color", spec.grids.color, {"Cd", "color"}, true);
+    i.density = pick("density", source.grids.density, {"density"}, false);
+    i.sdf = pick("sdf", source.grids.sdf, {"surface", "sdf"}, false);
+    i.color = pick("color", source.grids.color, {"Cd", "color"}, true);
     std::vector<std::string> names;
     for (const auto& g : *mGrids) {
         const std::string& name = g->getName();
@@ -73,8 +73,8 @@ VolumeFile::VolumeFile(const ObjectSpec& spec) : mSpec(spec)
 UserError VolumeFile::error(const std::string& what) const
 {
     const SourceLocation at =
-        mSpec.fileWhere.file.empty() ? SourceLocation{mSpec.volume.string()} : mSpec.fileWhere;
-    return UserError(at, "volume '" + mSpec.volume.string() + "': " + what);
+        mSource.where.file.empty() ? SourceLocation{mSource.file.string()} : mSource.where;
+    return UserError(at, "volume '" + mSource.file.string() + "': " + what);
 }
 
 openvdb::GridBase::Ptr VolumeFile::grid(const std::string& name) const
@@ -94,10 +94,10 @@ std::string VolumeFile::pick(const std::string& part, const std::string& given,
             std::vector<std::string> names;
             for (const auto& g : *mGrids) names.push_back(g->getName());
             const std::string near = closestMatch(given, names);
-            const SourceLocation at = mSpec.grids.where.file.empty()
-                                          ? SourceLocation{mSpec.volume.string()}
-                                          : mSpec.grids.where;
-            throw UserError(at, "grids." + part + ": volume '" + mSpec.volume.string() +
+            const SourceLocation at = mSource.grids.where.file.empty()
+                                          ? SourceLocation{mSource.file.string()}
+                                          : mSource.grids.where;
+            throw UserError(at, "grids." + part + ": volume '" + mSource.file.string() +
                                     "' has no grid '" + given + "'" +
                                     (near.empty() ? "" : "; did you mean '" + near + "'?") +
                                     " (it holds: " + joined(names) + ")");
@@ -128,7 +128,7 @@ void VolumeFile::measure()
     for (const std::string& name : {i.density, i.sdf}) {
         if (name.empty()) continue;
         const openvdb::GridBase& g = *grid(name);
-        const openvdb::math::Transform::Ptr xf = placedTransform(g.transform(), mSpec.transform);
+        const openvdb::math::Transform::Ptr xf = placedTransform(g.transform(), mSource.transform);
         const Vec3d size = xf->voxelSize();
         i.voxelSize = std::min({i.voxelSize, size.x(), size.y(), size.z()});
         const openvdb::CoordBBox box = g.evalActiveVoxelBoundingBox();
@@ -150,7 +150,7 @@ openvdb::GridBase::Ptr VolumeFile::read(const std::string& name) const
     const openvdb::GridBase::Ptr g = grid(name);
     if (!g) throw error("has no grid '" + name + "'");
     openvdb::GridBase::Ptr placed = g->copyGrid(); // shares the tree
-    placed->setTransform(placedTransform(g->transform(), mSpec.transform));
+    placed->setTransform(placedTransform(g->transform(), mSource.transform));
     return placed;
 }
 

@@ -3,8 +3,8 @@
 #pragma once
 
 #include <volmorph/core/Diagnostics.h>
-#include <volmorph/Scene.h>
 #include <volmorph/VolumeInput.h>
+#include <volmorph/VolumeSource.h>
 
 #include <openvdb/openvdb.h>
 
@@ -15,16 +15,16 @@ namespace volmorph::detail {
 
 class VolumeFile {
 public:
-    /// Reads `spec.volume` and picks its parts. Throws UserError (see VolumeInput).
-    explicit VolumeFile(const ObjectSpec& spec);
+    /// Reads `source.file` and picks its parts. Throws UserError (see VolumeInput).
+    explicit VolumeFile(const VolumeSource& source);
 
     const VolumeFileInfo& info() const { return mInfo; }
-    const ObjectSpec& spec() const { return mSpec; }
+    const VolumeSource& source() const { return mSource; }
 
     /// The grid `name`, placed: its transform followed by the object's.
     openvdb::GridBase::Ptr read(const std::string& name) const;
 
-    /// A user error about this file, at the scene's `volume` key, naming the file.
+    /// A user error about this file, at the source's location (else the file), naming the file.
     UserError error(const std::string& what) const;
 
 private:
@@ -33,7 +33,7 @@ private:
                      std::initializer_list<const char*> defaults, bool vec3) const;
     void measure();
 
-    ObjectSpec mSpec;
+    VolumeSource mSource;
     openvdb::GridPtrVecPtr mGrids;
     VolumeFileInfo mInfo;
 };

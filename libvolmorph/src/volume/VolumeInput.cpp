@@ -106,14 +106,16 @@ void checkBudget(const detail::VolumeFile& file, const VolumeInputOptions& o)
     char text[300];
     std::snprintf(text, sizeof text,
                   "resampled onto voxel size %g its grids could need %.1f GiB, over the memory "
-                  "limit of %.1f GiB; use a larger voxel size or raise --memory-limit",
+                  "limit of %.1f GiB; use a larger voxel size or raise the memory limit",
                   o.voxelSize, bytes / double(1ull << 30), double(limit) / double(1ull << 30));
-    throw file.error(text);
+    const Diagnostic d = file.error(text).diagnostics().front();
+    throw MemoryLimitExceeded(d.where, d.message, uint64_t(bytes), limit);
 }
 
 } // namespace
 
-VolumeInput::VolumeInput(const ObjectSpec& spec) : mFile(std::make_unique<detail::VolumeFile>(spec))
+VolumeInput::VolumeInput(const VolumeSource& source)
+    : mFile(std::make_unique<detail::VolumeFile>(source))
 {
 }
 
@@ -125,15 +127,15 @@ const VolumeFileInfo& VolumeInput::info() const
     return mFile->info();
 }
 
-VolumeFileInfo inspectVolume(const ObjectSpec& spec)
+VolumeFileInfo inspectVolume(const VolumeSource& source)
 {
-    return VolumeInput(spec).info();
+    return VolumeInput(source).info();
 }
 
 VolumeSet VolumeInput::resample(const VolumeInputOptions& options, Interrupter* interrupter) const
 {
     const detail::VolumeFile& file = *mFile;
-    const ObjectSpec& spec = file.spec();
+    const VolumeSource& source = file.source();
     const VolumeFileInfo& info = file.info();
     checkBudget(file, options);
     if (interrupter) interrupter->start("read volume");
@@ -156,7 +158,7 @@ VolumeSet VolumeInput::resample(const VolumeInputOptions& options, Interrupter* 
     if (!info.color.empty())
         out.color = resampled(*readChecked<Vec3SGrid>(file, info.color), xform, interrupter);
     else
-        out.color = Vec3SGrid::create(spec.color ? Vec3f(*spec.color) : Vec3f(0.8f));
+        out.color = Vec3SGrid::create(source.color ? Vec3f(*source.color) : Vec3f(0.8f));
     for (const std::string& name : info.extras) {
         const GridBase::Ptr g = file.read(name);
         if (auto f = openvdb::gridPtrCast<FloatGrid>(g)) {

@@ -103,9 +103,8 @@ uint64_t checkBudget(const Mesh& input, const VoxelizeOptions& options, double v
         s << "voxel size " << voxelSize << " world units gives " << std::ceil(cells)
           << " voxels across the mesh and needs about " << gib(estimate)
           << ", more than the limit of " << gib(limit)
-          << "; use a larger voxel size (or fewer voxels across), or raise the limit "
-          << "with --memory-limit (default: half the machine's memory)";
-        throw UserError(where, s.str());
+          << "; use a larger voxel size (or fewer voxels across), or raise the memory limit";
+        throw MemoryLimitExceeded(where, s.str(), estimate, limit);
     }
     return estimate;
 }

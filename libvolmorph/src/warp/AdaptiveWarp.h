@@ -68,7 +68,7 @@
 #pragma once
 
 #include <volmorph/core/Interrupter.h>
-#include <volmorph/Mesh.h>
+#include <volmorph/core/Math.h>
 #include <volmorph/Warp.h>
 
 #include "Occupancy.h"

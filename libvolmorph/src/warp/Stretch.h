@@ -1,7 +1,7 @@
 // How much a map stretches space locally: the spectral norm of its Jacobian.
 #pragma once
 
-#include <volmorph/Mesh.h>
+#include <volmorph/core/Math.h>
 
 #include <algorithm>
 #include <cmath>

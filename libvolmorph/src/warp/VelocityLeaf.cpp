@@ -7,7 +7,7 @@ namespace volmorph::detail {
 
 /// Both sides' velocities on the leaf's lattice, 4 voxels apart: point (i, j, k) at origin + 4 (i,
 /// j, k).
-struct Lattice {
+struct VelocityLattice {
     Vec3d v[2][3][3][3]; ///< side (0 source, 1 target), i, j, k
 
     /// The trilinear interpolant of side s at voxel offset (x, y, z), each in 0..8.
@@ -145,9 +145,9 @@ void VelocityLeaf::fillExact(const openvdb::Coord& origin, const openvdb::util::
     }
 }
 
-void VelocityLeaf::refine(const openvdb::Coord& origin, int c, double speed, const Lattice& coarse,
-                          const openvdb::util::NodeMask<3>& on, Vec3f source[512],
-                          Vec3f target[512]) const
+void VelocityLeaf::refine(const openvdb::Coord& origin, int c, double speed,
+                          const VelocityLattice& coarse, const openvdb::util::NodeMask<3>& on,
+                          Vec3f source[512], Vec3f target[512]) const
 {
     const int ox = (c >> 2) * 4, oy = ((c >> 1) & 1) * 4, oz = (c & 1) * 4;
     // The 19 new lattice points and the 8 cells' centres, in one batch.
@@ -220,7 +220,8 @@ void VelocityLeaf::refine(const openvdb::Coord& origin, int c, double speed, con
 
 void VelocityLeaf::finishFailed(const openvdb::Coord& origin, const openvdb::util::NodeMask<3>& on,
                                 const bool passed[8], const double miss[8], double speed,
-                                const Lattice& lattice, Vec3f source[512], Vec3f target[512]) const
+                                const VelocityLattice& lattice, Vec3f source[512],
+                                Vec3f target[512]) const
 {
     openvdb::util::NodeMask<3> rest[8];
     for (auto it = on.beginOn(); it; ++it) {
@@ -250,7 +251,7 @@ int VelocityLeaf::fill(const openvdb::Coord& origin, const openvdb::util::NodeMa
         fillExact(origin, on, source, target);
         return 0;
     }
-    Lattice lattice;
+    VelocityLattice lattice;
     double speed = 0.0;
     // Evaluates the lattice points (i, j, k) `points` in `batch` with the points it holds; false
     // at a fold.

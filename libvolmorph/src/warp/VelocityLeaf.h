@@ -28,7 +28,8 @@
 
 namespace volmorph::detail {
 
-struct Lattice; // VelocityLeaf.cpp: both sides' velocities at a leaf's points 4 voxels apart
+struct VelocityLattice; // VelocityLeaf.cpp: both sides' velocities at a leaf's points 4 voxels
+                        // apart
 
 class VelocityLeaf {
 public:
@@ -55,10 +56,10 @@ private:
     /// tolerances): on a finer lattice, or exactly.
     void finishFailed(const openvdb::Coord& origin, const openvdb::util::NodeMask<3>& on,
                       const bool passed[8], const double miss[8], double speed,
-                      const Lattice& lattice, Vec3f source[512], Vec3f target[512]) const;
+                      const VelocityLattice& lattice, Vec3f source[512], Vec3f target[512]) const;
     /// Sub-cube c's voxels `on` interpolated on a lattice 2 voxels apart (its 8 cells checked at
     /// their centres against the tolerance times `speed`; a cell that misses, or a fold, exactly).
-    void refine(const openvdb::Coord& origin, int c, double speed, const Lattice& coarse,
+    void refine(const openvdb::Coord& origin, int c, double speed, const VelocityLattice& coarse,
                 const openvdb::util::NodeMask<3>& on, Vec3f source[512], Vec3f target[512]) const;
 
     VelocityKernel mKernel;

@@ -27,11 +27,11 @@ bool eventually(Done done)
 TEST(Abandonable, ReturnsTheWorksResultAndRethrowsItsError)
 {
     Interrupter interrupter;
-    EXPECT_EQ(volmorph::detail::abandonable([] { return 42; }, &interrupter), 42);
-    EXPECT_THROW(
-        volmorph::detail::abandonable(
-            []() -> int { throw std::runtime_error("the work's own error"); }, &interrupter),
-        std::runtime_error);
+    EXPECT_EQ(volmorph::detail::abandonable([](Interrupter&) { return 42; }, &interrupter), 42);
+    EXPECT_THROW(volmorph::detail::abandonable(
+                     [](Interrupter&) -> int { throw std::runtime_error("the work's own error"); },
+                     &interrupter),
+                 std::runtime_error);
     EXPECT_EQ(volmorph::abandonedWorkRunning(), 0);
 }
 
@@ -52,7 +52,8 @@ TEST(Abandonable, AStopRequestAbandonsTheWorkWhichIsCountedUntilItEnds)
         interrupter.requestStop();
     });
     EXPECT_THROW(volmorph::detail::abandonable(
-                     [release, owned = std::move(owned)] {
+                     [release, owned = std::move(owned)](Interrupter&) {
+                         // Work that cannot stop: it ignores its own interrupter.
                          while (!*release) std::this_thread::sleep_for(1ms);
                          return 1;
                      },
@@ -65,4 +66,30 @@ TEST(Abandonable, AStopRequestAbandonsTheWorkWhichIsCountedUntilItEnds)
     *release = true;
     EXPECT_TRUE(eventually([] { return volmorph::abandonedWorkRunning() == 0; }));
     EXPECT_TRUE(*freed);
+}
+
+// The abandoned work's own interrupter asks it to stop, so that work that can stop (volmorph's own
+// loops inside it) ends early: this work would run forever otherwise.
+TEST(Abandonable, AbandonedWorkIsAskedToStop)
+{
+    Interrupter interrupter;
+    interrupter.requestStop();
+    auto asked = std::make_shared<std::atomic<bool>>(false);
+    EXPECT_THROW(volmorph::detail::abandonable(
+                     [asked](Interrupter& stop) {
+                         while (!stop.wasInterrupted()) std::this_thread::sleep_for(1ms);
+                         *asked = true;
+                         throw volmorph::Interrupted();
+                         return 1;
+                     },
+                     &interrupter),
+                 volmorph::Interrupted);
+    EXPECT_TRUE(eventually([] { return volmorph::abandonedWorkRunning() == 0; }));
+    EXPECT_TRUE(*asked);
+    // Not abandoned, the work's interrupter never asks.
+    Interrupter running;
+    EXPECT_FALSE(volmorph::detail::abandonable(
+        [](Interrupter& stop) { return stop.wasInterrupted(); }, &running));
+    EXPECT_FALSE(volmorph::detail::abandonable(
+        [](Interrupter& stop) { return stop.wasInterrupted(); }, nullptr));
 }

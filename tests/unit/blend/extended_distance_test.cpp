@@ -8,7 +8,10 @@
 
 #include <gtest/gtest.h>
 
+#include <chrono>
+#include <memory>
 #include <random>
+#include <thread>
 
 using volmorph::detail::ExtendedDistance;
 
@@ -20,7 +23,8 @@ struct Sphere {
     openvdb::FloatGrid::Ptr band = openvdb::tools::createLevelSetSphere<openvdb::FloatGrid>(
         float(kRadius), openvdb::Vec3f(0.0f), float(kVoxel), 3.0f);
     openvdb::CoordBBox box{openvdb::Coord(-150), openvdb::Coord(150)};
-    ExtendedDistance field{band, box};
+    std::unique_ptr<const ExtendedDistance> made = ExtendedDistance::make(band, box, nullptr);
+    const ExtendedDistance& field = *made;
 };
 
 /// The closed form at p (index space), voxels.
@@ -80,13 +84,17 @@ TEST(ExtendedDistance, NoStepWhereTheFarLatticeTakesOver)
 
 TEST(ExtendedDistance, StopsWhenAsked)
 {
-    // SIGINT's path: the interrupter asked to stop before the work, and the work throws
-    // Interrupted instead of finishing (the command then exits with status 130).
+    // SIGINT's path: the interrupter asked to stop before the work: make() throws Interrupted
+    // instead of finishing (the command then exits with status 130), and the abandoned work, asked
+    // to stop by its own interrupter, ends (it is counted until it does).
     const auto band = openvdb::tools::createLevelSetSphere<openvdb::FloatGrid>(
         float(kRadius), openvdb::Vec3f(0.0f), float(kVoxel), 3.0f);
     volmorph::Interrupter stop;
     stop.requestStop();
-    EXPECT_THROW(ExtendedDistance(
+    EXPECT_THROW(ExtendedDistance::make(
                      band, openvdb::CoordBBox(openvdb::Coord(-150), openvdb::Coord(150)), &stop),
                  volmorph::Interrupted);
+    for (int i = 0; i < 6000 && volmorph::abandonedWorkRunning() > 0; ++i)
+        std::this_thread::sleep_for(std::chrono::milliseconds(10));
+    EXPECT_EQ(volmorph::abandonedWorkRunning(), 0);
 }

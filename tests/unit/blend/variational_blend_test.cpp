@@ -6,6 +6,7 @@
 #include "support/ZeroSetTopology.h"
 
 #include <volmorph/core/Diagnostics.h>
+#include <volmorph/core/MemoryLimit.h>
 #include <volmorph/SceneVolumes.h>
 
 #include <openvdb/tools/Composite.h>
@@ -160,11 +161,13 @@ TEST(VariationalBlend, AConstraintCountPastTheMemoryLimitIsRefused)
     try {
         const Morpher m(sphere, sphere, {}, WarpSpec{}, variational(1000000), options);
         FAIL() << "not refused";
-    } catch (const UserError& e) {
+    } catch (const MemoryLimitExceeded& e) {
         const std::string text = e.what();
         EXPECT_NE(text.find("variational.constraints: 1000000 per shape"), std::string::npos)
             << text;
-        EXPECT_NE(text.find("raise --memory-limit"), std::string::npos) << text;
+        EXPECT_NE(text.find("raise the memory limit"), std::string::npos) << text;
+        EXPECT_EQ(text.find("--"), std::string::npos) << text;
+        EXPECT_GT(e.neededBytes(), e.limitBytes());
     }
 }
 

@@ -2,6 +2,8 @@
 // sparse domain against dense references.
 #include "support/WarpFixtures.h"
 
+#include <volmorph/Scene.h>
+
 using namespace volmorph;
 using namespace volmorph::test;
 

@@ -51,8 +51,8 @@ TEST(Frames, PickingFramesNeverChangesTheirTime)
 TEST(Frames, BadSpecsAreUserErrors)
 {
     const FramesSpec f = range(1, 24);
-    EXPECT_EQ(errorOf(f, "30"), "--frames: frame 30 is outside the scene's range 1-24");
-    EXPECT_EQ(errorOf(f, "0-3"), "--frames: frame 0 is outside the scene's range 1-24");
+    EXPECT_EQ(errorOf(f, "30"), "frames: frame 30 is outside the scene's range 1-24");
+    EXPECT_EQ(errorOf(f, "0-3"), "frames: frame 0 is outside the scene's range 1-24");
     EXPECT_NE(errorOf(f, "a-b").find("cannot read the frame spec \"a-b\""), std::string::npos);
     EXPECT_NE(errorOf(f, "1-2,x").find("cannot read the frame spec"), std::string::npos);
 }

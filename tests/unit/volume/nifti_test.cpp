@@ -51,11 +51,11 @@ std::filesystem::path writePhantom()
 }
 
 /// The phantom in world units of metres (scale 0.001): voxels of 2 mm = 0.002.
-ObjectSpec phantom(std::optional<std::pair<double, double>> window)
+VolumeSource phantom(std::optional<std::pair<double, double>> window)
 {
     static const std::filesystem::path file = writePhantom();
-    ObjectSpec spec;
-    spec.volume = file;
+    VolumeSource spec;
+    spec.file = file;
     spec.window = window;
     spec.transform.scale = Vec3d(0.001);
     return spec;
@@ -88,7 +88,7 @@ TEST(Nifti, APhantomWindowedToItsSphereIsTheSphere)
 
 TEST(Nifti, APhantomMorphsIntoAMesh)
 {
-    const std::string text = "[source]\nvolume = \"" + phantom(std::nullopt).volume.string() +
+    const std::string text = "[source]\nvolume = \"" + phantom(std::nullopt).file.string() +
                              "\"\nwindow = [600, 1000]\ntransform = { scale = 0.001 }\n"
                              "[target]\nmesh = \"" +
                              (kMeshes / "cube.obj").string() +

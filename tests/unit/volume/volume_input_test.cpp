@@ -19,14 +19,14 @@ namespace {
 
 namespace fs = std::filesystem;
 
-ObjectSpec volumeSpec(const fs::path& file)
+VolumeSource volumeSpec(const fs::path& file)
 {
-    ObjectSpec spec;
-    spec.volume = file;
+    VolumeSource spec;
+    spec.file = file;
     return spec;
 }
 
-VolumeSet resampled(const ObjectSpec& spec, double voxel, bool needSdf = false)
+VolumeSet resampled(const VolumeSource& spec, double voxel, bool needSdf = false)
 {
     VolumeInputOptions o;
     o.voxelSize = voxel;
@@ -53,7 +53,7 @@ TEST(VolumeInput, PicksTheDefaultNamesAndCarriesTheOtherGrids)
 
 TEST(VolumeInput, OnItsOwnVoxelSizeTheGridsAreKeptExactly)
 {
-    const ObjectSpec spec = volumeSpec(clouds().plain);
+    const VolumeSource spec = volumeSpec(clouds().plain);
     const VolumeSet v = resampled(spec, 0.04);
     const auto original =
         openvdb::gridPtrCast<openvdb::FloatGrid>((*readVdbGrids(clouds().plain))[0]);
@@ -147,7 +147,7 @@ TEST(VolumeInput, AFogAloneGetsALevelSetAtHalfDensityInSdfMode)
 
 TEST(VolumeInput, TheObjectTransformPlacesTheVolume)
 {
-    ObjectSpec spec = volumeSpec(clouds().plain);
+    VolumeSource spec = volumeSpec(clouds().plain);
     const Moments before = moments(*resampled(spec, 0.04).density);
     spec.transform.scale = Vec3d(2.0);
     spec.transform.translate = Vec3d(1.0, 0.0, -0.5);

@@ -117,7 +117,8 @@ PartitionOfUnity PartitionOfUnity::solve(const std::vector<Constraint>& constrai
     // The dense solves take about a second at 2000 and Eigen's LU takes no interrupter: they run
     // abandonable, so that a stop request is answered at once.
     const auto dense = [interrupter](std::vector<Constraint> c) {
-        return abandonable([c = std::move(c)] { return Interpolant::solveDense(c); }, interrupter);
+        return abandonable([c = std::move(c)](Interrupter&) { return Interpolant::solveDense(c); },
+                           interrupter);
     };
     if (constraints.size() <= options.coarse + options.leading) {
         pu.mCoarse = dense(constraints); // exact: no local level

@@ -6,9 +6,11 @@
 
 #include <algorithm>
 #include <atomic>
+#include <cassert>
 #include <limits>
 #include <array>
 #include <cmath>
+#include <optional>
 
 namespace volmorph::detail::variational {
 
@@ -43,13 +45,14 @@ namespace {
 
 using openvdb::Coord;
 
-/// Exact values (and rates) on the lattice box.min + stride * (a, b, c), covering the box; NaN
-/// where not evaluated.
+/// Exact values (and rates) on the lattice box.min + stride * (a, b, c), covering the box, at the
+/// nodes `evaluated` marks.
 struct Lattice {
     Coord origin;
     int stride = 1;
     Coord nodes; ///< per axis
     std::vector<float> values, rates;
+    std::vector<char> evaluated; ///< per node
 
     size_t node(int a, int b, int c) const { return (size_t(a) * nodes.y() + b) * nodes.z() + c; }
     float at(int a, int b, int c) const { return values[node(a, b, c)]; }
@@ -81,6 +84,21 @@ struct Lattice {
         return value;
     }
 
+    /// Whether every node tricubic() reads with these weights around cell (a, b, c) is evaluated.
+    bool stencilEvaluated(int a, int b, int c, const std::array<std::array<double, 4>, 3>& w) const
+    {
+        const auto clampTo = [](int i, int n) { return std::clamp(i, 0, n - 1); };
+        for (int i = 0; i < 4; ++i)
+            for (int j = 0; j < 4; ++j)
+                for (int k = 0; k < 4; ++k)
+                    if (w[0][i] != 0.0 && w[1][j] != 0.0 && w[2][k] != 0.0 &&
+                        !evaluated[node(clampTo(a + i - 1, nodes.x()),
+                                        clampTo(b + j - 1, nodes.y()),
+                                        clampTo(c + k - 1, nodes.z()))])
+                        return false;
+        return true;
+    }
+
     /// The cell holding voxel `v` (index space relative to the origin, inside the lattice) and
     /// the voxel's Catmull-Rom weights in it.
     std::pair<Coord, std::array<std::array<double, 4>, 3>> cellOf(const Coord& v) const;
@@ -106,7 +124,7 @@ std::pair<Coord, std::array<std::array<double, 4>, 3>> Lattice::cellOf(const Coo
 /// f at a lattice node: its voxel (index space, relative to the lattice's origin) and its point.
 using NodeFunction = std::function<double(const Coord& voxel, const Point4& p, double* rate)>;
 
-/// A lattice over `box` at `stride`, no node evaluated yet (NaN).
+/// A lattice over `box` at `stride`, no node evaluated yet.
 Lattice emptyLattice(const openvdb::CoordBBox& box, int stride, bool withRates)
 {
     Lattice l;
@@ -115,7 +133,8 @@ Lattice emptyLattice(const openvdb::CoordBBox& box, int stride, bool withRates)
     const Coord dim = box.dim();
     for (int a = 0; a < 3; ++a) l.nodes[a] = (dim[a] - 1 + stride - 1) / stride + 1;
     const size_t count = size_t(l.nodes.x()) * l.nodes.y() * l.nodes.z();
-    l.values.assign(count, std::numeric_limits<float>::quiet_NaN());
+    l.values.assign(count, 0.0f);
+    l.evaluated.assign(count, 0);
     if (withRates) l.rates.assign(count, 0.0f);
     return l;
 }
@@ -138,13 +157,14 @@ void evaluateNodes(Lattice& l, const NodeFunction& f, double w,
         for (int b = 0; b < l.nodes.y(); ++b)
             for (int c = 0; c < l.nodes.z(); ++c) {
                 const size_t n = l.node(a, b, c);
-                if (!needed[n] || !std::isnan(l.values[n])) continue;
+                if (!needed[n] || l.evaluated[n]) continue;
                 const Coord v(a * l.stride, b * l.stride, c * l.stride);
                 const openvdb::Vec3d p = transform.indexToWorld(l.origin + v);
                 double rate = 0.0;
                 l.values[n] =
                     float(-f(v, Point4(p.x(), p.y(), p.z(), w), withRates ? &rate : nullptr));
                 if (withRates) l.rates[n] = float(-rate);
+                l.evaluated[n] = 1;
                 ++here;
             }
         taken += here;
@@ -160,9 +180,8 @@ void evaluateNodes(Lattice& l, const NodeFunction& f, double w,
 /// allowance is for its curvature: across a cell of side s, f leaves its multilinear interpolant
 /// by about s^2 / 8 times its second derivative, which for a distance is one over the radius of
 /// curvature, and the grid resolves no radius under a voxel: s^2 / 8 voxels, and never over a
-/// stride (the stride alone, at every level, kept 16% more values on dino-to-eight-variational at
-/// 256 across and no voxel more within 4 voxels of the zero set; no allowance lost 69,628 of them
-/// at t = 0.25, BENCHMARKS.md).
+/// stride (BENCHMARKS.md, the variational method: what other allowances kept and lost). The
+/// corners are evaluated (the level evaluates the corners of every cell it tests).
 bool nearZero(const Lattice& l, int a, int b, int c, double band, double leastSlope)
 {
     float lo = 1e30f, hi = -1e30f, smallest = 1e30f, steepest = 0.0f;
@@ -273,16 +292,19 @@ double splitValue(const SplitFunction& f, const std::vector<Lattice>& lattices, 
     double value = f.detail(p, rate);
     for (size_t k = 0; k < f.smooth.size(); ++k) {
         const Lattice& l = lattices[k];
-        double part = std::numeric_limits<double>::quiet_NaN(), partRate = 0.0;
+        std::optional<double> part;
+        double partRate = 0.0;
         if (!l.values.empty()) {
             const auto [cell, weights] = l.cellOf(v);
-            part = -l.tricubic(l.values, cell.x(), cell.y(), cell.z(), weights);
-            if (rate && !l.rates.empty())
-                partRate = -l.tricubic(l.rates, cell.x(), cell.y(), cell.z(), weights);
+            if (l.stencilEvaluated(cell.x(), cell.y(), cell.z(), weights)) {
+                part = -l.tricubic(l.values, cell.x(), cell.y(), cell.z(), weights);
+                if (rate && !l.rates.empty())
+                    partRate = -l.tricubic(l.rates, cell.x(), cell.y(), cell.z(), weights);
+            }
         }
         // Not read from a lattice (yet), or (never) off its stencils: exact.
-        if (std::isnan(part)) part = f.smooth[k].f(p, rate ? &partRate : nullptr);
-        value += part;
+        if (!part) part = f.smooth[k].f(p, rate ? &partRate : nullptr);
+        value += *part;
         if (rate) *rate += partRate;
     }
     return value;
@@ -399,6 +421,8 @@ NearZeroSlice sliceNearZero(const SplitFunction& f, double w,
             const std::array<std::array<double, 4>, 3> weights{
                 weightsAt[size_t(v.x() - a * stride)], weightsAt[size_t(v.y() - b * stride)],
                 weightsAt[size_t(v.z() - c * stride)]};
+            // A written cell's stencil is evaluated (screen() evaluates nodesOf(kept, 2)).
+            assert(l.stencilEvaluated(a, b, c, weights));
             value->setValueOn(i, float(l.tricubic(l.values, a, b, c, weights)));
             if (rate) rate->setValueOn(i, float(l.tricubic(l.rates, a, b, c, weights)));
         }

@@ -1,13 +1,12 @@
-// The editor's JSON API (tools/editor/EditorSession.h), with the token from the page's URL, and the
+// The editor's JSON API (tools/editor/EditorSession.h), with the session's cookie (EditorServer.h), and the
 // compact meshes it sends (EditorSession.h, encodeMesh).
 import * as THREE from 'three';
-
-const token = new URLSearchParams(window.location.search).get('token') || '';
 
 async function call(method, route, body) {
   const response = await fetch(route, {
     method,
-    headers: { 'X-Volmorph-Token': token, 'Content-Type': 'application/json' },
+    headers: { 'Content-Type': 'application/json' },
+    credentials: 'same-origin', // the session's cookie, set when the printed URL was opened
     body: body === undefined ? undefined : JSON.stringify(body),
   });
   if (!response.ok) {

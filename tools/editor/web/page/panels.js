@@ -69,7 +69,13 @@ function row(name, children) {
 export function showErrors(state) {
   const list = $('errors');
   list.replaceChildren();
-  if (!state.errors.length) { list.innerHTML = '<li style="color:#7c7">none</li>'; return; }
+  if (!state.errors.length) {
+    const none = document.createElement('li');
+    none.className = 'none';
+    none.textContent = 'none';
+    list.appendChild(none);
+    return;
+  }
   for (const e of state.errors) {
     const item = document.createElement('li');
     item.textContent = `${e.where}: ${e.message}`;

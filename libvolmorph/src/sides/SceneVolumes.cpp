@@ -23,11 +23,29 @@ SideExtent extentOf(const Mesh& mesh)
 
 } // namespace
 
+SceneMeshes importSceneMeshes(const Scene& scene)
+{
+    SceneMeshes out;
+    std::vector<Diagnostic> problems;
+    const std::pair<const ObjectSpec*, Mesh*> sides[2] = {{&scene.source, &out.source},
+                                                          {&scene.target, &out.target}};
+    for (const auto& [spec, mesh] : sides) {
+        if (spec->isVolume()) continue;
+        try {
+            *mesh = importMesh(spec->mesh, spec->transform, spec->fileWhere);
+        } catch (const UserError& e) {
+            problems.insert(problems.end(), e.diagnostics().begin(), e.diagnostics().end());
+        }
+    }
+    if (!problems.empty()) throw UserError(problems);
+    return out;
+}
+
 std::pair<SideExtent, SideExtent> sceneExtents(const Scene& sequenced, const SceneMeshes& meshes)
 {
     const Scene scene = sceneAtFrame(sequenced, sequenced.frames.first);
     auto extent = [](const ObjectSpec& spec, const Mesh& mesh) {
-        return spec.isVolume() ? extentOf(inspectVolume(spec)) : extentOf(mesh);
+        return spec.isVolume() ? extentOf(inspectVolume(spec.volumeSource())) : extentOf(mesh);
     };
     return {extent(scene.source, meshes.source), extent(scene.target, meshes.target)};
 }
@@ -83,7 +101,7 @@ SceneVolumes voxelizeScene(const Scene& sequenced, Interrupter* interrupter,
     const Mesh* meshes[2] = {&out.meshes.source, &out.meshes.target};
     SideExtent extents[2];
     for (int i = 0; i < 2; ++i) {
-        if (specs[i]->isVolume()) inputs[i].emplace(*specs[i]);
+        if (specs[i]->isVolume()) inputs[i].emplace(specs[i]->volumeSource());
         extents[i] = inputs[i] ? extentOf(inputs[i]->info()) : extentOf(*meshes[i]);
     }
     const double voxelSize = sceneVoxelSize(scene.volume, extents[0], extents[1]);
@@ -100,11 +118,11 @@ std::vector<TimedVolume> voxelizeInfluences(const Scene& scene, double voxelSize
 {
     std::vector<TimedVolume> out;
     if (scene.blend.mode != BlendMode::Variational) return out;
-    for (const InfluenceSpec& influence : scene.blend.variational.influence) {
+    for (const InfluenceSpec& influence : scene.influences) {
         std::optional<VolumeInput> input;
         Mesh mesh;
         if (influence.object.isVolume())
-            input.emplace(influence.object);
+            input.emplace(influence.object.volumeSource());
         else
             mesh = importMesh(influence.object.mesh, influence.object.transform,
                               influence.object.fileWhere);
