@@ -15,11 +15,15 @@ command -v vdb_tool >/dev/null || { echo "vdb_tool missing (Debian's libopenvdb-
 work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
 # OFF -> OBJ (vdb_tool reads no OFF).
-awk 'NR == 1 { next } NR == 2 { nv = $1; nf = $2; next }
+awk 'NF == 0 || /^#/ { next } !h { h = 1; next } !c { c = 1; nv = $1; nf = $2; next }
      nv > 0 { print "v", $1, $2, $3; nv--; next }
      nf > 0 { printf "f"; for (i = 2; i <= $1 + 1; i++) printf " %d", $i + 1; print ""; nf-- }' \
     "$root/scenes/meshes/elephant.off" >"$work/elephant.obj"
-seconds() { /usr/bin/time -f %e "$@" 2>&1 >/dev/null | tail -n 1; }
+# seconds COMMAND...: its wall time; the bench stops if it fails.
+seconds() {
+    /usr/bin/time -f %e -o "$work/time" "$@" >/dev/null 2>"$work/err" || { echo "failed: $*" >&2; cat "$work/err" >&2; exit 1; }
+    cat "$work/time"
+}
 median() { sort -n | awk '{ a[NR] = $1 } END { print (NR % 2 ? a[(NR + 1) / 2] : (a[NR / 2] + a[NR / 2 + 1]) / 2) }'; }
 for n in 128 256; do
     : >"$work/v" ; : >"$work/t" ; : >"$work/b"
