@@ -19,8 +19,11 @@ default_scene "$out/scene.toml"
 load=""
 trap 'for p in $load; do kill "$p" 2>/dev/null; done; rm -rf "$out"' EXIT
 
-# ends PID SIGNAL: waits until PID has ended (a hang fails), prints its status.
+# ends PID SIGNAL: waits until PID has ended (a hang fails); sets status, and worst to the longest
+# wait so far (seconds, reported, never asserted).
+worst=0
 ends() {
+    t0=$(date +%s.%N)
     i=0
     while kill -0 "$1" 2>/dev/null && [ "$(awk '/^State:/ { print $2 }' "/proc/$1/status" 2>/dev/null)" != Z ]; do
         i=$((i + 1))
@@ -31,6 +34,7 @@ ends() {
     wait "$1"
     status=$?
     set -e
+    worst=$(awk -v a="$t0" -v b="$(date +%s.%N)" -v w="$worst" 'BEGIN { d = b - a; printf "%.3f", (d > w ? d : w) }')
 }
 
 # 1. Start-up, under load. How long it takes unloaded sets the delays.
@@ -63,7 +67,7 @@ while [ $round -lt "$rounds" ]; do
 done
 for p in $load; do kill "$p"; done
 load=""
-echo "start-up ($startup s unloaded): $rounds signals under load, every one ended it ($served after it served)"
+echo "start-up ($startup s unloaded): $rounds signals under load, every one ended it ($served after it served), the longest in $worst s"
 
 # 2. A slow frame. Exact warp, sdf mode, 320 voxels across: the first in-between sets up the
 #    extended distances and morphs for seconds.
