@@ -33,7 +33,16 @@ int runVolmorph(int argc, char** argv, AddCommands addImageCommands)
 
     try {
         for (const Command& c : commands)
-            if (c.app->parsed()) return c.run();
+            if (c.app->parsed()) {
+                const int status = c.run();
+                // A command that caught a stop request itself (the editor answers 503 and ends
+                // normally) may leave abandoned work running: exit without destroying what it uses.
+                if (volmorph::abandonedWorkRunning() > 0) {
+                    std::fflush(nullptr);
+                    std::_Exit(status);
+                }
+                return status;
+            }
     } catch (const volmorph::Interrupted&) {
         std::fprintf(stderr, "volmorph: interrupted; no output written for the current item\n");
         // Work left running on a stop request (an OpenVDB tool or a dense solve that takes no
