@@ -12,7 +12,9 @@
 
 namespace volmorph::cli {
 
-int runVolmorph(int argc, char** argv, AddCommands addImageCommands)
+namespace {
+
+int parseAndRun(int argc, char** argv, AddCommands addImageCommands)
 {
     CLI::App app{"volmorph: feature-based volumetric morphing of meshes through OpenVDB grids"};
     app.set_version_flag("--version", std::string("volmorph ") + volmorph::versionString());
@@ -33,24 +35,9 @@ int runVolmorph(int argc, char** argv, AddCommands addImageCommands)
 
     try {
         for (const Command& c : commands)
-            if (c.app->parsed()) {
-                const int status = c.run();
-                // A command that caught a stop request itself (the editor answers 503 and ends
-                // normally) may leave abandoned work running: exit without destroying what it uses.
-                if (volmorph::abandonedWorkRunning() > 0) {
-                    std::fflush(nullptr);
-                    std::_Exit(status);
-                }
-                return status;
-            }
+            if (c.app->parsed()) return c.run();
     } catch (const volmorph::Interrupted&) {
         std::fprintf(stderr, "volmorph: interrupted; no output written for the current item\n");
-        // Work left running on a stop request (an OpenVDB tool or a dense solve that takes no
-        // interrupter) still uses OpenVDB's and TBB's state: exit without destroying it.
-        if (volmorph::abandonedWorkRunning() > 0) {
-            std::fflush(nullptr);
-            std::_Exit(kExitInterrupted);
-        }
         return kExitInterrupted;
     } catch (const volmorph::MemoryLimitExceeded& e) {
         // The library says "raise the memory limit"; the way to do it here is the flag.
@@ -70,6 +57,22 @@ int runVolmorph(int argc, char** argv, AddCommands addImageCommands)
         return kExitInternal;
     }
     return 0;
+}
+
+} // namespace
+
+int runVolmorph(int argc, char** argv, AddCommands addImageCommands)
+{
+    const int status = parseAndRun(argc, argv, addImageCommands);
+    // Work abandoned on a stop request (an OpenVDB tool or a dense solve that takes no interrupter)
+    // may still be running, whether the command ended by Interrupted or caught the request itself
+    // (the editor answers 503 and ends normally): it uses OpenVDB's and TBB's state, so exit
+    // without destroying it.
+    if (volmorph::abandonedWorkRunning() > 0) {
+        std::fflush(nullptr);
+        std::_Exit(status);
+    }
+    return status;
 }
 
 } // namespace volmorph::cli

@@ -6,7 +6,6 @@
 
 #include <algorithm>
 #include <atomic>
-#include <cassert>
 #include <limits>
 #include <array>
 #include <cmath>
@@ -61,9 +60,10 @@ struct Lattice {
     /// Catmull-Rom in `field` between the nodes around cell (a, b, c), with weights `w` per axis
     /// (nodes beyond the lattice clamped to its edge): exact for cubics along each axis, its error
     /// the function's fourth derivatives times stride^4. Nodes of zero weight (all but one along
-    /// an axis where the point is on a node) are not read.
+    /// an axis where the point is on a node) are not read. With `complete`, a read of a node not
+    /// evaluated sets it false and ends the sum (its value then means nothing).
     double tricubic(const std::vector<float>& field, int a, int b, int c,
-                    const std::array<std::array<double, 4>, 3>& w) const
+                    const std::array<std::array<double, 4>, 3>& w, bool* complete = nullptr) const
     {
         const auto clampTo = [](int i, int n) { return std::clamp(i, 0, n - 1); };
         double value = 0.0;
@@ -76,27 +76,18 @@ struct Lattice {
                                      size_t(clampTo(b + j - 1, nodes.y()))) *
                                     nodes.z();
                 for (int k = 0; k < 4; ++k)
-                    if (w[2][k] != 0.0)
-                        row += w[2][k] * field[base + size_t(clampTo(c + k - 1, nodes.z()))];
+                    if (w[2][k] != 0.0) {
+                        const size_t n = base + size_t(clampTo(c + k - 1, nodes.z()));
+                        if (complete && !evaluated[n]) {
+                            *complete = false;
+                            return 0.0;
+                        }
+                        row += w[2][k] * field[n];
+                    }
                 value += w[0][i] * w[1][j] * row;
             }
         }
         return value;
-    }
-
-    /// Whether every node tricubic() reads with these weights around cell (a, b, c) is evaluated.
-    bool stencilEvaluated(int a, int b, int c, const std::array<std::array<double, 4>, 3>& w) const
-    {
-        const auto clampTo = [](int i, int n) { return std::clamp(i, 0, n - 1); };
-        for (int i = 0; i < 4; ++i)
-            for (int j = 0; j < 4; ++j)
-                for (int k = 0; k < 4; ++k)
-                    if (w[0][i] != 0.0 && w[1][j] != 0.0 && w[2][k] != 0.0 &&
-                        !evaluated[node(clampTo(a + i - 1, nodes.x()),
-                                        clampTo(b + j - 1, nodes.y()),
-                                        clampTo(c + k - 1, nodes.z()))])
-                        return false;
-        return true;
     }
 
     /// The cell holding voxel `v` (index space relative to the origin, inside the lattice) and
@@ -296,8 +287,11 @@ double splitValue(const SplitFunction& f, const std::vector<Lattice>& lattices, 
         double partRate = 0.0;
         if (!l.values.empty()) {
             const auto [cell, weights] = l.cellOf(v);
-            if (l.stencilEvaluated(cell.x(), cell.y(), cell.z(), weights)) {
-                part = -l.tricubic(l.values, cell.x(), cell.y(), cell.z(), weights);
+            bool complete = true;
+            const double read =
+                -l.tricubic(l.values, cell.x(), cell.y(), cell.z(), weights, &complete);
+            if (complete) {
+                part = read;
                 if (rate && !l.rates.empty())
                     partRate = -l.tricubic(l.rates, cell.x(), cell.y(), cell.z(), weights);
             }
@@ -422,7 +416,6 @@ NearZeroSlice sliceNearZero(const SplitFunction& f, double w,
                 weightsAt[size_t(v.x() - a * stride)], weightsAt[size_t(v.y() - b * stride)],
                 weightsAt[size_t(v.z() - c * stride)]};
             // A written cell's stencil is evaluated (screen() evaluates nodesOf(kept, 2)).
-            assert(l.stencilEvaluated(a, b, c, weights));
             value->setValueOn(i, float(l.tricubic(l.values, a, b, c, weights)));
             if (rate) rate->setValueOn(i, float(l.tricubic(l.rates, a, b, c, weights)));
         }
