@@ -1,9 +1,10 @@
 #!/bin/sh
 # How soon a stop request is answered (the promise: within 1 s of SIGINT or SIGTERM), measured on an
-# idle machine: tests/cli/render_interrupt.sh run RUNS times (default 5), each of its nine cases
-# (render-vdb mid-frame and in its shadow maps; render, morph and preview mid-morph; morph in its
-# setup; a variational solve and frame) recording its latency; then the median and the worst of each
-# case. The test itself asserts no time (a loaded machine answers later).
+# idle machine: tests/cli/render_interrupt.sh and tests/cli/edit_stop.sh run RUNS times (default 5),
+# each case recording its latency (render-vdb mid-frame and in its shadow maps; render, morph and
+# preview mid-morph; morph in its setup; a variational solve and frame; the editor during start-up,
+# beside the test's own two busy loops, and during a slow frame's morph); then the median and the
+# worst of each case. The tests themselves read no clock (a loaded machine answers later).
 # usage: tests/bench/stop_latency.sh BUILD_DIR [RUNS]
 set -eu
 build=$(cd "$1" && pwd)
@@ -15,6 +16,8 @@ i=0
 while [ "$i" -lt "$runs" ]; do
     STOP_LATENCY_LOG=$log sh "$root/tests/cli/render_interrupt.sh" "$build/bin/volmorph" "$root" 1 1 >/dev/null ||
         { echo "run $i failed"; exit 1; }
+    STOP_LATENCY_LOG=$log sh "$root/tests/cli/edit_stop.sh" "$build/bin/volmorph" "$root" 1 >/dev/null ||
+        { echo "run $i failed (editor)"; exit 1; }
     i=$((i + 1))
 done
 echo "stop latency over $runs runs (seconds: median, worst):"

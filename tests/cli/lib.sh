@@ -56,11 +56,19 @@ start_editor() {
     token=${url##*token=}
 }
 
-# stop_editor SLOWNESS [SIGNAL]: SIGINT (or SIGNAL) to the editor, which must exit 0; sets
-# stop_seconds to how long it took (tests assert no time: a run still going 30 s x SLOWNESS after
-# the signal has hung).
+# latency_start / latency_record WHAT: only when tests/bench/stop_latency.sh runs a test (it sets
+# STOP_LATENCY_LOG), the seconds from the start to now, appended to that log as "SECONDS WHAT".
+# Tests themselves read no clock: they assert behaviour, and a loaded machine answers later.
+latency_start() { [ -z "${STOP_LATENCY_LOG:-}" ] || latency_t0=$(date +%s.%N); }
+latency_record() {
+    [ -z "${STOP_LATENCY_LOG:-}" ] ||
+        awk -v a="$latency_t0" -v b="$(date +%s.%N)" -v w="$1" 'BEGIN { printf "%.3f %s\n", b - a, w }' >>"$STOP_LATENCY_LOG"
+}
+
+# stop_editor SLOWNESS [SIGNAL [WHAT]]: SIGINT (or SIGNAL) to the editor, which must exit 0 (a run
+# still going 30 s x SLOWNESS after the signal has hung); WHAT names its latency for the benchmark.
 stop_editor() {
-    t0=$(date +%s.%N)
+    latency_start
     kill -s "${2:-INT}" "$editor_pid"
     polls=$(($1 * 3000))
     i=0
@@ -70,7 +78,7 @@ stop_editor() {
         sleep 0.01
     done
     wait "$editor_pid" || { echo "volmorph edit exited $? on SIG${2:-INT}"; cat "$out/edit.err"; exit 1; }
-    stop_seconds=$(awk -v a="$t0" -v b="$(date +%s.%N)" 'BEGIN { printf "%.3f", b - a }')
+    [ -z "${3:-}" ] || latency_record "$3"
 }
 
 # default_scene DEST: the default scene with its paths made absolute.
