@@ -192,10 +192,12 @@ void printSettings(const Scene& scene)
     for (const auto& [name, grid] : b.grids)
         std::printf("        carried grid %s: %s\n", name.c_str(), describe(grid.schedule).c_str());
     const RenderSpec& r = scene.render;
-    std::printf(
-        "render  %dx%d, %d samples, step %s voxels, extinction %s per world unit, albedo %s\n",
-        r.width, r.height, r.samples, fmt(r.stepVoxels).c_str(), fmt(r.extinction).c_str(),
-        fmt(r.albedo).c_str());
+    const std::string samples = r.noise > 0.0 ? "noise target " + fmt(r.noise) + ", at most " +
+                                                    std::to_string(r.samples) + " samples"
+                                              : std::to_string(r.samples) + " samples";
+    std::printf("render  %dx%d, %s, step %s voxels, extinction %s per world unit, albedo %s\n",
+                r.width, r.height, samples.c_str(), fmt(r.stepVoxels).c_str(),
+                fmt(r.extinction).c_str(), fmt(r.albedo).c_str());
     if (r.bounces > 0)
         std::printf("        multiple scattering, %d bounces", r.bounces);
     else

@@ -166,9 +166,10 @@ Progress::~Progress()
 
 void checkFilmMemory(int width, int height, double limitGiB, bool layers)
 {
-    // Per channel (RGBA, and the layers' 15): the float film, the float copy interleaved to write
-    // it, and the encoder's buffer.
-    const double bytesPerPixel = (layers ? 19.0 : 4.0) * 12.0;
+    // Per channel (RGBA, and the layers' 15): the film's double sums, the float image, the float
+    // copy interleaved to write it, and the encoder's buffer; per pixel, the last pass's RGB
+    // (doubles), the counts and the variance.
+    const double bytesPerPixel = (layers ? 19.0 : 4.0) * 20.0 + 3.0 * 8.0 + 3.0 * 4.0 + 4.0;
     const double bytes = bytesPerPixel * double(width) * double(height);
     const double limit = double(memoryLimitBytes(limitGiB));
     if (bytes <= limit) return;

@@ -2,6 +2,7 @@
 // volmorph render SCENE [--frames SPEC] [-o PATTERN.exr]: the morph of each frame, rendered.
 #include "Common.h"
 #include "FrameLoop.h"
+#include "NoiseTarget.h"
 #include "SceneMorph.h"
 #include "SceneRender.h"
 
@@ -46,7 +47,8 @@ struct RenderVdbArgs {
            extinction = 40.0, albedo = 0.8, step = 1.0, lightAngle = 0.0;
     int shadowCache = 1;
     int samples = 1, threads = 0, bounces = 0;
-    double memoryLimitGiB = 0.0;
+    unsigned seed = 0;
+    double memoryLimitGiB = 0.0, noise = 0.0;
     std::vector<double> shutter; ///< open, close in frames: motion blur along the vel grid
     double fps = 24.0;
     bool floatExr = false, noLayers = false, verbose = false;
@@ -210,6 +212,8 @@ int runRenderVdb(const RenderVdbArgs& args)
     if (!args.emission.empty()) medium.emission = vec3(args.emission);
     render::RenderSettings settings;
     settings.samples = args.samples;
+    settings.noise = args.noise;
+    settings.seed = args.seed;
     settings.stepVoxels = args.step;
     settings.shadowCacheVoxels = args.shadowCache;
     settings.bounces = args.bounces;
@@ -223,6 +227,7 @@ int runRenderVdb(const RenderVdbArgs& args)
     render::ExrOptions exr;
     exr.halfFloat = !args.floatExr;
     exr.samples = args.samples;
+    exr.noiseTarget = args.noise;
     exr.renderSeconds = seconds;
     exr.metadata["volmorph:source"] = args.input;
     try {
@@ -232,8 +237,8 @@ int runRenderVdb(const RenderVdbArgs& args)
         throw UserError(SourceLocation{args.output},
                         std::string("cannot write image (") + e.what() + ")");
     }
-    std::printf("rendered %s (%dx%d, %d samples) in %.2f s -> %s\n",
-                grids.density->getName().c_str(), width, height, args.samples, seconds,
+    std::printf("rendered %s (%dx%d, %s) in %.2f s -> %s\n", grids.density->getName().c_str(),
+                width, height, samplesAndNoise(image, args.samples, args.noise).c_str(), seconds,
                 args.output.c_str());
     return 0;
 }
@@ -241,6 +246,7 @@ int runRenderVdb(const RenderVdbArgs& args)
 struct RenderSceneArgs {
     std::string scene, frames, output, png;
     int threads = 0;
+    double noise = -1.0; ///< --noise: the scene's render.noise overridden (negative: not given)
     bool skipExisting = false, quiet = false, verbose = false;
     double memoryLimitGiB = 0.0;
     CacheArgs cache;
@@ -267,6 +273,7 @@ std::string writeFrameImage(const render::Image& image, const SceneRender& rende
     render::ExrOptions exr;
     exr.frame = step.frame;
     exr.samples = scene.render.samples;
+    exr.noiseTarget = renderer.settings.noise;
     exr.renderSeconds = seconds;
     exr.metadata["volmorph:scene"] = std::filesystem::absolute(args.scene).string();
     exr.metadata["volmorph:t"] = fmt(step.t);
@@ -294,6 +301,7 @@ int runRenderScene(const RenderSceneArgs& args)
     checkFilmMemory(scene.render.width, scene.render.height, args.memoryLimitGiB,
                     scene.render.layers);
     SceneRender renderer(scene, args.threads);
+    if (args.noise >= 0.0) renderer.settings.noise = args.noise;
     MorphOptions morphOptions;
     morphOptions.memoryLimitBytes = memoryLimitBytes(args.memoryLimitGiB);
     if (scene.render.motionBlur()) { // the vel grid, over the shutter's reach
@@ -319,7 +327,9 @@ int runRenderScene(const RenderSceneArgs& args)
         const std::string error =
             writeFrameImage(image, renderer, file, args, scene, step, secondsSince(start));
         if (!error.empty()) return FrameResult{FrameResult::Outcome::Failed, error, ""};
-        return FrameResult{FrameResult::Outcome::Done, "", file.string()};
+        return FrameResult{FrameResult::Outcome::Done,
+                           samplesAndNoise(image, scene.render.samples, renderer.settings.noise),
+                           file.string()};
     });
     return failed ? kExitUserError : 0;
 }
@@ -395,7 +405,12 @@ Command addRenderVdbCommand(CLI::App& app)
                     "volume scattering events after the first (0: single scattering; more: "
                     "path tracing)")
         ->check(CLI::Range(0, 100000));
-    sub->add_option("--samples", a->samples, "samples per pixel")->check(CLI::Range(1, 65536));
+    sub->add_option("--samples", a->samples, "samples per pixel (the cap under a noise target)")
+        ->check(CLI::Range(1, 65536));
+    addNoiseOption(sub, a->noise);
+    sub->add_option("--seed", a->seed,
+                    "the samples' seed (another seed: another, independent, image of the same "
+                    "noise)");
     sub->add_option("--shutter", a->shutter,
                     "motion blur along the vel grid: the shutter's OPEN,CLOSE in frames around "
                     "the frame (e.g. -0.25,0.25); one shutter time per sample, up to 64")
@@ -436,6 +451,7 @@ Command addRenderCommand(CLI::App& app)
     sub->add_option("-o,--output", a->output,
                     "output pattern, e.g. out/f.####.exr (default: the scene's)");
     sub->add_option("--threads", a->threads, "threads (0 = all cores)")->check(CLI::Range(0, 1024));
+    addNoiseOption(sub, a->noise);
     sub->add_flag("--skip-existing", a->skipExisting,
                   "skip frames whose file exists and reads back whole");
     sub->add_option("--memory-limit", a->memoryLimitGiB,

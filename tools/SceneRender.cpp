@@ -64,6 +64,7 @@ SceneRender::SceneRender(const Scene& scene, int threads, int width)
     medium.anisotropy = r.anisotropy;
     medium.emission = r.emission;
     settings.samples = r.samples;
+    settings.noise = r.noise;
     settings.stepVoxels = r.stepVoxels;
     settings.shadowCacheVoxels = r.shadowCacheVoxels;
     settings.bounces = r.bounces;

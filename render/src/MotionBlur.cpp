@@ -8,6 +8,7 @@
 #include <openvdb/tools/VolumeAdvect.h>
 
 #include <algorithm>
+#include <cmath>
 #include <optional>
 
 namespace volmorph::render {
@@ -87,6 +88,8 @@ Image renderMotionBlurred(const openvdb::FloatGrid& density, const openvdb::Vec3
     Motion motion(density, velocity, settings.interrupter);
     RenderSettings each = settings;
     each.samples = std::max(1, settings.samples / int(times.size()));
+    // The mean of K independent images of noise e each has noise e / sqrt(K).
+    each.noise = settings.noise * std::sqrt(double(times.size()));
     Image sum;
     for (size_t k = 0; k < times.size(); ++k) {
         const ShutterTime& time = times[k];
@@ -101,6 +104,8 @@ Image renderMotionBlurred(const openvdb::FloatGrid& density, const openvdb::Vec3
             sum = image;
         } else {
             for (size_t i = 0; i < sum.pixels.size(); ++i) sum.pixels[i] += image.pixels[i];
+            for (size_t i = 0; i < sum.variance.size(); ++i) sum.variance[i] += image.variance[i];
+            sum.meanSamples += image.meanSamples;
             for (size_t i = 0; i < sum.layers.size(); ++i)
                 sum.layers[i] = i % layer::kFloats == layer::kDepth
                                     ? std::min(sum.layers[i], image.layers[i])
@@ -108,6 +113,9 @@ Image renderMotionBlurred(const openvdb::FloatGrid& density, const openvdb::Vec3
         }
     }
     for (float& v : sum.pixels) v /= float(times.size());
+    const float k2 = float(times.size()) * float(times.size());
+    for (float& v : sum.variance) v /= k2; // var of the mean of K independent images
+    sum.noise = estimateNoise(sum);
     for (size_t i = 0; i < sum.layers.size(); ++i)
         if (i % layer::kFloats != layer::kDepth) sum.layers[i] /= float(times.size());
     return sum;

@@ -8,6 +8,7 @@
 #include <OpenImageIO/imageio.h>
 
 #include <algorithm>
+#include <cmath>
 #include <stdexcept>
 
 namespace volmorph::render {
@@ -94,6 +95,11 @@ void writeExr(const Image& image, const Camera& camera, const std::filesystem::p
     spec.attribute("volmorph:frame", options.frame);
     spec.attribute("volmorph:samples", options.samples);
     spec.attribute("volmorph:renderSeconds", float(options.renderSeconds));
+    // The noise estimate and the mean samples a pixel took (adaptive sampling: fewer than the cap).
+    if (std::isfinite(image.noise)) spec.attribute("volmorph:noise", float(image.noise));
+    if (options.noiseTarget > 0.0)
+        spec.attribute("volmorph:noiseTarget", float(options.noiseTarget));
+    if (image.meanSamples > 0.0) spec.attribute("volmorph:meanSamples", float(image.meanSamples));
     // Linear Rec.709 primaries and D65 white: R, G, B, white as (x, y).
     const float chromaticities[8] = {0.64f, 0.33f, 0.30f, 0.60f, 0.15f, 0.06f, 0.3127f, 0.3290f};
     spec.attribute("chromaticities", OIIO::TypeDesc(OIIO::TypeDesc::FLOAT, 8), chromaticities);

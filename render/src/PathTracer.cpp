@@ -136,15 +136,16 @@ public:
         Vec3d received = directIrradiance(mR, x, n, unoccluded, &mRandom);
         const Sky& sky = mIn.sky;
         if (sky.constant != Vec3d(0.0)) {
-            const double u1 = mRandom.next(), u2 = mRandom.next();
+            double u1, u2;
+            mRandom.nextLD2(u1, u2);
             const Vec3d w = cosineDirection(n, u1, u2);
             const Vec3d E = sky.constant * M_PI; // a uniform sky's irradiance
             unoccluded += E;
             received += E * exactVisibility(mR, x, w, kNoProp);
         }
         if (sky.map) {
-            const double u1 = mRandom.next(), u2 = mRandom.next();
-            double pdf;
+            double u1, u2, pdf;
+            mRandom.nextLD2(u1, u2);
             const Vec3d w = sky.map->sample(u1, u2, pdf);
             const double cosine = n.dot(w);
             if (pdf > 0.0 && cosine > 0.0) {
@@ -193,8 +194,9 @@ private:
     bool next(Vertex& v)
     {
         if (!v.surface) {
-            const Vec3d dir = sampleHenyeyGreenstein(v.dir, mIn.medium.anisotropy, mRandom.next(),
-                                                     mRandom.next());
+            double u1, u2;
+            mRandom.nextLD2(u1, u2);
+            const Vec3d dir = sampleHenyeyGreenstein(v.dir, mIn.medium.anisotropy, u1, u2);
             mPdf = henyeyGreenstein(v.dir.dot(dir), mIn.medium.anisotropy);
             if (!mIn.props) { // the medium alone, in index space
                 if (track(v.ip, dir, kNoProp)) {
@@ -206,7 +208,8 @@ private:
             }
             return go(mIn.density.indexToWorld(v.ip), worldDirection(v.ip, dir), v);
         }
-        const double u1 = mRandom.next(), u2 = mRandom.next();
+        double u1, u2;
+        mRandom.nextLD2(u1, u2);
         const Vec3d w = cosineDirection(v.n, u1, u2);
         mPdf = v.n.dot(w) / M_PI;
         return go(v.x, w, v);
@@ -235,8 +238,8 @@ private:
     Vec3d skyLight(const Vertex& v)
     {
         const Sky& sky = mIn.sky;
-        const double u1 = mRandom.next(), u2 = mRandom.next();
-        double pdf;
+        double u1, u2, pdf;
+        mRandom.nextLD2(u1, u2);
         const Vec3d w = sky.map->sample(u1, u2, pdf);
         if (pdf <= 0.0) return Vec3d(0.0);
         double f = 0.0, T = 0.0;
@@ -403,7 +406,7 @@ RaySample tracePath(ThreadReaders& readers, const Ray& ray, Random& random)
         out.T = std::exp(-tau);
         if (tau > 0.0) {
             // The first collision, given one: optical depth -ln(1 - u (1 - T)), weight 1 - T.
-            const double target = -std::log1p(-random.next() * (1.0 - out.T));
+            const double target = -std::log1p(-random.nextLD() * (1.0 - out.T));
             const double t = invertPrimary(readers, line, std::min(target, tau));
             // The weight applies outside the path, so that roulette sees the path's own
             // attenuation.

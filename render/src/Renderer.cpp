@@ -4,6 +4,7 @@
 
 #include <volmorph/core/Interrupter.h>
 
+#include "Film.h"
 #include "GridReaders.h"
 #include "Majorants.h"
 #include "PathTracer.h"
@@ -54,59 +55,109 @@ void accumulate(const RaySample& sample, double viewCosine, double* rgba, double
         layers[layer::kDepth] = std::min(layers[layer::kDepth], sample.depth * viewCosine);
 }
 
-/// The pixel (x, y)'s samples averaged into px (RGBA: RGB premultiplied, A = 1 - transmittance)
-/// and, when given, `layers` (layer::kFloats).
+/// Pixel (x, y)'s samples from film.count to film.target, added to its sums in their order. Sample
+/// s is sample s of the pixel's Sobol sequence: its first two dimensions place it in the pixel (a
+/// lone sample goes through the centre, as vdb_render's, unless the settings say otherwise).
 void renderPixel(ThreadReaders& readers, const Camera& camera, const RenderSettings& settings,
-                 int x, int y, float* px, float* layers)
+                 int x, int y, Film& film)
 {
-    const int samples = std::max(1, settings.samples);
-    const int strata = int(std::ceil(std::sqrt(double(samples))));
-    double rgba[4] = {0, 0, 0, 0}, sums[layer::kFloats] = {};
-    sums[layer::kDepth] = layer::kNoDepth;
-    for (int s = 0; s < samples; ++s) {
+    const size_t p = size_t(y) * size_t(film.width()) + size_t(x);
+    const uint32_t from = film.count(p), to = film.target(p);
+    const bool centre = settings.samples <= 1 && settings.centreSingleSample;
+    double* rgba = film.rgba(p);
+    double* layers = film.layers(p);
+    double pass[3] = {0.0, 0.0, 0.0};
+    for (uint32_t s = from; s < to; ++s) {
         Random random(uint64_t(y) * 65536u + uint64_t(x), uint64_t(s),
                       (uint64_t(settings.frame) << 32) ^ settings.seed);
-        // One sample goes through the pixel centre (no antialiasing, as vdb_render); more are
-        // stratified and jittered over the pixel.
-        const double jx = random.next(), jy = random.next();
-        const bool centre = samples == 1 && settings.centreSingleSample;
-        const double sx = centre ? 0.5 : ((s % strata) + jx) / strata;
-        const double sy = centre ? 0.5 : ((s / strata) % strata + jy) / strata;
+        double sx = 0.5, sy = 0.5;
+        random.nextLD2(sx, sy);
+        if (centre) sx = sy = 0.5;
         const Ray ray = camera.ray(x + sx, y + sy);
         const RaySample sample = readers.in.majorants ? tracePath(readers, ray, random)
                                                       : integrateRay(readers, ray, &random);
-        accumulate(sample, ray.direction.dot(camera.forward()), rgba, layers ? sums : nullptr);
+        accumulate(sample, ray.direction.dot(camera.forward()), rgba, layers);
+        const Vec3d L = sample.L.sum();
+        for (int c = 0; c < 3; ++c) pass[c] += L[c];
     }
-    for (int c = 0; c < 4; ++c) px[c] = float(rgba[c] / samples);
-    if (!layers) return;
-    for (int c = 0; c < layer::kFloats; ++c)
-        layers[c] = float(c == layer::kDepth ? sums[c] : sums[c] / samples);
+    film.finishPass(p, to - from, pass);
 }
 
-/// Every pixel of `image`, tiles in parallel. Pixels are independent and each one's samples are
-/// seeded by its position, so the result does not depend on how the tiles are scheduled. Stops
-/// starting pixels once the interrupter asks (the image is then incomplete).
-void renderTiles(const FrameInputs& frame, const Camera& camera, const RenderSettings& settings,
-                 Image& image)
+/// One pass: every pixel whose target is above its count, tiles in parallel. Pixels are
+/// independent and each one's samples are seeded by its position, so the result does not depend
+/// on how the tiles are scheduled. Throws Interrupted once the interrupter asks (between pixels).
+void renderPass(const FrameInputs& frame, const Camera& camera, const RenderSettings& settings,
+                Film& film)
 {
-    tbb::parallel_for(tbb::blocked_range2d<int>(0, image.height, 16, 0, image.width, 16),
+    tbb::parallel_for(tbb::blocked_range2d<int>(0, film.height(), 16, 0, film.width(), 16),
                       [&](const tbb::blocked_range2d<int>& tile) {
                           ThreadReaders readers(frame);
                           for (int y = tile.rows().begin(); y != tile.rows().end(); ++y)
                               for (int x = tile.cols().begin(); x != tile.cols().end(); ++x) {
                                   if (interrupted(settings.interrupter)) return;
-                                  renderPixel(readers, camera, settings, x, y, image.at(x, y),
-                                              image.layers.empty() ? nullptr
-                                                                   : image.layersAt(x, y));
+                                  const size_t p = size_t(y) * size_t(film.width()) + size_t(x);
+                                  if (film.target(p) > film.count(p))
+                                      renderPixel(readers, camera, settings, x, y, film);
                               }
                       });
+    if (interrupted(settings.interrupter)) throw Interrupted();
+}
+
+/// Every pixel's target set to `samples`.
+void targetAll(Film& film, uint32_t samples)
+{
+    for (size_t p = 0; p < film.pixels(); ++p) film.target(p) = samples;
+}
+
+/// The pixels whose smoothed variance exceeds the frame's per-pixel share of the target's (all
+/// pixels' mean variance at the noise target), each set to twice its samples, up to `cap`; when
+/// none does while the frame is still above the target, a lower share. False when no pixel can
+/// take more samples.
+bool chooseNextPass(Film& film, double target, uint32_t cap)
+{
+    const std::vector<double> variance = smoothedVariance(film);
+    const double mean = film.coveredMean();
+    for (double share = (target * mean) * (target * mean); share > 0.0; share *= 0.25) {
+        bool any = false;
+        for (size_t p = 0; p < film.pixels(); ++p) {
+            const uint32_t n = film.count(p);
+            const bool more = n < cap && variance[p] > share;
+            film.target(p) = more ? std::min<uint32_t>(cap, 2 * n) : n;
+            any = any || more;
+        }
+        if (any) return true;
+        if (share < 1e-12 * mean * mean) break;
+    }
+    return false;
+}
+
+/// The image's passes: with no noise target, exactly `samples` samples per pixel in two halves
+/// (the second half's difference from the first is the noise estimate); with one, the first
+/// kFirstSamples in two halves, then passes that double the samples of the pixels still noisy
+/// (chooseNextPass) until the frame's estimated noise reaches the target or no pixel may take
+/// more.
+void renderPasses(const FrameInputs& frame, const Camera& camera, const RenderSettings& settings,
+                  Film& film)
+{
+    constexpr uint32_t kFirstSamples = 16;
+    const uint32_t cap = uint32_t(std::max(1, settings.samples));
+    const uint32_t first = settings.noise > 0.0 ? std::min(cap, kFirstSamples) : cap;
+    if (first >= 2) {
+        targetAll(film, first / 2);
+        renderPass(frame, camera, settings, film);
+    }
+    targetAll(film, first);
+    renderPass(frame, camera, settings, film);
+    if (!(settings.noise > 0.0)) return;
+    while (film.noise() > settings.noise && chooseNextPass(film, settings.noise, cap))
+        renderPass(frame, camera, settings, film);
 }
 
 /// Prepares what every ray reads (the empty-space mask, padded leaves, every light's shadow), then
 /// renders the tiles. Throws Interrupted when the interrupter asked to stop.
 void renderFrame(const openvdb::FloatGrid& density, const openvdb::Vec3SGrid* color,
                  const Camera& camera, const std::vector<Light>& lights, const Medium& medium,
-                 const RenderSettings& settings, Image& image)
+                 const RenderSettings& settings, Film& film)
 {
     const bool levelSet = medium.kind == Medium::Kind::LevelSet;
     const Props* props = settings.props && !settings.props->empty() ? settings.props : nullptr;
@@ -147,9 +198,8 @@ void renderFrame(const openvdb::FloatGrid& density, const openvdb::Vec3SGrid* co
                             sky,
                             props};
     stage(settings.interrupter, "render: pixels");
-    renderTiles(frame, camera, settings, image);
+    renderPasses(frame, camera, settings, film);
     stage(settings.interrupter, nullptr);
-    if (interrupted(settings.interrupter)) throw Interrupted();
 }
 
 } // namespace
@@ -158,18 +208,10 @@ Image renderVolume(const openvdb::FloatGrid& density, const openvdb::Vec3SGrid* 
                    const Camera& camera, const std::vector<Light>& lights, const Medium& medium,
                    const RenderSettings& settings)
 {
-    Image image;
-    image.width = camera.width();
-    image.height = camera.height();
-    image.pixels.assign(size_t(image.width) * size_t(image.height) * 4, 0.0f);
-    if (settings.layers) {
-        image.layers.assign(size_t(image.width) * size_t(image.height) * layer::kFloats, 0.0f);
-        for (size_t p = 0; p < image.layers.size(); p += layer::kFloats)
-            image.layers[p + layer::kDepth] = layer::kNoDepth;
-    }
     const bool props = settings.props && !settings.props->empty();
     const bool empty = density.tree().activeVoxelCount() == 0;
-    if (empty && !props) return image;
+    Film film(camera.width(), camera.height(), settings.layers);
+    if (empty && !props) return film.resolve();
     // Props with no volume: the same machinery over one active voxel of the background's value,
     // which adds exactly nothing (its ray-marching structures need an active voxel).
     openvdb::FloatGrid::Ptr nothing;
@@ -178,12 +220,12 @@ Image renderVolume(const openvdb::FloatGrid& density, const openvdb::Vec3SGrid* 
         nothing->tree().setValueOn(openvdb::Coord(0), density.background());
     }
     const openvdb::FloatGrid& volume = empty ? *nothing : density;
-    auto body = [&] { renderFrame(volume, color, camera, lights, medium, settings, image); };
+    auto body = [&] { renderFrame(volume, color, camera, lights, medium, settings, film); };
     if (settings.threads > 0)
         tbb::task_arena(settings.threads).execute(body);
     else
         body();
-    return image;
+    return film.resolve();
 }
 
 } // namespace volmorph::render

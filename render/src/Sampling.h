@@ -3,20 +3,34 @@
 
 #include <volmorph/render/Renderer.h>
 
+#include "Sobol.h"
+
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
 
 namespace volmorph::render {
 
-/// A counter-based generator: the same (pixel, sample, frame, seed) always gives the same numbers,
-/// whichever thread draws them, so frames are bit-identical for any thread count.
+/// A sample's random numbers, of two kinds. `next()`: a counter-based generator, for the choices
+/// a path makes a varying number of times (tracking, roulette). `nextLD()` / `nextLD2()`: the
+/// sample's next dimensions of an Owen-scrambled Sobol sequence (Sobol.h), one per pixel, for the
+/// choices every sample makes in the same order (the position in the pixel, the first collision,
+/// each vertex's light and direction), so that a pixel's samples stratify them together; after
+/// kLowDiscrepancyDims dimensions, the generator. The same (pixel, sample, frame, seed) always
+/// gives the same numbers, whichever thread draws them, so frames are bit-identical for any thread
+/// count.
 struct Random {
+    static constexpr uint32_t kLowDiscrepancyDims = 32;
     uint64_t state;
-    Random(uint64_t a, uint64_t b, uint64_t c)
+    uint64_t sequence; ///< the pixel's Sobol sequence (its scrambles' seed)
+    uint32_t index;    ///< the sample's index in it
+    uint32_t dim = 0;  ///< the next low-discrepancy dimension
+    Random(uint64_t pixel, uint64_t sample, uint64_t stream)
+        : sequence(mix(pixel * 0x9E3779B97F4A7C15ull ^ mix(stream + 0x85157AF5ull))),
+          index(uint32_t(sample))
     {
-        state = mix(a * 0x9E3779B97F4A7C15ull ^ mix(b + 0x632BE59BD9B4E019ull) ^
-                    mix(c + 0x85157AF5ull));
+        state = mix(pixel * 0x9E3779B97F4A7C15ull ^ mix(sample + 0x632BE59BD9B4E019ull) ^
+                    mix(stream + 0x85157AF5ull));
     }
     static uint64_t mix(uint64_t z)
     {
@@ -29,6 +43,19 @@ struct Random {
     {
         state += 0x9E3779B97F4A7C15ull;
         return double(mix(state) >> 11) * (1.0 / 9007199254740992.0);
+    }
+    /// The sample's next low-discrepancy dimension, in [0, 1).
+    double nextLD()
+    {
+        if (dim >= kLowDiscrepancyDims) return next();
+        return sobol::sample(index, dim++, sequence);
+    }
+    /// Two dimensions stratified together (a pair of one group of four).
+    void nextLD2(double& u1, double& u2)
+    {
+        dim += dim & 1u;
+        u1 = nextLD();
+        u2 = nextLD();
     }
 };
 
@@ -51,7 +78,8 @@ inline Vec3d sampleLight(const Light& light, const Vec3d& center, Random* random
 {
     if (light.type != Light::Type::Directional || light.angle <= 0.0 || !random) return center;
     const double cosMax = std::cos(0.5 * light.angle);
-    const double u1 = random->next(), u2 = random->next();
+    double u1, u2;
+    random->nextLD2(u1, u2);
     return directionAround(center, 1.0 - u1 * (1.0 - cosMax), 2.0 * M_PI * u2);
 }
 

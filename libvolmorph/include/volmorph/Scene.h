@@ -122,7 +122,10 @@ struct LightSpec {
 
 struct RenderSpec {
     int width = 960, height = 540; ///< pixels
-    int samples = 4;               ///< jittered samples per pixel
+    int samples = 4;               ///< per pixel: exactly, or the cap under a noise target
+    /// The noise target: the frame's estimated relative RMSE against its converged image, at which
+    /// the renderer stops (adaptive sampling up to `samples`); 0: exactly `samples` samples.
+    double noise = 0.0;
     double stepVoxels = 0.5;       ///< ray-march step
     double extinction = 40.0;      ///< per world unit at density 1
     double albedo = 0.8;           ///< single-scattering albedo, 0..1

@@ -11,8 +11,8 @@ namespace volmorph::detail {
 namespace {
 
 const std::vector<std::string> kRenderKeys = {
-    "resolution", "samples", "step",     "extinction", "albedo",       "anisotropy", "seed",
-    "camera",     "lights",  "emission", "bounces",    "shadow_cache", "shutter",    "layers"};
+    "resolution", "samples",  "step",    "extinction",   "albedo",  "anisotropy", "seed", "camera",
+    "lights",     "emission", "bounces", "shadow_cache", "shutter", "layers",     "noise"};
 const std::vector<std::string> kCameraKeys = {"projection", "eye",   "lookat", "up",
                                               "fov",        "width", "keys"};
 const std::vector<std::string> kCameraKeyKeys = {"frame", "eye", "lookat", "up", "fov", "width"};
@@ -260,6 +260,11 @@ void parseRender(Reader& r, const toml::node& node, const std::filesystem::path&
     }
     if (const toml::node* n = t->get("samples"))
         if (auto v = r.integerIn(*n, "render.samples", 1, 65536)) rs.samples = int(*v);
+    if (const toml::node* n = t->get("noise"))
+        if (auto v = r.numberIn(*n, "render.noise", 0.0, true, 1.0,
+                                "a noise target from 0 (exactly `samples` samples) to 1, the "
+                                "frame's relative RMSE"))
+            rs.noise = *v;
     if (const toml::node* n = t->get("step"))
         if (auto v = r.numberIn(*n, "render.step", 0.0, false, 8.0,
                                 "a ray-march step in voxels, 0 < step <= 8"))

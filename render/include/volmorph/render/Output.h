@@ -15,7 +15,8 @@ struct ExrOptions {
     bool halfFloat = true;                       ///< half colours (default) or float
     std::map<std::string, std::string> metadata; ///< extra string attributes
     int frame = 0;
-    int samples = 0;
+    int samples = 0;          ///< the settings' samples (the cap under a noise target)
+    double noiseTarget = 0.0; ///< written as volmorph:noiseTarget when above 0
     double renderSeconds = 0.0;
 };
 
@@ -23,7 +24,8 @@ struct ExrOptions {
 /// named as Nuke reads them: volume.R/G/B/A, direct.*, indirect.*, emission.* (R, G, B),
 /// shadow.A and depth.Z, colours in half (or float) and depth always float. ZIP compression,
 /// linear Rec.709 chromaticities, software and version, frame, worldToCamera and worldToNDC,
-/// samples and render time. The file appears at
+/// samples and render time, the estimated noise (volmorph:noise, the image's when estimated) and
+/// the mean samples per pixel (volmorph:meanSamples). The file appears at
 /// `path` only when complete (written under a temporary name, then renamed). Throws
 /// std::runtime_error with the reason when it cannot be written.
 void writeExr(const Image& image, const Camera& camera, const std::filesystem::path& path,

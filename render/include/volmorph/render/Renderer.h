@@ -29,9 +29,12 @@
 // spacing (smooth fields: second order; a sharp shadow edge is blurred over the spacing) plus that
 // 2.5e-4; the tests measure it against the exact march and a closed form.
 //
-// Sampling: one ray through each pixel centre for samples = 1; otherwise stratified, jittered
-// positions seeded by pixel, sample, frame and seed. Nothing depends on the thread count, so
-// images are bit-identical for any --threads.
+// Sampling: one ray through each pixel centre for samples = 1; otherwise each pixel's samples are
+// the points of an Owen-scrambled Sobol sequence of its own (its position in the pixel, the first
+// collision, each vertex's light and direction), seeded by pixel, frame and seed. With a noise
+// target (RenderSettings::noise) the samples come in passes that double the noisy pixels'; the
+// decisions are taken between passes from the whole frame. Nothing depends on the thread count,
+// so images are bit-identical for any --threads.
 #pragma once
 
 #include <volmorph/render/Camera.h>
@@ -41,6 +44,7 @@
 #include <openvdb/util/NullInterrupter.h>
 
 #include <cstdint>
+#include <limits>
 #include <memory>
 #include <vector>
 
@@ -81,7 +85,14 @@ struct Medium {
 };
 
 struct RenderSettings {
-    int samples = 4;         ///< per pixel, stratified and jittered; 1 = through the pixel centre
+    /// Per pixel: exactly this many with no noise target, at most this many with one; 1 = through
+    /// the pixel centre.
+    int samples = 4;
+    /// The noise target: the frame's relative RMSE against its converged image (over the pixels
+    /// with alpha above 0.1, relative to their mean RGB), which the renderer estimates from the two
+    /// halves of each pixel's samples and stops at, doubling the samples of the pixels still
+    /// noisy, up to `samples`. 0: exactly `samples` samples everywhere (the reference mode).
+    double noise = 0.0;
     double stepVoxels = 0.5; ///< longest step of the scattering integral along a primary ray
     /// The single-scattering estimator's shadow maps' spacing, in voxels (1 =
     /// every voxel); 0: no cache, the exact transmittance toward each light marched per sample (the
@@ -137,6 +148,14 @@ struct Image {
     int width = 0, height = 0;
     std::vector<float> pixels; ///< 4 floats per pixel
     std::vector<float> layers; ///< empty, or layer::kFloats floats per pixel (see layer::)
+    /// Per pixel, the estimated variance of its RGB (the mean over the channels of the variance of
+    /// each channel's estimate), from the two halves of its samples; empty or 0 where not
+    /// estimated (one sample).
+    std::vector<float> variance;
+    /// The frame's estimated relative noise (estimateNoise in the renderer: the RMS of the pixels'
+    /// estimated errors over the pixels it covers, over their mean); NaN when not estimated.
+    double noise = std::numeric_limits<double>::quiet_NaN();
+    double meanSamples = 0.0; ///< the samples a pixel took, on average (times summed under blur)
 
     float* at(int x, int y) { return &pixels[4 * index(x, y)]; }
     const float* at(int x, int y) const { return &pixels[4 * index(x, y)]; }
@@ -147,6 +166,15 @@ struct Image {
     }
     size_t index(int x, int y) const { return size_t(y) * size_t(width) + size_t(x); }
 };
+
+/// The pixels a noise figure is taken over: those whose alpha exceeds this (as the benchmarks'
+/// image comparisons).
+inline constexpr double kNoiseMinAlpha = 0.1;
+
+/// The image's relative noise: the root mean square of its pixels' estimated error (the square
+/// root of Image::variance) over the pixels it covers (alpha > kNoiseMinAlpha), divided by their
+/// mean RGB. NaN when it has no variance (one sample per pixel) or covers nothing.
+double estimateNoise(const Image& image);
 
 /// Renders `density` (a fog: any float grid of densities, negative values counting as 0; or a level
 /// set, see Medium::Kind), coloured by `color` (linear RGB albedo colour, may be null: white).
