@@ -51,7 +51,7 @@ struct RenderVdbArgs {
     double memoryLimitGiB = 0.0, noise = 0.0;
     std::vector<double> shutter; ///< open, close in frames: motion blur along the vel grid
     double fps = 24.0;
-    bool floatExr = false, noLayers = false, verbose = false;
+    bool floatExr = false, noLayers = false, verbose = false, noDenoise = false;
 };
 
 void parseResolution(const std::string& text, int& width, int& height)
@@ -214,6 +214,7 @@ int runRenderVdb(const RenderVdbArgs& args)
     settings.samples = args.samples;
     settings.noise = args.noise;
     settings.seed = args.seed;
+    settings.denoise = !args.noDenoise;
     settings.stepVoxels = args.step;
     settings.shadowCacheVoxels = args.shadowCache;
     settings.bounces = args.bounces;
@@ -408,6 +409,8 @@ Command addRenderVdbCommand(CLI::App& app)
     sub->add_option("--samples", a->samples, "samples per pixel (the cap under a noise target)")
         ->check(CLI::Range(1, 65536));
     addNoiseOption(sub, a->noise);
+    sub->add_flag("--no-denoise", a->noDenoise,
+                  "under a noise target, reach it by samples alone (no denoiser: no bias)");
     sub->add_option("--seed", a->seed,
                     "the samples' seed (another seed: another, independent, image of the same "
                     "noise)");

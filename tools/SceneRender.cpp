@@ -65,6 +65,7 @@ SceneRender::SceneRender(const Scene& scene, int threads, int width)
     medium.emission = r.emission;
     settings.samples = r.samples;
     settings.noise = r.noise;
+    settings.denoise = r.denoise;
     settings.stepVoxels = r.stepVoxels;
     settings.shadowCacheVoxels = r.shadowCacheVoxels;
     settings.bounces = r.bounces;

@@ -11,6 +11,7 @@ Film::Film(int width, int height, bool layers)
       mPassRgb(size_t(width) * size_t(height) * 3, 0.0), mCount(size_t(width) * size_t(height), 0u),
       mPassCount(mCount.size(), 0u), mTarget(mCount.size(), 0u)
 {
+    mDepth.assign(mCount.size(), layer::kNoDepth);
     if (!layers) return;
     mLayers.assign(mCount.size() * layer::kFloats, 0.0);
     for (size_t p = 0; p < mCount.size(); ++p)
@@ -22,6 +23,17 @@ void Film::finishPass(size_t p, uint32_t added, const double passRgb[3])
     mCount[p] += added;
     mPassCount[p] = added;
     for (int c = 0; c < 3; ++c) mPassRgb[3 * p + c] = passRgb[c];
+}
+
+void Film::halves(size_t p, double a[3], double b[3], double& nA, double& nB) const
+{
+    nB = mPassCount[p];
+    nA = double(mCount[p]) - nB;
+    for (int c = 0; c < 3; ++c) {
+        const double passSum = mPassRgb[3 * p + c];
+        a[c] = nA > 0.0 ? (mRgba[4 * p + c] - passSum) / nA : 0.0;
+        b[c] = nB > 0.0 ? passSum / nB : 0.0;
+    }
 }
 
 double Film::variance(size_t p) const
@@ -122,21 +134,27 @@ double estimateNoise(const Image& image)
     return c.noise();
 }
 
-std::vector<double> smoothedVariance(const Film& film)
+std::vector<double> boxMean3(const std::vector<double>& values, int width, int height)
 {
-    const int w = film.width(), h = film.height();
-    std::vector<double> perSample(film.pixels()), out(film.pixels());
-    for (size_t p = 0; p < perSample.size(); ++p) perSample[p] = film.variance(p) * film.count(p);
-    for (int y = 0; y < h; ++y)
-        for (int x = 0; x < w; ++x) {
+    std::vector<double> out(values.size());
+    for (int y = 0; y < height; ++y)
+        for (int x = 0; x < width; ++x) {
             double sum = 0.0;
             int n = 0;
-            for (int yy = std::max(0, y - 1); yy <= std::min(h - 1, y + 1); ++yy)
-                for (int xx = std::max(0, x - 1); xx <= std::min(w - 1, x + 1); ++xx, ++n)
-                    sum += perSample[size_t(yy) * size_t(w) + size_t(xx)];
-            const size_t p = size_t(y) * size_t(w) + size_t(x);
-            out[p] = sum / n / std::max(1u, film.count(p));
+            for (int yy = std::max(0, y - 1); yy <= std::min(height - 1, y + 1); ++yy)
+                for (int xx = std::max(0, x - 1); xx <= std::min(width - 1, x + 1); ++xx, ++n)
+                    sum += values[size_t(yy) * size_t(width) + size_t(xx)];
+            out[size_t(y) * size_t(width) + size_t(x)] = sum / n;
         }
+    return out;
+}
+
+std::vector<double> smoothedVariance(const Film& film)
+{
+    std::vector<double> perSample(film.pixels());
+    for (size_t p = 0; p < perSample.size(); ++p) perSample[p] = film.variance(p) * film.count(p);
+    std::vector<double> out = boxMean3(perSample, film.width(), film.height());
+    for (size_t p = 0; p < out.size(); ++p) out[p] /= std::max(1u, film.count(p));
     return out;
 }
 

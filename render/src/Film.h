@@ -37,6 +37,15 @@ public:
     /// Marks pass `added` samples of pixel p done, `passRgb` their RGB sum.
     void finishPass(size_t p, uint32_t added, const double passRgb[3]);
 
+    /// Pixel p's two halves: the mean RGB of its samples before the last pass (a, nA of them) and
+    /// of the last pass's (b, nB).
+    void halves(size_t p, double a[3], double b[3], double& nA, double& nB) const;
+
+    /// Each pixel's nearest depth over its samples (as layer::kDepth; kept with or without the
+    /// layers, for the denoiser).
+    float& depth(size_t p) { return mDepth[p]; }
+    const std::vector<float>& depths() const { return mDepth; }
+
     /// The estimated variance of pixel p's mean RGB (mean over the channels); 0 before it has two
     /// halves.
     double variance(size_t p) const;
@@ -53,6 +62,7 @@ public:
 private:
     int mWidth, mHeight;
     std::vector<double> mRgba, mLayers, mPassRgb;
+    std::vector<float> mDepth;
     std::vector<uint32_t> mCount, mPassCount, mTarget;
 };
 
@@ -60,5 +70,8 @@ private:
 /// (times the pixel's count), and divided by its own count again: a steadier figure to decide by
 /// than one pixel's two halves.
 std::vector<double> smoothedVariance(const Film& film);
+
+/// The mean of `values` (width x height, row-major) over each pixel's 3x3 neighbourhood.
+std::vector<double> boxMean3(const std::vector<double>& values, int width, int height);
 
 } // namespace volmorph::render

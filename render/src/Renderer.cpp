@@ -4,6 +4,7 @@
 
 #include <volmorph/core/Interrupter.h>
 
+#include "Denoiser.h"
 #include "Film.h"
 #include "GridReaders.h"
 #include "Majorants.h"
@@ -76,7 +77,10 @@ void renderPixel(ThreadReaders& readers, const Camera& camera, const RenderSetti
         const Ray ray = camera.ray(x + sx, y + sy);
         const RaySample sample = readers.in.majorants ? tracePath(readers, ray, random)
                                                       : integrateRay(readers, ray, &random);
-        accumulate(sample, ray.direction.dot(camera.forward()), rgba, layers);
+        const double viewCosine = ray.direction.dot(camera.forward());
+        accumulate(sample, viewCosine, rgba, layers);
+        if (sample.depth != kNoHit)
+            film.depth(p) = std::min(film.depth(p), float(sample.depth * viewCosine));
         const Vec3d L = sample.L.sum();
         for (int c = 0; c < 3; ++c) pass[c] += L[c];
     }
@@ -109,19 +113,18 @@ void targetAll(Film& film, uint32_t samples)
     for (size_t p = 0; p < film.pixels(); ++p) film.target(p) = samples;
 }
 
-/// The pixels whose smoothed variance exceeds the frame's per-pixel share of the target's (all
-/// pixels' mean variance at the noise target), each set to twice its samples, up to `cap`; when
-/// none does while the frame is still above the target, a lower share. False when no pixel can
-/// take more samples.
-bool chooseNextPass(Film& film, double target, uint32_t cap)
+/// The pixels whose estimated error (`error`, smoothed) exceeds the frame's per-pixel share of the
+/// target's (all pixels' mean variance at the noise target), each set to twice its samples, up to
+/// `cap`; when none does while the frame is still above the target, a lower share. False when no
+/// pixel can take more samples.
+bool chooseNextPass(Film& film, const std::vector<double>& error, double target, uint32_t cap)
 {
-    const std::vector<double> variance = smoothedVariance(film);
     const double mean = film.coveredMean();
     for (double share = (target * mean) * (target * mean); share > 0.0; share *= 0.25) {
         bool any = false;
         for (size_t p = 0; p < film.pixels(); ++p) {
             const uint32_t n = film.count(p);
-            const bool more = n < cap && variance[p] > share;
+            const bool more = n < cap && error[p] > share;
             film.target(p) = more ? std::min<uint32_t>(cap, 2 * n) : n;
             any = any || more;
         }
@@ -134,10 +137,10 @@ bool chooseNextPass(Film& film, double target, uint32_t cap)
 /// The image's passes: with no noise target, exactly `samples` samples per pixel in two halves
 /// (the second half's difference from the first is the noise estimate); with one, the first
 /// kFirstSamples in two halves, then passes that double the samples of the pixels still noisy
-/// (chooseNextPass) until the frame's estimated noise reaches the target or no pixel may take
-/// more.
-void renderPasses(const FrameInputs& frame, const Camera& camera, const RenderSettings& settings,
-                  Film& film)
+/// (chooseNextPass) until the frame's estimated noise, denoised unless the settings say not to,
+/// reaches the target or no pixel may take more.
+Image renderPasses(const FrameInputs& frame, const Camera& camera, const RenderSettings& settings,
+                   Film& film)
 {
     constexpr uint32_t kFirstSamples = 16;
     const uint32_t cap = uint32_t(std::max(1, settings.samples));
@@ -148,16 +151,29 @@ void renderPasses(const FrameInputs& frame, const Camera& camera, const RenderSe
     }
     targetAll(film, first);
     renderPass(frame, camera, settings, film);
-    if (!(settings.noise > 0.0)) return;
-    while (film.noise() > settings.noise && chooseNextPass(film, settings.noise, cap))
+    if (!(settings.noise > 0.0)) return film.resolve();
+    for (;;) {
+        Image image = film.resolve();
+        std::vector<double> error;
+        if (settings.denoise) {
+            stage(settings.interrupter, "render: denoise");
+            error = boxMean3(denoise(film, film.depths(), image, settings.interrupter).variance,
+                             film.width(), film.height());
+        } else {
+            error = smoothedVariance(film);
+        }
+        if (!(image.noise > settings.noise) || !chooseNextPass(film, error, settings.noise, cap))
+            return image;
+        stage(settings.interrupter, "render: pixels");
         renderPass(frame, camera, settings, film);
+    }
 }
 
 /// Prepares what every ray reads (the empty-space mask, padded leaves, every light's shadow), then
 /// renders the tiles. Throws Interrupted when the interrupter asked to stop.
 void renderFrame(const openvdb::FloatGrid& density, const openvdb::Vec3SGrid* color,
                  const Camera& camera, const std::vector<Light>& lights, const Medium& medium,
-                 const RenderSettings& settings, Film& film)
+                 const RenderSettings& settings, Film& film, Image& image)
 {
     const bool levelSet = medium.kind == Medium::Kind::LevelSet;
     const Props* props = settings.props && !settings.props->empty() ? settings.props : nullptr;
@@ -198,7 +214,7 @@ void renderFrame(const openvdb::FloatGrid& density, const openvdb::Vec3SGrid* co
                             sky,
                             props};
     stage(settings.interrupter, "render: pixels");
-    renderPasses(frame, camera, settings, film);
+    image = renderPasses(frame, camera, settings, film);
     stage(settings.interrupter, nullptr);
 }
 
@@ -220,12 +236,13 @@ Image renderVolume(const openvdb::FloatGrid& density, const openvdb::Vec3SGrid* 
         nothing->tree().setValueOn(openvdb::Coord(0), density.background());
     }
     const openvdb::FloatGrid& volume = empty ? *nothing : density;
-    auto body = [&] { renderFrame(volume, color, camera, lights, medium, settings, film); };
+    Image image;
+    auto body = [&] { renderFrame(volume, color, camera, lights, medium, settings, film, image); };
     if (settings.threads > 0)
         tbb::task_arena(settings.threads).execute(body);
     else
         body();
-    return film.resolve();
+    return image;
 }
 
 } // namespace volmorph::render

@@ -17,7 +17,8 @@
 # - brute force at BRUTE samples: its error, and the time to 1% extrapolated as 1/sqrt(samples);
 # - the estimate's honesty: noise 0 at 16, 64 and 256 samples, the estimate against the error;
 # - each noise target of TARGETS (default 0.05 0.02 0.01): time, error, estimate, samples spent.
-# usage: [SCENE=default|cloud|dino] [RUNS=1] [TARGETS="0.05 0.02 0.01"]
+# DENOISE=0 reaches the targets by samples alone (--no-denoise).
+# usage: [SCENE=default|cloud|dino] [RUNS=1] [TARGETS="0.05 0.02 0.01"] [DENOISE=0]
 #        tests/bench/noise_bench.sh [BUILD_DIR [REF_SAMPLES [RES [BOUNCES [BRUTE]]]]]
 #        defaults: build 4096 320x180 16 256
 set -eu
@@ -27,6 +28,8 @@ res=${3:-320x180}
 bounces=${4:-16}
 brute=${5:-256}
 runs=${RUNS:-1}
+denoise=""
+[ "${DENOISE:-1}" = 0 ] && denoise=--no-denoise
 scene=${SCENE:-default}
 src=$(cd "$(dirname "$0")/../.." && pwd)
 vm=$build/bin/volmorph
@@ -62,7 +65,7 @@ render() { # OUT SAMPLES NOISE SEED
     # shellcheck disable=SC2086
     "$vm" render-vdb "$vdb" -o "$1" --grid density --translate $eye --lookat $lookat --fov $fov \
         --res "$res" --extinction $extinction --albedo $albedo --light 1,1,0.5,3,2.85,2.7 $sky \
-        --bounces "$bounces" --samples "$2" --noise "$3" --seed "$4" --float --no-layers >/dev/null
+        --bounces "$bounces" --samples "$2" --noise "$3" --seed "$4" --float --no-layers $denoise >/dev/null
     echo "$(date +%s.%N) - $start" | bc
 }
 median() { tr ' ' '\n' | grep . | sort -g | awk '{ v[NR] = $1 } END { print v[int((NR + 1) / 2)] }'; }

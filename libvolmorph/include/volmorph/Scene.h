@@ -126,6 +126,7 @@ struct RenderSpec {
     /// The noise target: the frame's estimated relative RMSE against its converged image, at which
     /// the renderer stops (adaptive sampling up to `samples`); 0: exactly `samples` samples.
     double noise = 0.0;
+    bool denoise = true;           ///< under a noise target, denoise the frame (render.denoise)
     double stepVoxels = 0.5;       ///< ray-march step
     double extinction = 40.0;      ///< per world unit at density 1
     double albedo = 0.8;           ///< single-scattering albedo, 0..1

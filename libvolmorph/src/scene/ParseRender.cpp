@@ -10,9 +10,10 @@
 namespace volmorph::detail {
 namespace {
 
-const std::vector<std::string> kRenderKeys = {
-    "resolution", "samples",  "step",    "extinction",   "albedo",  "anisotropy", "seed", "camera",
-    "lights",     "emission", "bounces", "shadow_cache", "shutter", "layers",     "noise"};
+const std::vector<std::string> kRenderKeys = {"resolution", "samples",    "step",    "extinction",
+                                              "albedo",     "anisotropy", "seed",    "camera",
+                                              "lights",     "emission",   "bounces", "shadow_cache",
+                                              "shutter",    "layers",     "noise",   "denoise"};
 const std::vector<std::string> kCameraKeys = {"projection", "eye",   "lookat", "up",
                                               "fov",        "width", "keys"};
 const std::vector<std::string> kCameraKeyKeys = {"frame", "eye", "lookat", "up", "fov", "width"};
@@ -292,6 +293,8 @@ void parseRender(Reader& r, const toml::node& node, const std::filesystem::path&
         if (auto v = r.nonNegativeVec3(*n, "render.emission")) rs.emission = *v;
     if (const toml::node* n = t->get("layers"))
         if (auto v = r.boolean(*n, "render.layers")) rs.layers = *v;
+    if (const toml::node* n = t->get("denoise"))
+        if (auto v = r.boolean(*n, "render.denoise")) rs.denoise = *v;
     if (const toml::node* n = t->get("shutter"))
         if (auto v = r.interval(*n, "render.shutter",
                                 "the shutter's open and close in frames around the frame", false))

@@ -93,6 +93,10 @@ struct RenderSettings {
     /// halves of each pixel's samples and stops at, doubling the samples of the pixels still
     /// noisy, up to `samples`. 0: exactly `samples` samples everywhere (the reference mode).
     double noise = 0.0;
+    /// Under a noise target: the frame denoised (non-local means guided by alpha and depth, the
+    /// radiance layers alike), and the target judged on the denoised frame's estimate. Trades a
+    /// little bias (BENCHMARKS.md measures it) for much less noise. Ignored at noise 0.
+    bool denoise = true;
     double stepVoxels = 0.5; ///< longest step of the scattering integral along a primary ray
     /// The single-scattering estimator's shadow maps' spacing, in voxels (1 =
     /// every voxel); 0: no cache, the exact transmittance toward each light marched per sample (the
