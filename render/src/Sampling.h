@@ -22,9 +22,10 @@ namespace volmorph::render {
 struct Random {
     static constexpr uint32_t kLowDiscrepancyDims = 32;
     uint64_t state;
-    uint64_t sequence; ///< the pixel's Sobol sequence (its scrambles' seed)
-    uint32_t index;    ///< the sample's index in it
-    uint32_t dim = 0;  ///< the next low-discrepancy dimension
+    uint64_t sequence;     ///< the pixel's Sobol sequence (its scrambles' seed)
+    uint32_t index;        ///< the sample's index in it
+    uint32_t dim = 0;      ///< the next low-discrepancy dimension
+    uint32_t shuffled = 0; ///< the sample's index in the current group's shuffle
     Random(uint64_t pixel, uint64_t sample, uint64_t stream)
         : sequence(mix(pixel * 0x9E3779B97F4A7C15ull ^ mix(stream + 0x85157AF5ull))),
           index(uint32_t(sample))
@@ -48,7 +49,9 @@ struct Random {
     double nextLD()
     {
         if (dim >= kLowDiscrepancyDims) return next();
-        return sobol::sample(index, dim++, sequence);
+        // Every group is entered at its first dimension (nextLD2 skips only odd ones).
+        if (dim % 4 == 0) shuffled = sobol::shuffledIndex(index, dim / 4, sequence);
+        return sobol::scrambledPoint(shuffled, dim++, sequence);
     }
     /// Two dimensions stratified together (a pair of one group of four).
     void nextLD2(double& u1, double& u2)

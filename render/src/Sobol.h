@@ -44,13 +44,30 @@ constexpr std::array<std::array<uint32_t, 32>, 4> makeMatrices()
 
 inline constexpr std::array<std::array<uint32_t, 32>, 4> kMatrices = makeMatrices();
 
+/// The matrices by byte: kBytes[dim][b][v] is the XOR of the columns 8 b to 8 b + 7 that byte
+/// value v selects, so a point is four lookups instead of a loop over 32 bits.
+constexpr std::array<std::array<std::array<uint32_t, 256>, 4>, 4> makeByteTables()
+{
+    std::array<std::array<std::array<uint32_t, 256>, 4>, 4> t{};
+    for (int d = 0; d < 4; ++d)
+        for (int b = 0; b < 4; ++b)
+            for (uint32_t v = 0; v < 256; ++v) {
+                uint32_t x = 0;
+                for (int k = 0; k < 8; ++k)
+                    if (v & (1u << k)) x ^= kMatrices[d][8 * b + k];
+                t[d][b][v] = x;
+            }
+    return t;
+}
+
+inline constexpr std::array<std::array<std::array<uint32_t, 256>, 4>, 4> kBytes = makeByteTables();
+
 /// Sobol dimension `dim` (0 to 3) of point `index`, as 32 bits of a fraction.
 inline uint32_t point(uint32_t index, int dim)
 {
-    uint32_t x = 0;
-    for (int k = 0; index != 0; index >>= 1, ++k)
-        if (index & 1u) x ^= kMatrices[dim][k];
-    return x;
+    const auto& t = kBytes[dim];
+    return t[0][index & 0xffu] ^ t[1][(index >> 8) & 0xffu] ^ t[2][(index >> 16) & 0xffu] ^
+           t[3][index >> 24];
 }
 
 inline uint32_t reverseBits(uint32_t x)
@@ -86,16 +103,27 @@ inline uint32_t hash(uint64_t a, uint64_t b)
     return uint32_t((z ^ (z >> 31)) >> 32);
 }
 
-/// Dimension `dim` (any) of sample `index` of the sequence `seed` (a pixel's), in [0, 1): group
-/// dim / 4 shuffles the index and scrambles its four dimensions with seeds of its own. The index
-/// shuffle is itself an Owen scramble, which maps the first 2^m indices onto an aligned block of
-/// 2^m: a pixel's first 2^m samples are a net whatever the seed.
-inline double sample(uint32_t index, uint32_t dim, uint64_t seed)
+/// The index of sample `index` in group `group`'s shuffle of the sequence `seed` (a pixel's): an
+/// Owen scramble of the index, which maps the first 2^m indices onto an aligned block of 2^m, so a
+/// pixel's first 2^m samples are a net whatever the seed.
+inline uint32_t shuffledIndex(uint32_t index, uint32_t group, uint64_t seed)
 {
-    const uint32_t group = dim / 4;
-    const uint32_t shuffled = owenScramble(index, hash(seed, 2u * group));
+    return owenScramble(index, hash(seed, 2u * group));
+}
+
+/// Dimension `dim` (any; its group is dim / 4) of the point at `shuffled` (shuffledIndex of that
+/// group), scrambled with a seed of its own, in [0, 1).
+inline double scrambledPoint(uint32_t shuffled, uint32_t dim, uint64_t seed)
+{
     const uint32_t bits = owenScramble(point(shuffled, int(dim % 4)), hash(seed, 2u * dim + 1u));
     return double(bits) * (1.0 / 4294967296.0);
+}
+
+/// Dimension `dim` of sample `index` of the sequence `seed`: group dim / 4 shuffles the index and
+/// scrambles its four dimensions with seeds of its own.
+inline double sample(uint32_t index, uint32_t dim, uint64_t seed)
+{
+    return scrambledPoint(shuffledIndex(index, dim / 4, seed), dim, seed);
 }
 
 } // namespace volmorph::render::sobol

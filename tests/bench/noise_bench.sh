@@ -77,7 +77,12 @@ timed() { # OUT SAMPLES NOISE: the median seconds of RUNS runs (seed 7)
 }
 
 cache=${XDG_CACHE_HOME:-$HOME/.cache}/volmorph/noise-bench
-key=$( { echo "$scene $res $bounces $ref_samples $sky"; sha256sum <"$vdb"; } | sha256sum | cut -c1-16)
+# The key: what decides the reference: the shot, and the volume, by the committed trees that make it
+# (an OpenVDB file holds UUIDs that differ per write, so its bytes cannot be the key; the renderer's
+# code is left out: the reference is the converged image, whatever unbiased code renders it).
+key=$( { echo "$scene $res $bounces $ref_samples $sky" | sed "s|$work||g"
+         git -C "$src" rev-parse HEAD:libvolmorph HEAD:scenes HEAD:tests/unit/support; } |
+       sha256sum | cut -c1-16)
 mkdir -p "$cache"
 for seed in 1 2; do
     ref=$cache/$key.ref$seed.exr
