@@ -192,9 +192,10 @@ void printSettings(const Scene& scene)
     for (const auto& [name, grid] : b.grids)
         std::printf("        carried grid %s: %s\n", name.c_str(), describe(grid.schedule).c_str());
     const RenderSpec& r = scene.render;
-    const std::string samples = r.noise > 0.0 ? "noise target " + fmt(r.noise) + ", at most " +
-                                                    std::to_string(r.samples) + " samples"
-                                              : std::to_string(r.samples) + " samples";
+    const std::string samples =
+        r.noise > 0.0 ? "noise target " + fmt(r.noise) + (r.denoise ? " (denoised)" : "") +
+                            ", at most " + std::to_string(r.samples) + " samples"
+                      : std::to_string(r.samples) + " samples";
     std::printf("render  %dx%d, %s, step %s voxels, extinction %s per world unit, albedo %s\n",
                 r.width, r.height, samples.c_str(), fmt(r.stepVoxels).c_str(),
                 fmt(r.extinction).c_str(), fmt(r.albedo).c_str());
