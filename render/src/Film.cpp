@@ -12,10 +12,7 @@ Film::Film(int width, int height, bool layers)
       mPassCount(mCount.size(), 0u), mTarget(mCount.size(), 0u)
 {
     mDepth.assign(mCount.size(), layer::kNoDepth);
-    if (!layers) return;
-    mLayers.assign(mCount.size() * layer::kFloats, 0.0);
-    for (size_t p = 0; p < mCount.size(); ++p)
-        mLayers[p * layer::kFloats + layer::kDepth] = layer::kNoDepth;
+    if (layers) mLayers.assign(mCount.size() * layer::kFloats, 0.0); // the depth: mDepth
 }
 
 void Film::finishPass(size_t p, uint32_t added, const double passRgb[3])
@@ -112,8 +109,8 @@ Image Film::resolve() const
         image.variance[p] = float(variance(p));
         if (mLayers.empty()) continue;
         for (int c = 0; c < layer::kFloats; ++c) {
-            const double v = mLayers[p * layer::kFloats + c];
-            image.layers[p * layer::kFloats + c] = float(c == layer::kDepth ? v : v / n);
+            image.layers[p * layer::kFloats + c] =
+                c == layer::kDepth ? mDepth[p] : float(mLayers[p * layer::kFloats + c] / n);
         }
     }
     image.noise = estimateNoise(image);

@@ -36,12 +36,15 @@ void stage(openvdb::util::NullInterrupter* interrupter, const char* name)
     if (name) interrupter->start(name);
 }
 
-/// One sample's part of its pixel: RGBA into `rgba`, the layers (layer::) into `layers` when
-/// given, the depth there as the nearest; `viewCosine` is the ray's cosine to the view axis.
-void accumulate(const RaySample& sample, double viewCosine, double* rgba, double* layers)
+/// One sample's part of its pixel: RGBA into `rgba`, its RGB into `pass` too, and the layers
+/// (layer::, but the depth, which the film keeps) into `layers` when given.
+void accumulate(const RaySample& sample, double* rgba, double* pass, double* layers)
 {
     const Vec3d L = sample.L.sum();
-    for (int c = 0; c < 3; ++c) rgba[c] += L[c];
+    for (int c = 0; c < 3; ++c) {
+        rgba[c] += L[c];
+        pass[c] += L[c];
+    }
     rgba[3] += 1.0 - sample.T;
     if (!layers) return;
     for (int c = 0; c < 3; ++c) {
@@ -52,8 +55,6 @@ void accumulate(const RaySample& sample, double viewCosine, double* rgba, double
     }
     layers[layer::kVolume + 3] += 1.0 - sample.volumeT;
     layers[layer::kShadow] += sample.shadow;
-    if (sample.depth != kNoHit)
-        layers[layer::kDepth] = std::min(layers[layer::kDepth], sample.depth * viewCosine);
 }
 
 /// Pixel (x, y)'s samples from film.count to film.target, added to its sums in their order. Sample
@@ -77,12 +78,10 @@ void renderPixel(ThreadReaders& readers, const Camera& camera, const RenderSetti
         const Ray ray = camera.ray(x + sx, y + sy);
         const RaySample sample = readers.in.majorants ? tracePath(readers, ray, random)
                                                       : integrateRay(readers, ray, &random);
-        const double viewCosine = ray.direction.dot(camera.forward());
-        accumulate(sample, viewCosine, rgba, layers);
-        if (sample.depth != kNoHit)
-            film.depth(p) = std::min(film.depth(p), float(sample.depth * viewCosine));
-        const Vec3d L = sample.L.sum();
-        for (int c = 0; c < 3; ++c) pass[c] += L[c];
+        accumulate(sample, rgba, pass, layers);
+        if (sample.depth != kNoHit) // the nearest, camera-space depth
+            film.depth(p) =
+                std::min(film.depth(p), float(sample.depth * ray.direction.dot(camera.forward())));
     }
     film.finishPass(p, to - from, pass);
 }
