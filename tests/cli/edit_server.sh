@@ -44,7 +44,9 @@ nonce=$(sed -n 's/.*<script type="importmap" nonce="\([0-9a-f]*\)".*/\1/p' "$out
 grep -qi "^content-security-policy: default-src 'none'; script-src 'self' 'nonce-$nonce';" "$out/headers" ||
     { echo "CSP of the page:"; cat "$out/headers"; exit 1; }
 expect 200 -H "Cookie: $cookie" "$base/api/state"
-expect 403 -H "Cookie: ${cookie%?}0" "$base/api/state"
+# The cookie with its last hex digit changed (to 1 if it was 0, else to 0: never the same token).
+case "$cookie" in *0) wrong="${cookie%?}1" ;; *) wrong="${cookie%?}0" ;; esac
+expect 403 -H "Cookie: $wrong" "$base/api/state"
 # Every answer, refusals included: nosniff, one CSP, and JSON errors.
 for request in "$base/api/state" "-H Cookie:$cookie $base/nothing" "-H Cookie:$cookie $base/api/nothing"; do
     # shellcheck disable=SC2086
