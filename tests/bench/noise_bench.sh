@@ -77,11 +77,20 @@ timed() { # OUT SAMPLES NOISE: the median seconds of RUNS runs (seed 7)
 }
 
 cache=${XDG_CACHE_HOME:-$HOME/.cache}/volmorph/noise-bench
-# The key: what decides the reference: the shot, and the volume, by the committed trees that make it
-# (an OpenVDB file holds UUIDs that differ per write, so its bytes cannot be the key; the renderer's
-# code is left out: the reference is the converged image, whatever unbiased code renders it).
+# The key: what decides the reference: the shot, and the volume, by the committed trees and files
+# that make it (an OpenVDB file holds UUIDs that differ per write, so its bytes cannot be the key; a
+# scene file's samples, noise and denoise lines are left out, render-vdb does not read them; the
+# renderer's code is left out too: the reference is the converged image, whatever unbiased code
+# renders it).
+case $scene in
+    default) inputs="HEAD:libvolmorph HEAD:scenes/meshes HEAD:scenes/skies" file=scenes/bunny-to-knot.toml ;;
+    cloud) inputs="HEAD:libvolmorph HEAD:tests/bench/cloud.cpp HEAD:tests/unit/support" file= ;;
+    dino) inputs="HEAD:libvolmorph HEAD:scenes/meshes" file=scenes/dino-to-eight.toml ;;
+esac
+# shellcheck disable=SC2086
 key=$( { echo "$scene $res $bounces $ref_samples $sky" | sed "s|$work||g"
-         git -C "$src" rev-parse HEAD:libvolmorph HEAD:scenes HEAD:tests/unit/support; } |
+         git -C "$src" rev-parse $inputs
+         [ -z "$file" ] || git -C "$src" show "HEAD:$file" | grep -Ev '^(samples|noise|denoise) *='; } |
        sha256sum | cut -c1-16)
 mkdir -p "$cache"
 for seed in 1 2; do
