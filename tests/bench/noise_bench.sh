@@ -17,8 +17,9 @@
 # - brute force at BRUTE samples: its error, and the time to 1% extrapolated as 1/sqrt(samples);
 # - the estimate's honesty: noise 0 at 16, 64 and 256 samples, the estimate against the error;
 # - each noise target of TARGETS (default 0.05 0.02 0.01): time, error, estimate, samples spent.
-# DENOISE=0 reaches the targets by samples alone (--no-denoise).
-# usage: [SCENE=default|cloud|dino] [RUNS=1] [TARGETS="0.05 0.02 0.01"] [DENOISE=0]
+# DENOISE=0 reaches the targets by samples alone (--no-denoise). REF_ONLY=1 makes the references and
+# stops (their time is not measured: run it while the machine is busy, the timed part when it is idle).
+# usage: [SCENE=default|cloud|dino] [RUNS=1] [TARGETS="0.05 0.02 0.01"] [DENOISE=0] [REF_ONLY=1]
 #        tests/bench/noise_bench.sh [BUILD_DIR [REF_SAMPLES [RES [BOUNCES [BRUTE]]]]]
 #        defaults: build 4096 320x180 16 256
 set -eu
@@ -103,6 +104,7 @@ for seed in 1 2; do
         mv "$work/ref.exr" "$ref"
     fi
 done
+[ "${REF_ONLY:-0}" = 1 ] && { echo "references: $cache/$key.ref1.exr, .ref2.exr"; exit 0; }
 error() { "$measure" "$1" "$cache/$key.ref1.exr" "$cache/$key.ref2.exr"; }
 
 echo "scene $scene, $res, $bounces bounces, reference $ref_samples samples x 2 seeds, $runs run(s)"

@@ -22,6 +22,7 @@ HEADERS = {
     "Morph.h": "morph", "Export.h": "export",
     "Scene.h": "scene", "Frames.h": "scene", "SceneDocument.h": "scene",
     "SceneVolumes.h": "sides", "VoxelCache.h": "sides",
+    "SurfaceSettings.h": "surface", "SurfaceMorph.h": "surface",
 }
 
 # What each stage may read, itself included. The scene builds every stage's options, so it reads
@@ -36,10 +37,11 @@ ALLOWED = {
     "warp": {"core", "volumeset", "feature", "warp"},
     "blend": {"core", "volumeset", "voxelize", "feature", "warp", "blend"},
     "morph": {"core", "volumeset", "voxelize", "feature", "warp", "blend", "morph"},
+    "surface": {"core", "mesh", "surface"},
     "export": {"core", "volumeset", "mesh", "export"},
-    "scene": {"core", "feature", "warp", "blend", "volume", "scene"},
-    "sides": {"core", "volumeset", "mesh", "voxelize", "volume", "export", "feature", "scene",
-              "sides"},
+    "scene": {"core", "feature", "warp", "blend", "volume", "surface", "scene"},
+    "sides": {"core", "volumeset", "mesh", "voxelize", "volume", "export", "feature", "surface",
+              "scene", "sides"},
 }
 
 INCLUDE = re.compile(r'^\s*#\s*include\s*[<"]([^>"]+)[>"]', re.M)

@@ -1,0 +1,58 @@
+// The surface stage (blend.mode = "surface"): the first half of the lecture volmorph comes from.
+// Two triangle meshes are put into correspondence (one connectivity for both, each vertex with a
+// place on each surface), then every in-between is that connectivity with each vertex between its
+// two places: one mesh per frame, the same vertex count and triangles at every t, with the exact
+// velocity of each vertex.
+//
+// Reads meshes (Mesh.h) and knows nothing of voxels, warps or blends: the scene's schedules are
+// applied by its caller, which passes the shape's and the colour's tau and turns d position / d tau
+// into world units per second.
+#pragma once
+
+#include <volmorph/Mesh.h>
+#include <volmorph/SurfaceSettings.h>
+
+#include <memory>
+#include <vector>
+
+namespace volmorph {
+
+/// One in-between, in double precision (the ends reproduce the inputs and the straight line is
+/// exact to double rounding; Mesh's floats are for consumers that want them: mesh()).
+struct SurfaceFrame {
+    std::vector<Vec3d> points;    ///< at the shape's tau, world units
+    std::vector<Vec3I> triangles; ///< the same at every tau
+    /// Linear RGB at the colour's tau; empty when neither input has colours.
+    std::vector<Vec3f> colors;
+    /// d position / d tau of each vertex, world units per unit of the shape's tau (exact: the
+    /// derivative of what `points` holds, not a difference of frames).
+    std::vector<Vec3d> velocity;
+
+    Mesh mesh() const; ///< points rounded to float, the triangles and colours, topology analysed
+};
+
+class SurfaceMorpher {
+public:
+    /// Puts `source` and `target` (world units) into correspondence as `spec` says and prepares
+    /// the interpolation (for "arap", one sparse factorization for every frame). Throws UserError
+    /// at `spec`'s location when the chosen correspondence does not apply to the meshes (naming
+    /// the mesh file and what was found).
+    SurfaceMorpher(Mesh source, Mesh target, const SurfaceSpec& spec);
+    ~SurfaceMorpher();
+    SurfaceMorpher(SurfaceMorpher&&) noexcept;
+    SurfaceMorpher& operator=(SurfaceMorpher&&) noexcept;
+
+    /// The in-between at `shapeTau` (positions) and `colorTau` (colours), each in [0, 1]: the
+    /// source's at 0 and the target's at 1.
+    SurfaceFrame frame(double shapeTau, double colorTau) const;
+
+    Correspondence correspondence() const; ///< the one used ("auto" resolved)
+    size_t vertexCount() const;
+    size_t triangleCount() const;
+
+private:
+    struct Impl;
+    std::unique_ptr<Impl> mImpl;
+};
+
+} // namespace volmorph

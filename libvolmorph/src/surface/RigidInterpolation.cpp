@@ -1,0 +1,190 @@
+#include "RigidInterpolation.h"
+
+#include "mesh/DisjointSets.h"
+
+#include <Eigen/Geometry>
+#include <Eigen/SVD>
+
+#include <cmath>
+#include <stdexcept>
+
+namespace volmorph::detail {
+namespace {
+
+Eigen::Vector3d toEigen(const Vec3f& p)
+{
+    return {double(p.x()), double(p.y()), double(p.z())};
+}
+
+/// A triangle's frame: its two edges from its first vertex and a normal scaled by the square root
+/// of its double area (Sumner and Popovic 2004), so that the frame's volume grows with the area.
+/// Zero for a triangle without area.
+bool triangleFrame(const Mesh& mesh, const Vec3I& t, Eigen::Matrix3d& frame)
+{
+    const Eigen::Vector3d p0 = toEigen(mesh.points[t[0]]);
+    const Eigen::Vector3d e1 = toEigen(mesh.points[t[1]]) - p0;
+    const Eigen::Vector3d e2 = toEigen(mesh.points[t[2]]) - p0;
+    const Eigen::Vector3d c = e1.cross(e2);
+    const double area2 = c.norm();
+    if (!(area2 > 1e-300)) return false;
+    frame.col(0) = e1;
+    frame.col(1) = e2;
+    frame.col(2) = c / std::sqrt(area2);
+    return true;
+}
+
+Eigen::Matrix3d cross(const Eigen::Vector3d& k)
+{
+    Eigen::Matrix3d m;
+    m << 0.0, -k.z(), k.y(), k.z(), 0.0, -k.x(), -k.y(), k.x(), 0.0;
+    return m;
+}
+
+} // namespace
+
+RigidInterpolation::RigidInterpolation(const Mesh& source, const Mesh& target)
+{
+    const size_t n = source.points.size();
+    // Pieces: a vertex of each is held at the origin (the energy does not see translations).
+    DisjointSets sets(n);
+    for (const Vec3I& t : source.triangles) {
+        sets.unite(t[0], t[1]);
+        sets.unite(t[1], t[2]);
+    }
+    std::vector<int> pieceOfRoot(n, -1);
+    mPiece.resize(n);
+    mFree.assign(n, -1);
+    int rows = 0;
+    for (uint32_t v = 0; v < n; ++v) {
+        int& piece = pieceOfRoot[sets.find(v)];
+        if (piece < 0) { // the piece's first vertex: held
+            piece = int(mSourceMean.size());
+            mSourceMean.emplace_back(Eigen::Vector3d::Zero());
+            mTargetMean.emplace_back(Eigen::Vector3d::Zero());
+            mPieceSize.push_back(0.0);
+        } else {
+            mFree[v] = rows++;
+        }
+        mPiece[v] = uint32_t(piece);
+        mSourceMean[piece] += toEigen(source.points[v]);
+        mTargetMean[piece] += toEigen(target.points[v]);
+        mPieceSize[piece] += 1.0;
+    }
+    for (size_t i = 0; i < mPieceSize.size(); ++i) {
+        mSourceMean[i] /= mPieceSize[i];
+        mTargetMean[i] /= mPieceSize[i];
+    }
+
+    std::vector<Eigen::Triplet<double>> entries;
+    mTriangles.resize(source.triangles.size());
+    for (uint32_t j = 0; j < source.triangles.size(); ++j) {
+        const Vec3I& t = source.triangles[j];
+        Triangle& tri = mTriangles[j];
+        Eigen::Matrix3d p, q;
+        if (!triangleFrame(source, t, p) || !triangleFrame(target, t, q)) {
+            tri.rotation = tri.stretch = Eigen::Matrix3d::Identity();
+            tri.axis = Eigen::Vector3d::UnitZ();
+        } else {
+            // A = Q P^-1 = R S; R = U V^T (a rotation: both frames are right-handed), S = V Sigma
+            // V^T.
+            const Eigen::JacobiSVD<Eigen::Matrix3d> svd(q * p.inverse(),
+                                                        Eigen::ComputeFullU | Eigen::ComputeFullV);
+            Eigen::Matrix3d u = svd.matrixU();
+            Eigen::Vector3d sigma = svd.singularValues();
+            const Eigen::Matrix3d& v = svd.matrixV();
+            if ((u * v.transpose()).determinant() < 0.0) {
+                u.col(2) = -u.col(2);
+                sigma(2) = -sigma(2);
+            }
+            tri.rotation = u * v.transpose();
+            tri.stretch = v * sigma.asDiagonal() * v.transpose();
+            const Eigen::AngleAxisd turn(tri.rotation);
+            tri.axis = turn.axis();
+            tri.angle = turn.angle();
+        }
+        // The cotangent weight of each edge, from the source's angle opposite it.
+        for (int c = 0; c < 3; ++c) {
+            const uint32_t k = t[c], a = t[(c + 1) % 3], b = t[(c + 2) % 3];
+            const Eigen::Vector3d pk = toEigen(source.points[k]);
+            const Eigen::Vector3d ea = toEigen(source.points[a]) - pk;
+            const Eigen::Vector3d eb = toEigen(source.points[b]) - pk;
+            const double area2 = ea.cross(eb).norm();
+            if (!(area2 > 1e-300)) continue;
+            const double w = 0.5 * ea.dot(eb) / area2;
+            mEdges.push_back({a, b, j, w, toEigen(source.points[a]) - toEigen(source.points[b])});
+            const int ra = mFree[a], rb = mFree[b];
+            if (ra >= 0) entries.emplace_back(ra, ra, w);
+            if (rb >= 0) entries.emplace_back(rb, rb, w);
+            if (ra >= 0 && rb >= 0) {
+                entries.emplace_back(ra, rb, -w);
+                entries.emplace_back(rb, ra, -w);
+            }
+        }
+    }
+    mRows = rows;
+    if (rows == 0) return;
+    Eigen::SparseMatrix<double> laplacian(rows, rows);
+    laplacian.setFromTriplets(entries.begin(), entries.end());
+    mSolver.compute(laplacian);
+    if (mSolver.info() != Eigen::Success)
+        throw std::runtime_error("the mesh's cotangent Laplacian cannot be factored");
+}
+
+void RigidInterpolation::rightHandSide(double tau, bool derivative, Eigen::MatrixXd& rhs) const
+{
+    std::vector<Eigen::Matrix3d> g(mTriangles.size());
+    for (size_t j = 0; j < mTriangles.size(); ++j) {
+        const Triangle& t = mTriangles[j];
+        const Eigen::Matrix3d turn = Eigen::AngleAxisd(tau * t.angle, t.axis).toRotationMatrix();
+        const Eigen::Matrix3d stretch = (1.0 - tau) * Eigen::Matrix3d::Identity() + tau * t.stretch;
+        g[j] = derivative ? Eigen::Matrix3d(t.angle * cross(t.axis) * turn * stretch +
+                                            turn * (t.stretch - Eigen::Matrix3d::Identity()))
+                          : Eigen::Matrix3d(turn * stretch);
+    }
+    rhs.setZero(mRows, 3);
+    for (const Edge& e : mEdges) {
+        const Eigen::RowVector3d wg = e.weight * (g[e.triangle] * e.edge).transpose();
+        if (mFree[e.a] >= 0) rhs.row(mFree[e.a]) += wg;
+        if (mFree[e.b] >= 0) rhs.row(mFree[e.b]) -= wg;
+    }
+}
+
+void RigidInterpolation::solve(const Eigen::MatrixXd& rhs, Eigen::MatrixXd& x) const
+{
+    x = rhs.rows() ? Eigen::MatrixXd(mSolver.solve(rhs)) : Eigen::MatrixXd(0, 3);
+}
+
+void RigidInterpolation::positions(double tau, std::vector<Vec3d>& out,
+                                   std::vector<Vec3d>* velocity) const
+{
+    const size_t n = mFree.size();
+    auto assemble = [&](const Eigen::MatrixXd& solved, const std::vector<Eigen::Vector3d>& centre,
+                        std::vector<Vec3d>& dest) {
+        std::vector<Eigen::Vector3d> y(n, Eigen::Vector3d::Zero());
+        std::vector<Eigen::Vector3d> mean(mPieceSize.size(), Eigen::Vector3d::Zero());
+        for (size_t v = 0; v < n; ++v) {
+            if (mFree[v] >= 0) y[v] = solved.row(mFree[v]).transpose();
+            mean[mPiece[v]] += y[v];
+        }
+        dest.resize(n);
+        for (size_t v = 0; v < n; ++v) {
+            const uint32_t p = mPiece[v];
+            const Eigen::Vector3d x = y[v] + centre[p] - mean[p] / mPieceSize[p];
+            dest[v] = Vec3d(x.x(), x.y(), x.z());
+        }
+    };
+    Eigen::MatrixXd rhs, solved;
+    std::vector<Eigen::Vector3d> centre(mPieceSize.size());
+    rightHandSide(tau, false, rhs);
+    solve(rhs, solved);
+    for (size_t p = 0; p < centre.size(); ++p)
+        centre[p] = (1.0 - tau) * mSourceMean[p] + tau * mTargetMean[p];
+    assemble(solved, centre, out);
+    if (!velocity) return;
+    rightHandSide(tau, true, rhs);
+    solve(rhs, solved);
+    for (size_t p = 0; p < centre.size(); ++p) centre[p] = mTargetMean[p] - mSourceMean[p];
+    assemble(solved, centre, *velocity);
+}
+
+} // namespace volmorph::detail

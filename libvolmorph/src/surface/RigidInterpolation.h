@@ -1,0 +1,64 @@
+// As-rigid-as-possible in-betweens of two meshes of one connectivity (Alexa, Cohen-Or and Levin
+// 2000; for surfaces, Xu et al. 2005 "Poisson shape interpolation").
+//
+// Each triangle's affine map A from its source to its target shape (the triangle's two edges and
+// a normal scaled by the square root of its double area, as in Sumner and Popovic 2004) is split
+// A = R S by the polar decomposition; at tau the triangle asks for G(tau) = R(tau) ((1 - tau) I +
+// tau S), where R(tau) turns by tau times R's angle about R's axis. The vertices x are those whose
+// edges e' best match G e over every triangle, in the sense of the gradient energy
+//   E(x) = sum over triangles T, edges e = (a, b) of T of  cot(angle opposite e) / 2 *
+//          | (x_a - x_b) - G_T(tau) (p_a - p_b) |^2,
+// which is the integral of | grad x - G |^2 over the surface: its matrix is the source's
+// cotangent Laplacian, the same at every tau, factored once (one vertex per connected piece held
+// at the origin); each piece is then moved so that its vertex mean follows the straight line
+// between the two sides' means. At tau = 0 and 1 every G maps the source's edges onto that side's
+// exactly, so the ends are the inputs. A limb that turns by theta keeps its thickness, where the
+// straight line shrinks it by cos(theta / 2) half-way.
+//
+// The velocity is exact: dG/dtau = theta [k]x R(tau) S(tau) + R(tau) (S - I) gives the right-hand
+// side's derivative, and the same factorization solves for dx/dtau.
+#pragma once
+
+#include <volmorph/Mesh.h>
+
+#include <Eigen/Core>
+#include <Eigen/SparseCholesky>
+
+#include <vector>
+
+namespace volmorph::detail {
+
+class RigidInterpolation {
+public:
+    /// `source` and `target` have the same triangles (world units). Throws std::runtime_error when
+    /// the Laplacian cannot be factored (a mesh made of degenerate triangles only).
+    RigidInterpolation(const Mesh& source, const Mesh& target);
+
+    /// Positions at `tau`, and d position / d tau when `velocity` is not null.
+    void positions(double tau, std::vector<Vec3d>& out, std::vector<Vec3d>* velocity) const;
+
+private:
+    struct Triangle {
+        Eigen::Matrix3d rotation, stretch; ///< A = rotation * stretch
+        Eigen::Vector3d axis;              ///< of the rotation, unit
+        double angle = 0.0;                ///< of the rotation, radians in [0, pi]
+    };
+    struct Edge {
+        uint32_t a, b, triangle;
+        double weight;        ///< cot(opposite angle) / 2
+        Eigen::Vector3d edge; ///< source p_a - p_b
+    };
+    void rightHandSide(double tau, bool derivative, Eigen::MatrixXd& rhs) const;
+    void solve(const Eigen::MatrixXd& rhs, Eigen::MatrixXd& x) const;
+
+    std::vector<Triangle> mTriangles;
+    std::vector<Edge> mEdges;
+    int mRows = 0;                ///< of the reduced system: the vertices not held
+    std::vector<int> mFree;       ///< vertex -> row of the reduced system, -1 for a held vertex
+    std::vector<uint32_t> mPiece; ///< vertex -> its connected piece
+    std::vector<Eigen::Vector3d> mSourceMean, mTargetMean; ///< per piece
+    std::vector<double> mPieceSize;
+    Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> mSolver;
+};
+
+} // namespace volmorph::detail
