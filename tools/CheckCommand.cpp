@@ -4,6 +4,7 @@
 
 #include <volmorph/Frames.h>
 #include <volmorph/Scene.h>
+#include <volmorph/SceneSurface.h>
 #include <volmorph/SceneVolumes.h>
 #include <volmorph/Schedule.h>
 #include <volmorph/VolumeInput.h>
@@ -176,6 +177,7 @@ void printSettings(const Scene& scene)
     std::printf("blend   %s mode; density %s, colour %s, sdf %s\n",
                 b.mode == BlendMode::Sdf           ? "sdf"
                 : b.mode == BlendMode::Variational ? "variational"
+                : b.mode == BlendMode::Surface     ? "surface"
                                                    : "density",
                 describe(b.density).c_str(), describe(b.color).c_str(), describe(b.sdf).c_str());
     if (b.mode == BlendMode::Variational) {
@@ -214,6 +216,21 @@ void printSettings(const Scene& scene)
         std::printf("; shadow caches every %d voxels\n", r.shadowCacheVoxels);
     else
         std::printf("; exact transmittance toward lights\n");
+}
+
+/// Surface mode: the correspondence the meshes get (auto resolved) and how vertices travel.
+void printSurface(const Scene& scene)
+{
+    const SceneSurface surface(scene); // imports both meshes and puts them into correspondence
+    const SurfaceMorpher& m = surface.morpher();
+    const std::string used = name(m.correspondence());
+    std::printf("surface %s correspondence%s: %zu vertices, %zu triangles at every frame; %s "
+                "interpolation (positions on the sdf schedule, colours on the colour schedule)\n",
+                used.c_str(), scene.surface.correspondence == Correspondence::Auto ? " (auto)" : "",
+                m.vertexCount(), m.triangleCount(), name(scene.surface.interpolation));
+    if (!scene.pairs.empty())
+        std::printf("        %zu landmark pairs: not used by the identity (vertex i is vertex i)\n",
+                    scene.pairs.size());
 }
 
 /// An environment light, and its sky map's size once read.
@@ -309,6 +326,7 @@ int runCheck(const std::string& scenePath)
     printVolume(scene, meshes, source, target);
     printPairs(scene);
     printSettings(scene);
+    if (scene.blend.mode == BlendMode::Surface) printSurface(scene);
     printView(scene.render);
     printProps(scene);
     printFrames(scene);

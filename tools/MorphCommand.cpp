@@ -1,4 +1,5 @@
-// volmorph morph SCENE [--frames SPEC] [-o PATTERN.vdb]: one .vdb of the in-between per frame.
+// volmorph morph SCENE [--frames SPEC] [-o PATTERN.vdb]: one .vdb of the in-between per frame; in
+// surface mode -o PATTERN.ply|.obj writes the surface stage's mesh of each frame.
 #include "Common.h"
 #include "FrameLoop.h"
 #include "SceneMorph.h"
@@ -6,6 +7,7 @@
 #include <volmorph/Export.h>
 #include <volmorph/Frames.h>
 #include <volmorph/Morph.h>
+#include <volmorph/SceneSurface.h>
 #include <volmorph/core/Version.h>
 #include <volmorph/Voxelize.h>
 
@@ -48,16 +50,53 @@ void writeFrame(const VolumeSet& v, const std::filesystem::path& file, const Mor
     }
 }
 
+bool isMeshPattern(const std::string& pattern)
+{
+    const std::string ext = std::filesystem::path(pattern).extension().string();
+    return ext == ".ply" || ext == ".obj";
+}
+
+/// Surface mode's meshes, one per frame: every frame the same vertices and triangles, with the
+/// exact vertex velocity (world units per second) in a PLY's vx vy vz.
+void writeSurfaceFrames(const Scene& scene, const std::vector<int>& frames,
+                        const std::string& pattern, const MorphArgs& args)
+{
+    if (!args.mesh.empty() || !args.side.empty() || args.exact)
+        throw UserError(SourceLocation{!args.mesh.empty()   ? "--mesh"
+                                       : !args.side.empty() ? "--side"
+                                                            : "--exact"},
+                        "blend.mode = \"surface\" makes meshes: -o out.####.ply writes them "
+                        "(--mesh, --side and --exact are the volume modes')");
+    Interrupter interrupter(false, args.verbose);
+    StopSignals signals(interrupter);
+    interrupter.start("surface correspondence");
+    const SceneSurface surface(scene);
+    interrupter.end();
+    FrameLoop loop(scene, frames, 1, args.quiet, true, interrupter);
+    loop.run([&](const FrameStep& step) {
+        const SurfaceFrame f = surface.frame(step.frame);
+        const std::filesystem::path file = frameFileName(pattern, step.frame);
+        if (file.has_parent_path()) std::filesystem::create_directories(file.parent_path());
+        writeSurfaceFrame(f, file);
+        return FrameResult{FrameResult::Outcome::Done,
+                           std::to_string(f.points.size()) + " vertices, " +
+                               std::to_string(f.triangles.size()) + " triangles",
+                           file.string()};
+    });
+}
+
 int runMorph(const MorphArgs& args)
 {
     Scene scene = loadScene(args.scene);
     const std::vector<int> frames = selectFrames(scene.frames, args.frames, "--frames");
-    // Default: the scene's output pattern with .vdb for .exr, relative to the scene's folder.
+    const bool surface = scene.blend.mode == BlendMode::Surface;
+    // Default: the scene's output pattern with .vdb for .exr (.ply in surface mode), relative to
+    // the scene's folder.
     std::string pattern = args.output;
     if (pattern.empty())
-        pattern =
-            (scene.folder / std::filesystem::path(scene.frames.output).replace_extension(".vdb"))
-                .string();
+        pattern = (scene.folder / std::filesystem::path(scene.frames.output)
+                                      .replace_extension(surface ? ".ply" : ".vdb"))
+                      .string();
     if (const std::string why = checkFramePattern(pattern); !why.empty())
         throw UserError(SourceLocation{"-o"}, "\"" + pattern + "\": " + why);
     if (frames.size() > 1 && frameFileName(pattern, frames[0]) == frameFileName(pattern, frames[1]))
@@ -71,7 +110,21 @@ int runMorph(const MorphArgs& args)
             throw UserError(SourceLocation{"--mesh"},
                             "expected a pattern ending in .ply or .obj, got \"" + args.mesh + "\"");
     }
+    if (isMeshPattern(pattern)) {
+        if (!surface)
+            throw UserError(SourceLocation{"-o"},
+                            "\"" + pattern +
+                                "\": a mesh per frame is surface mode's output (blend.mode = "
+                                "\"surface\"); for a volume mode's surface use -o out.####.vdb "
+                                "--mesh out.####.ply");
+        writeSurfaceFrames(scene, frames, pattern, args);
+        return 0;
+    }
     if (args.exact) scene.warp.toleranceVoxels = 0.0;
+    if (!args.side.empty() && surface)
+        throw UserError(SourceLocation{"--side"},
+                        "blend.mode = \"surface\" warps neither side; --side shows how a side "
+                        "bends under the warp, in density and sdf modes");
     if (!args.side.empty() && scene.blend.mode == BlendMode::Variational)
         throw UserError(SourceLocation{"--side"},
                         "blend.mode = \"variational\" warps neither side (its in-betweens are "
@@ -115,7 +168,8 @@ Command addMorphCommand(CLI::App& app)
                     "frames to write, e.g. 1-10, 1-100x2, 1,5,10-20 (default: all)");
     sub->add_option(
         "-o,--output", args->output,
-        "output pattern, e.g. out/morph.####.vdb (default: the scene's output with .vdb)");
+        "output pattern, e.g. out/morph.####.vdb; in surface mode also out/morph.####.ply or .obj, "
+        "one mesh per frame (default: the scene's output with .vdb, .ply in surface mode)");
     sub->add_option(
         "--mesh", args->mesh,
         "also write each in-between's surface, e.g. out/morph.####.ply (PLY with colours, or OBJ)");

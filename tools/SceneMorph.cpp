@@ -17,6 +17,10 @@ SceneMorph::SceneMorph(const Scene& scene, const CacheArgs& cache, Interrupter& 
     : mScene(scene), mFixed(scene), mCache(cache), mInterrupter(interrupter), mOptions(options),
       mQuiet(quiet)
 {
+    if (scene.blend.mode == BlendMode::Surface) {
+        mSurface.emplace(scene);
+        return;
+    }
     if (hasSequence(scene)) {
         const Scene first = sceneAtFrame(scene, scene.frames.first);
         const auto [source, target] = sceneExtents(first, importSceneMeshes(first));
@@ -48,7 +52,10 @@ VolumeSet SceneMorph::frame(int frame, MorphStats* stats)
     if (hasSequence(mScene)) load(frame);
     const std::string stage = "frame " + std::to_string(frame) + ": morph";
     mInterrupter.start(stage.c_str());
-    VolumeSet v = mMorpher->frame(mScene.frames.t(frame), stats, &mInterrupter);
+    VolumeSet v = mSurface ? mSurface->voxels(mSurface->frame(frame), &mInterrupter,
+                                              mOptions.memoryLimitBytes)
+                           : mMorpher->frame(mScene.frames.t(frame), stats, &mInterrupter);
+    if (mSurface && stats) stats->activeVoxels = v.density->activeVoxelCount();
     mInterrupter.end();
     if (mInterrupter.stopRequested()) throw Interrupted();
     return v;

@@ -1,12 +1,14 @@
 // The scene's morph, ready to give frames: source and target through the voxel cache, then the
 // Morpher. Shared by `morph`, `render` and `preview`. A side that is a volume sequence changes with
 // the frame: its file for each frame is read (through the cache, keyed on that file) and the
-// Morpher rebuilt when a frame's inputs differ from the last frame's.
+// Morpher rebuilt when a frame's inputs differ from the last frame's. In surface mode the frames
+// are the surface stage's meshes voxelized at the scene's voxel size (SceneSurface.h).
 #pragma once
 
 #include "Common.h"
 
 #include <volmorph/Morph.h>
+#include <volmorph/SceneSurface.h>
 
 #include <filesystem>
 #include <optional>
@@ -40,6 +42,7 @@ private:
     bool mQuiet;
     std::pair<std::filesystem::path, std::filesystem::path> mLoaded; ///< the Morpher's inputs
     std::optional<Morpher> mMorpher;
+    std::optional<SceneSurface> mSurface; ///< surface mode
 };
 
 } // namespace volmorph::cli

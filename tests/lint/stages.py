@@ -21,7 +21,7 @@ HEADERS = {
     "Schedule.h": "blend", "BlendSettings.h": "blend",
     "Morph.h": "morph", "Export.h": "export",
     "Scene.h": "scene", "Frames.h": "scene", "SceneDocument.h": "scene",
-    "SceneVolumes.h": "sides", "VoxelCache.h": "sides",
+    "SceneVolumes.h": "sides", "VoxelCache.h": "sides", "SceneSurface.h": "sides",
     "SurfaceSettings.h": "surface", "SurfaceMorph.h": "surface",
 }
 
@@ -38,10 +38,10 @@ ALLOWED = {
     "blend": {"core", "volumeset", "voxelize", "feature", "warp", "blend"},
     "morph": {"core", "volumeset", "voxelize", "feature", "warp", "blend", "morph"},
     "surface": {"core", "mesh", "surface"},
-    "export": {"core", "volumeset", "mesh", "export"},
+    "export": {"core", "volumeset", "mesh", "surface", "export"},
     "scene": {"core", "feature", "warp", "blend", "volume", "surface", "scene"},
-    "sides": {"core", "volumeset", "mesh", "voxelize", "volume", "export", "feature", "surface",
-              "scene", "sides"},
+    "sides": {"core", "volumeset", "mesh", "voxelize", "volume", "export", "feature", "blend",
+              "surface", "scene", "sides"},
 }
 
 INCLUDE = re.compile(r'^\s*#\s*include\s*[<"]([^>"]+)[>"]', re.M)

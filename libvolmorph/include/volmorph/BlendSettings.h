@@ -12,7 +12,8 @@
 
 namespace volmorph {
 
-enum class BlendMode { Density, Sdf, Variational };
+/// Surface: no voxels are blended; the surface stage makes one mesh per frame (SurfaceMorph.h).
+enum class BlendMode { Density, Sdf, Variational, Surface };
 
 /// Turk and O'Brien's variational implicit morph (BlendMode::Variational).
 struct VariationalSpec {

@@ -6,6 +6,7 @@
 #pragma once
 
 #include <volmorph/BlendSettings.h>
+#include <volmorph/SurfaceSettings.h>
 #include <volmorph/FeaturePair.h>
 #include <volmorph/VolumeSource.h>
 #include <volmorph/WarpSettings.h>
@@ -174,6 +175,7 @@ struct Scene {
     WarpSpec warp;
     BlendSpec blend;
     std::vector<InfluenceSpec> influences; ///< [variational] influence (variational mode only)
+    SurfaceSpec surface;                   ///< [surface] (surface mode only)
     RenderSpec render;
     std::vector<PropSpec> props;
     FramesSpec frames;

@@ -48,6 +48,7 @@
 
 #include <cstdint>
 #include <optional>
+#include <vector>
 
 namespace volmorph {
 
@@ -62,6 +63,10 @@ struct VoxelizeOptions {
     float densityRampVoxels = 1.5f;
     /// A constant colour instead of the mesh's vertex colours.
     std::optional<Vec3f> color;
+    /// Per vertex of the mesh, world units per second: when given, VolumeSet::velocity holds it
+    /// on the sdf's band, interpolated at each voxel's closest surface point as the colours are
+    /// (a hole's patch vertices move with nothing: zero). Empty: no velocity grid.
+    std::vector<Vec3f> vertexVelocity;
     /// Refuse to start when the estimate exceeds this many bytes; 0 = half the machine's RAM.
     uint64_t memoryLimitBytes = 0;
     enum class Sign { Auto, FloodFill, WindingNumber };

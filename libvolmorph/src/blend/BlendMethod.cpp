@@ -17,6 +17,8 @@ std::unique_ptr<const BlendMethod> makeBlendMethod(const BlendSetup& setup)
         return makeSdfBlend(setup);
     case BlendMode::Variational:
         return makeVariationalBlend(setup);
+    case BlendMode::Surface:
+        throw std::logic_error("makeBlendMethod: surface mode blends no voxels (SceneSurface.h)");
     }
     throw std::logic_error("makeBlendMethod: unknown blend mode");
 }

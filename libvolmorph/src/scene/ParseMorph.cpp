@@ -1,4 +1,4 @@
-// [warp] (weights, tolerance), [blend] (mode, schedules, dust) and [variational].
+// [warp] (weights, tolerance), [blend] (mode, schedules, dust), [variational] and [surface].
 #include "TableParsers.h"
 
 #include <cmath>
@@ -11,6 +11,7 @@ namespace {
 const std::vector<std::string> kWarpKeys = {"epsilon", "tolerance", "weighting", "a", "b", "p"};
 const std::vector<std::string> kBlendKeys = {"mode", "density",    "color",
                                              "sdf",  "min_island", "grids"};
+const std::vector<std::string> kSurfaceKeys = {"correspondence", "interpolation", "kernel"};
 const std::vector<std::string> kVariationalKeys = {"constraints", "normal_offset", "time_scale",
                                                    "influence"};
 
@@ -138,9 +139,10 @@ void parseBlend(Reader& r, const toml::node& node, BlendSpec& b)
     r.checkKeys(*t, "blend", kBlendKeys);
 
     if (const toml::node* n = t->get("mode"))
-        if (auto s = r.choice(*n, "blend.mode", {"density", "sdf", "variational"}))
+        if (auto s = r.choice(*n, "blend.mode", {"density", "sdf", "variational", "surface"}))
             b.mode = *s == "sdf"           ? BlendMode::Sdf
                      : *s == "variational" ? BlendMode::Variational
+                     : *s == "surface"     ? BlendMode::Surface
                                            : BlendMode::Density;
     if (const toml::node* n = t->get("density")) parseSchedule(r, *n, "blend.density", b.density);
     if (const toml::node* n = t->get("color")) parseSchedule(r, *n, "blend.color", b.color);
@@ -192,6 +194,51 @@ void parseVariational(Reader& r, const toml::node& node, const std::filesystem::
                 }
                 influences.push_back(std::move(influence));
             });
+}
+
+void parseSurface(Reader& r, const toml::node& node, SurfaceSpec& s)
+{
+    const toml::table* t = r.table(node, "surface");
+    if (!t) return;
+    r.checkKeys(*t, "surface", kSurfaceKeys);
+    s.where = r.at(node);
+    if (const toml::node* n = t->get("correspondence")) {
+        s.correspondenceWhere = r.at(*n);
+        if (auto c = r.choice(*n, "surface.correspondence",
+                              {"auto", "identity", "star", "sphere", "disk"})) {
+            s.correspondence = *c == "identity" ? Correspondence::Identity
+                               : *c == "star"   ? Correspondence::Star
+                               : *c == "sphere" ? Correspondence::Sphere
+                               : *c == "disk"   ? Correspondence::Disk
+                                                : Correspondence::Auto;
+            if (*c == "star" || *c == "sphere" || *c == "disk")
+                r.error(r.at(*n), "surface.correspondence: \"" + *c +
+                                      "\" is not in this version of volmorph; \"identity\" "
+                                      "(the same vertices and triangles on both sides) and "
+                                      "\"auto\" are");
+        }
+    }
+    if (const toml::node* n = t->get("interpolation"))
+        if (auto i = r.choice(*n, "surface.interpolation", {"arap", "linear"}))
+            s.interpolation =
+                *i == "linear" ? SurfaceInterpolation::Linear : SurfaceInterpolation::Arap;
+    if (const toml::node* n = t->get("kernel")) {
+        const toml::table* k = r.table(*n, "surface.kernel");
+        if (!k) return;
+        r.checkKeys(*k, "surface.kernel", {"source", "target"});
+        std::optional<Vec3d> a, b;
+        if (const toml::node* p = k->get("source"))
+            a = r.vec3(*p, "surface.kernel.source");
+        else
+            r.missing(*k, "surface.kernel.source", "a point inside the source, [x, y, z]");
+        if (const toml::node* p = k->get("target"))
+            b = r.vec3(*p, "surface.kernel.target");
+        else
+            r.missing(*k, "surface.kernel.target", "a point inside the target, [x, y, z]");
+        if (a && b) s.kernel = std::pair{*a, *b};
+        if (s.correspondence != Correspondence::Star)
+            r.error(r.at(*n), "surface.kernel: only used with correspondence = \"star\"");
+    }
 }
 
 } // namespace volmorph::detail

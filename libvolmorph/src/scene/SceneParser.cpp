@@ -26,8 +26,9 @@ using detail::typeName;
 
 // Keys allowed at the root and in [frames]; each table group's are in its unit. Anything else is
 // reported with a "did you mean" for near misses.
-const std::vector<std::string> kRootKeys = {"source", "target",      "volume", "pair", "warp",
-                                            "blend",  "variational", "render", "prop", "frames"};
+const std::vector<std::string> kRootKeys = {"source", "target", "volume",  "pair",
+                                            "warp",   "blend",  "surface", "variational",
+                                            "render", "prop",   "frames"};
 const std::vector<std::string> kFramesKeys = {"range", "output", "fps"};
 
 class SceneParser {
@@ -62,6 +63,12 @@ public:
             if (mScene.blend.mode != BlendMode::Variational)
                 r.error(r.at(*n), "[variational]: only used with blend.mode = \"variational\"");
         }
+        if (const toml::node* n = root.get("surface")) {
+            detail::parseSurface(r, *n, mScene.surface);
+            if (mScene.blend.mode != BlendMode::Surface)
+                r.error(r.at(*n), "[surface]: only used with blend.mode = \"surface\"");
+        }
+        if (mScene.blend.mode == BlendMode::Surface) checkSurfaceMode();
         if (const toml::node* n = root.get("render"))
             detail::parseRender(r, *n, mScene.folder, mScene.render);
         if (const toml::node* n = root.get("prop"))
@@ -77,6 +84,20 @@ public:
     }
 
 private:
+    /// Surface mode morphs two meshes; its point pairs are landmarks, other pairs have no meaning.
+    void checkSurfaceMode()
+    {
+        for (const ObjectSpec* side : {&mScene.source, &mScene.target})
+            if (side->isVolume())
+                r.error(side->fileWhere, "blend.mode = \"surface\" morphs two meshes; " +
+                                             side->volume.filename().string() +
+                                             " is a volume (use density, sdf or variational)");
+        for (const FeaturePairSpec& p : mScene.pairs)
+            if (p.type != FeatureType::Point)
+                r.error(p.where, "[[pair]]: blend.mode = \"surface\" takes point pairs only "
+                                 "(landmarks that meet)");
+    }
+
     void parseFrames(const toml::node& node)
     {
         const toml::table* t = r.table(node, "frames");

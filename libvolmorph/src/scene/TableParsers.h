@@ -34,6 +34,8 @@ void parseBlend(Reader& r, const toml::node& node, BlendSpec& blend);
 /// [variational], its influence shapes' files resolved against `folder`.
 void parseVariational(Reader& r, const toml::node& node, const std::filesystem::path& folder,
                       VariationalSpec& variational, std::vector<InfluenceSpec>& influences);
+/// [surface] (surface mode): correspondence, interpolation, kernel.
+void parseSurface(Reader& r, const toml::node& node, SurfaceSpec& surface);
 /// [render], its camera and lights (with their keys); a sky map's path resolved against `folder`.
 void parseRender(Reader& r, const toml::node& node, const std::filesystem::path& folder,
                  RenderSpec& render);

@@ -42,66 +42,47 @@ Eigen::Matrix3d cross(const Eigen::Vector3d& k)
 
 } // namespace
 
+namespace {
+
+/// The polar decomposition of a triangle's map from source to target, and its rotation's axis and
+/// angle.
+RigidInterpolation::Triangle decompose(const Mesh& source, const Mesh& target, const Vec3I& t)
+{
+    RigidInterpolation::Triangle tri;
+    Eigen::Matrix3d p, q;
+    if (!triangleFrame(source, t, p) || !triangleFrame(target, t, q)) {
+        tri.rotation = tri.stretch = Eigen::Matrix3d::Identity();
+        tri.axis = Eigen::Vector3d::UnitZ();
+        return tri;
+    }
+    // A = Q P^-1 = R S; R = U V^T (a rotation: both frames are right-handed), S = V Sigma V^T.
+    const Eigen::JacobiSVD<Eigen::Matrix3d> svd(q * p.inverse(),
+                                                Eigen::ComputeFullU | Eigen::ComputeFullV);
+    Eigen::Matrix3d u = svd.matrixU();
+    Eigen::Vector3d sigma = svd.singularValues();
+    const Eigen::Matrix3d& v = svd.matrixV();
+    if ((u * v.transpose()).determinant() < 0.0) {
+        u.col(2) = -u.col(2);
+        sigma(2) = -sigma(2);
+    }
+    tri.rotation = u * v.transpose();
+    tri.stretch = v * sigma.asDiagonal() * v.transpose();
+    const Eigen::AngleAxisd turn(tri.rotation);
+    tri.axis = turn.axis();
+    tri.angle = turn.angle();
+    return tri;
+}
+
+} // namespace
+
 RigidInterpolation::RigidInterpolation(const Mesh& source, const Mesh& target)
 {
-    const size_t n = source.points.size();
-    // Pieces: a vertex of each is held at the origin (the energy does not see translations).
-    DisjointSets sets(n);
-    for (const Vec3I& t : source.triangles) {
-        sets.unite(t[0], t[1]);
-        sets.unite(t[1], t[2]);
-    }
-    std::vector<int> pieceOfRoot(n, -1);
-    mPiece.resize(n);
-    mFree.assign(n, -1);
-    int rows = 0;
-    for (uint32_t v = 0; v < n; ++v) {
-        int& piece = pieceOfRoot[sets.find(v)];
-        if (piece < 0) { // the piece's first vertex: held
-            piece = int(mSourceMean.size());
-            mSourceMean.emplace_back(Eigen::Vector3d::Zero());
-            mTargetMean.emplace_back(Eigen::Vector3d::Zero());
-            mPieceSize.push_back(0.0);
-        } else {
-            mFree[v] = rows++;
-        }
-        mPiece[v] = uint32_t(piece);
-        mSourceMean[piece] += toEigen(source.points[v]);
-        mTargetMean[piece] += toEigen(target.points[v]);
-        mPieceSize[piece] += 1.0;
-    }
-    for (size_t i = 0; i < mPieceSize.size(); ++i) {
-        mSourceMean[i] /= mPieceSize[i];
-        mTargetMean[i] /= mPieceSize[i];
-    }
-
+    findPieces(source, target);
     std::vector<Eigen::Triplet<double>> entries;
     mTriangles.resize(source.triangles.size());
     for (uint32_t j = 0; j < source.triangles.size(); ++j) {
         const Vec3I& t = source.triangles[j];
-        Triangle& tri = mTriangles[j];
-        Eigen::Matrix3d p, q;
-        if (!triangleFrame(source, t, p) || !triangleFrame(target, t, q)) {
-            tri.rotation = tri.stretch = Eigen::Matrix3d::Identity();
-            tri.axis = Eigen::Vector3d::UnitZ();
-        } else {
-            // A = Q P^-1 = R S; R = U V^T (a rotation: both frames are right-handed), S = V Sigma
-            // V^T.
-            const Eigen::JacobiSVD<Eigen::Matrix3d> svd(q * p.inverse(),
-                                                        Eigen::ComputeFullU | Eigen::ComputeFullV);
-            Eigen::Matrix3d u = svd.matrixU();
-            Eigen::Vector3d sigma = svd.singularValues();
-            const Eigen::Matrix3d& v = svd.matrixV();
-            if ((u * v.transpose()).determinant() < 0.0) {
-                u.col(2) = -u.col(2);
-                sigma(2) = -sigma(2);
-            }
-            tri.rotation = u * v.transpose();
-            tri.stretch = v * sigma.asDiagonal() * v.transpose();
-            const Eigen::AngleAxisd turn(tri.rotation);
-            tri.axis = turn.axis();
-            tri.angle = turn.angle();
-        }
+        mTriangles[j] = decompose(source, target, t);
         // The cotangent weight of each edge, from the source's angle opposite it.
         for (int c = 0; c < 3; ++c) {
             const uint32_t k = t[c], a = t[(c + 1) % 3], b = t[(c + 2) % 3];
@@ -121,13 +102,45 @@ RigidInterpolation::RigidInterpolation(const Mesh& source, const Mesh& target)
             }
         }
     }
-    mRows = rows;
-    if (rows == 0) return;
-    Eigen::SparseMatrix<double> laplacian(rows, rows);
+    if (mRows == 0) return;
+    Eigen::SparseMatrix<double> laplacian(mRows, mRows);
     laplacian.setFromTriplets(entries.begin(), entries.end());
     mSolver.compute(laplacian);
     if (mSolver.info() != Eigen::Success)
         throw std::runtime_error("the mesh's cotangent Laplacian cannot be factored");
+}
+
+void RigidInterpolation::findPieces(const Mesh& source, const Mesh& target)
+{
+    const size_t n = source.points.size();
+    // A vertex of each piece is held at the origin (the energy does not see translations).
+    DisjointSets sets(n);
+    for (const Vec3I& t : source.triangles) {
+        sets.unite(t[0], t[1]);
+        sets.unite(t[1], t[2]);
+    }
+    std::vector<int> pieceOfRoot(n, -1);
+    mPiece.resize(n);
+    mFree.assign(n, -1);
+    for (uint32_t v = 0; v < n; ++v) {
+        int& piece = pieceOfRoot[sets.find(v)];
+        if (piece < 0) { // the piece's first vertex: held
+            piece = int(mSourceMean.size());
+            mSourceMean.emplace_back(Eigen::Vector3d::Zero());
+            mTargetMean.emplace_back(Eigen::Vector3d::Zero());
+            mPieceSize.push_back(0.0);
+        } else {
+            mFree[v] = mRows++;
+        }
+        mPiece[v] = uint32_t(piece);
+        mSourceMean[piece] += toEigen(source.points[v]);
+        mTargetMean[piece] += toEigen(target.points[v]);
+        mPieceSize[piece] += 1.0;
+    }
+    for (size_t i = 0; i < mPieceSize.size(); ++i) {
+        mSourceMean[i] /= mPieceSize[i];
+        mTargetMean[i] /= mPieceSize[i];
+    }
 }
 
 void RigidInterpolation::rightHandSide(double tau, bool derivative, Eigen::MatrixXd& rhs) const

@@ -37,17 +37,20 @@ public:
     /// Positions at `tau`, and d position / d tau when `velocity` is not null.
     void positions(double tau, std::vector<Vec3d>& out, std::vector<Vec3d>* velocity) const;
 
-private:
+    /// One triangle's map from source to target, A = rotation * stretch.
     struct Triangle {
         Eigen::Matrix3d rotation, stretch; ///< A = rotation * stretch
         Eigen::Vector3d axis;              ///< of the rotation, unit
         double angle = 0.0;                ///< of the rotation, radians in [0, pi]
     };
+
+private:
     struct Edge {
         uint32_t a, b, triangle;
         double weight;        ///< cot(opposite angle) / 2
         Eigen::Vector3d edge; ///< source p_a - p_b
     };
+    void findPieces(const Mesh& source, const Mesh& target);
     void rightHandSide(double tau, bool derivative, Eigen::MatrixXd& rhs) const;
     void solve(const Eigen::MatrixXd& rhs, Eigen::MatrixXd& x) const;
 

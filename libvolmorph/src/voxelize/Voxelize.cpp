@@ -35,6 +35,49 @@ std::string gib(uint64_t bytes)
     return s.str();
 }
 
+/// A vertex attribute on the band: `values` (one per vertex of `mesh`, or fewer: the rest are 0)
+/// interpolated at each voxel's closest point on its closest triangle; `mean` where there is none.
+void attributeFromIndex(const Mesh& mesh, const std::vector<Vec3f>& values, const Int32Grid& index,
+                        const FloatGrid& sdf, Vec3SGrid& grid)
+{
+    grid.tree().topologyUnion(sdf.tree());
+    using AttributeTree = Vec3SGrid::TreeType;
+    openvdb::tree::LeafManager<AttributeTree> leaves(grid.tree());
+    const openvdb::math::Transform& xform = sdf.transform();
+    const Vec3f mean = grid.background();
+    auto value = [&](uint32_t v) { return v < values.size() ? Vec3d(values[v]) : Vec3d(0.0); };
+    leaves.foreach ([&](AttributeTree::LeafNodeType& leaf, size_t) {
+        const auto* indexLeaf = index.tree().probeConstLeaf(leaf.origin());
+        for (auto it = leaf.beginValueOn(); it; ++it) {
+            Vec3f c = mean;
+            if (indexLeaf) {
+                const int32_t t = indexLeaf->getValue(it.pos());
+                if (t >= 0 && size_t(t) < mesh.triangles.size()) {
+                    const Vec3I& tri = mesh.triangles[size_t(t)];
+                    Vec3d uvw;
+                    openvdb::math::closestPointOnTriangleToPoint(
+                        Vec3d(mesh.points[tri[0]]), Vec3d(mesh.points[tri[1]]),
+                        Vec3d(mesh.points[tri[2]]), xform.indexToWorld(it.getCoord()), uvw);
+                    c = Vec3f(uvw[0] * value(tri[0]) + uvw[1] * value(tri[1]) +
+                              uvw[2] * value(tri[2]));
+                }
+            }
+            it.setValue(c);
+        }
+    });
+}
+
+Vec3SGrid::Ptr bandGrid(const FloatGrid& sdf, const Vec3f& background, const char* name,
+                        openvdb::VecType type)
+{
+    auto grid = Vec3SGrid::create(background);
+    grid->setTransform(sdf.transform().copy());
+    grid->setName(name);
+    grid->setGridClass(openvdb::GRID_UNKNOWN);
+    grid->setVectorType(type);
+    return grid;
+}
+
 /// Colour on the band: vertex colours interpolated at the closest point of the closest triangle.
 Vec3SGrid::Ptr colorFromIndex(const Mesh& mesh, const Int32Grid* index, const FloatGrid& sdf,
                               const std::optional<Vec3f>& constant)
@@ -47,11 +90,7 @@ Vec3SGrid::Ptr colorFromIndex(const Mesh& mesh, const Int32Grid* index, const Fl
         for (const Vec3f& c : mesh.colors) sum += Vec3d(c);
         mean = Vec3f(sum / double(mesh.colors.size()));
     }
-    auto color = Vec3SGrid::create(mean);
-    color->setTransform(sdf.transform().copy());
-    color->setName(kColorGridName);
-    color->setGridClass(openvdb::GRID_UNKNOWN);
-    color->setVectorType(openvdb::VEC_INVARIANT);
+    auto color = bandGrid(sdf, mean, kColorGridName, openvdb::VEC_INVARIANT);
     const bool interpolate = !constant && mesh.hasColors() && index;
     if (!interpolate) {
         // One colour everywhere: active tiles over the band's blocks, no voxels (a 1000-across
@@ -60,30 +99,7 @@ Vec3SGrid::Ptr colorFromIndex(const Mesh& mesh, const Int32Grid* index, const Fl
             color->tree().addTile(1, leaf->origin(), mean, true);
         return color;
     }
-    color->tree().topologyUnion(sdf.tree());
-    using ColorTree = Vec3SGrid::TreeType;
-    openvdb::tree::LeafManager<ColorTree> leaves(color->tree());
-    const openvdb::math::Transform& xform = sdf.transform();
-    leaves.foreach ([&](ColorTree::LeafNodeType& leaf, size_t) {
-        const auto* indexLeaf = index->tree().probeConstLeaf(leaf.origin());
-        for (auto it = leaf.beginValueOn(); it; ++it) {
-            Vec3f c = mean;
-            if (indexLeaf) {
-                const int32_t t = indexLeaf->getValue(it.pos());
-                if (t >= 0 && size_t(t) < mesh.triangles.size()) {
-                    const Vec3I& tri = mesh.triangles[size_t(t)];
-                    Vec3d uvw;
-                    openvdb::math::closestPointOnTriangleToPoint(
-                        Vec3d(mesh.points[tri[0]]), Vec3d(mesh.points[tri[1]]),
-                        Vec3d(mesh.points[tri[2]]), xform.indexToWorld(it.getCoord()), uvw);
-                    c = Vec3f(uvw[0] * Vec3d(mesh.colors[tri[0]]) +
-                              uvw[1] * Vec3d(mesh.colors[tri[1]]) +
-                              uvw[2] * Vec3d(mesh.colors[tri[2]]));
-                }
-            }
-            it.setValue(c);
-        }
-    });
+    attributeFromIndex(mesh, mesh.colors, *index, sdf, *color);
     return color;
 }
 
@@ -208,7 +224,8 @@ VolumeSet voxelize(const Mesh& input, const VoxelizeOptions& options, Interrupte
 
     // The winding-number path refines OpenVDB's unsigned distances with the closest triangles.
     const bool winding = path == VoxelizeStats::SignPath::WindingNumber;
-    const bool needIndex = winding || (!options.color && mesh.hasColors());
+    const bool needIndex =
+        winding || (!options.color && mesh.hasColors()) || !options.vertexVelocity.empty();
     Int32Grid::Ptr index = needIndex ? Int32Grid::create(-1) : nullptr;
     openvdb::util::NullInterrupter none;
     openvdb::util::NullInterrupter& hook = interrupter ? *interrupter : none;
@@ -230,6 +247,11 @@ VolumeSet voxelize(const Mesh& input, const VoxelizeOptions& options, Interrupte
     out.density = fogFromLevelSet(*sdf, options.densityRampVoxels * float(voxelSize));
     throwIfInterrupted(interrupter, 90);
     out.color = colorFromIndex(mesh, index.get(), *sdf, options.color);
+    if (!options.vertexVelocity.empty()) {
+        out.velocity =
+            bandGrid(*sdf, Vec3f(0.0f), kVelocityGridName, openvdb::VEC_CONTRAVARIANT_RELATIVE);
+        attributeFromIndex(mesh, options.vertexVelocity, *index, *sdf, *out.velocity);
+    }
     throwIfInterrupted(interrupter, 100);
     if (interrupter) interrupter->end();
 

@@ -1,0 +1,44 @@
+// The sides stage's adapter for surface mode (blend.mode = "surface"): a scene's two meshes,
+// imported with the scene's colours and put into correspondence (SurfaceMorph.h), and each frame's
+// in-between with the scene's schedules applied: positions follow blend.sdf's schedule (the
+// shape's, as in sdf mode), colours blend.color's.
+#pragma once
+
+#include <volmorph/Scene.h>
+#include <volmorph/SurfaceMorph.h>
+#include <volmorph/VolumeSet.h>
+#include <volmorph/core/Interrupter.h>
+
+#include <cstdint>
+
+namespace volmorph {
+
+class SceneSurface {
+public:
+    /// Imports both meshes (UserError at their `mesh` keys when they cannot be read) and puts them
+    /// into correspondence (UserError at [surface] when it does not apply).
+    explicit SceneSurface(const Scene& scene);
+
+    /// Frame `frame`'s in-between; its velocity in world units per second (zero for a scene of one
+    /// frame, where t stands still).
+    SurfaceFrame frame(int frame) const;
+
+    /// The in-between voxelized at the scene's voxel size (Voxelize.h: sdf, density, Cd) with its
+    /// velocity as `vel` on the sdf's band (the vertex velocities interpolated at each voxel's
+    /// closest surface point, as the colours are).
+    VolumeSet voxels(const SurfaceFrame& frame, Interrupter* interrupter = nullptr,
+                     uint64_t memoryLimitBytes = 0) const;
+
+    const SurfaceMorpher& morpher() const { return mMorpher; }
+    double voxelSize() const { return mVoxelSize; }
+
+private:
+    SceneSurface(const Scene& scene, std::pair<Mesh, Mesh> meshes);
+
+    BlendSpec mBlend;
+    FramesSpec mFrames;
+    double mVoxelSize = 0.0;
+    SurfaceMorpher mMorpher;
+};
+
+} // namespace volmorph
