@@ -94,6 +94,10 @@ EditorSession::EditorSession(const std::filesystem::path& scene, int resolution,
     : mInterrupter(interrupter), mDocument(scene)
 {
     Scene preview = mDocument.scene();
+    if (preview.blend.mode == BlendMode::Surface)
+        throw UserError(SourceLocation{scene.string()},
+                        "blend.mode = \"surface\": the editor does not edit surface morphs yet "
+                        "(morph -o out.####.ply writes their frames)");
     preview.volume.voxelSize.reset();
     preview.volume.resolution = resolution;
     SceneVolumes volumes = voxelizeScene(preview, interrupter);
