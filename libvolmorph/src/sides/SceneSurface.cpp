@@ -14,6 +14,12 @@ Mesh coloured(Mesh mesh, const ObjectSpec& spec)
     return mesh;
 }
 
+SideExtent extentOf(const Mesh& mesh)
+{
+    const auto [lo, hi] = mesh.bounds();
+    return {lo, hi, {}};
+}
+
 std::pair<Mesh, Mesh> sceneMeshes(const Scene& scene)
 {
     SceneMeshes meshes = importSceneMeshes(scene);
@@ -27,9 +33,7 @@ SceneSurface::SceneSurface(const Scene& scene) : SceneSurface(scene, sceneMeshes
 
 SceneSurface::SceneSurface(const Scene& scene, std::pair<Mesh, Mesh> meshes)
     : mBlend(scene.blend), mFrames(scene.frames),
-      mVoxelSize(sceneVoxelSize(
-          scene.volume, SideExtent{meshes.first.bounds().first, meshes.first.bounds().second, {}},
-          SideExtent{meshes.second.bounds().first, meshes.second.bounds().second, {}})),
+      mVoxelSize(sceneVoxelSize(scene.volume, extentOf(meshes.first), extentOf(meshes.second))),
       mMorpher(std::move(meshes.first), std::move(meshes.second), scene.surface)
 {
 }
