@@ -5,6 +5,7 @@
 #include <Eigen/Geometry>
 #include <Eigen/SparseLU>
 
+#include <algorithm>
 #include <cmath>
 #include <string>
 #include <unordered_map>
@@ -127,8 +128,12 @@ std::vector<std::vector<uint32_t>> boundaryLoops(const Mesh& mesh, const SourceL
                 throw UserError(where, mesh.file.string() + ": a boundary that does not close");
             v = n->second;
         }
+        // Each loop from its smallest vertex, the loops by it: the same map whatever the hash
+        // order.
+        std::rotate(loop.begin(), std::min_element(loop.begin(), loop.end()), loop.end());
         loops.push_back(std::move(loop));
     }
+    std::sort(loops.begin(), loops.end());
     return loops;
 }
 
