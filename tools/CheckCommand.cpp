@@ -4,7 +4,7 @@
 
 #include <volmorph/Frames.h>
 #include <volmorph/Scene.h>
-#include <volmorph/SceneSurface.h>
+#include <volmorph/SurfaceMorph.h>
 #include <volmorph/SceneVolumes.h>
 #include <volmorph/Schedule.h>
 #include <volmorph/VolumeInput.h>
@@ -219,10 +219,9 @@ void printSettings(const Scene& scene)
 }
 
 /// Surface mode: the correspondence the meshes get (auto resolved) and how vertices travel.
-void printSurface(const Scene& scene)
+void printSurface(const Scene& scene, const SceneMeshes& meshes)
 {
-    const SceneSurface surface(scene); // imports both meshes and puts them into correspondence
-    const SurfaceMorpher& m = surface.morpher();
+    const SurfaceMorpher m(meshes.source, meshes.target, scene.surface); // or a UserError
     const std::string used = name(m.correspondence());
     std::printf("surface %s correspondence%s: %zu vertices, %zu triangles at every frame; %s "
                 "interpolation (positions on the sdf schedule, colours on the colour schedule)\n",
@@ -326,7 +325,7 @@ int runCheck(const std::string& scenePath)
     printVolume(scene, meshes, source, target);
     printPairs(scene);
     printSettings(scene);
-    if (scene.blend.mode == BlendMode::Surface) printSurface(scene);
+    if (scene.blend.mode == BlendMode::Surface) printSurface(scene, meshes);
     printView(scene.render);
     printProps(scene);
     printFrames(scene);

@@ -105,8 +105,7 @@ int runMorph(const MorphArgs& args)
     if (!args.mesh.empty()) {
         if (const std::string why = checkFramePattern(args.mesh); !why.empty())
             throw UserError(SourceLocation{"--mesh"}, "\"" + args.mesh + "\": " + why);
-        const std::string ext = std::filesystem::path(args.mesh).extension().string();
-        if (ext != ".ply" && ext != ".obj")
+        if (!isMeshPattern(args.mesh))
             throw UserError(SourceLocation{"--mesh"},
                             "expected a pattern ending in .ply or .obj, got \"" + args.mesh + "\"");
     }

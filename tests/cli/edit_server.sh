@@ -2,8 +2,8 @@
 # volmorph edit's server refuses what it must (issue 39): a request without the token or with a
 # wrong one (403), a foreign Host (403), a path outside the page's files (404, never a file from
 # disk), a 10 MB body (413), malformed JSON (400); it answers the API with the token, listens on
-# 127.0.0.1 only, writes nothing (the scene byte for byte as it was), and stops on SIGINT within
-# LIMIT seconds with status 0. The printed URL sets a per-session cookie and redirects to the page
+# 127.0.0.1 only, writes nothing (the scene byte for byte as it was), and stops on SIGINT with
+# status 0 (LIMIT scales the hang bound, 30 s; the stop's latency is tests/bench/stop_latency.sh's). The printed URL sets a per-session cookie and redirects to the page
 # without the token; every answer, refusals too, carries nosniff and a Content-Security-Policy, and
 # every error is JSON.
 # usage: edit_server.sh VOLMORPH SOURCE_DIR [LIMIT]

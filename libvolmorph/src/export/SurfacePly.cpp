@@ -1,4 +1,5 @@
-// A surface morph's frame as binary PLY with each vertex's velocity (vx vy vz), or as OBJ.
+// A surface morph's frame as binary PLY with each vertex's velocity (vx vy vz), or as OBJ. Written
+// here, not through Assimp: its exporter has no vertex properties of a program's own.
 #include <volmorph/Export.h>
 
 #include <volmorph/core/AtomicFile.h>

@@ -1,5 +1,6 @@
 #include "DiskMap.h"
 
+#include "Cotangent.h"
 #include "mesh/DisjointSets.h"
 
 #include <Eigen/Geometry>
@@ -53,21 +54,22 @@ std::vector<Weight> weights(const Mesh& mesh, bool meanValue)
 {
     std::vector<Weight> out;
     out.reserve(mesh.triangles.size() * 6);
+    if (!meanValue) { // each corner weighs the edge opposite it, both ways
+        forEachCotangentWeight(mesh, [&](uint32_t, uint32_t a, uint32_t b, double w) {
+            out.push_back({a, b, w});
+            out.push_back({b, a, w});
+        });
+        return out;
+    }
     for (const Vec3I& t : mesh.triangles)
         for (int c = 0; c < 3; ++c) {
             const uint32_t i = t[c], j = t[(c + 1) % 3], k = t[(c + 2) % 3];
             const Eigen::Vector3d ej = at(mesh, j) - at(mesh, i), ek = at(mesh, k) - at(mesh, i);
             const double sine = ej.cross(ek).norm(), cosine = ej.dot(ek);
             if (!(sine > 1e-300)) continue;
-            if (meanValue) {
-                const double half = std::tan(0.5 * std::atan2(sine, cosine));
-                out.push_back({i, j, half / ej.norm()});
-                out.push_back({i, k, half / ek.norm()});
-            } else { // the corner at i weighs the edge opposite it, (j, k), both ways
-                const double w = 0.5 * cosine / sine;
-                out.push_back({j, k, w});
-                out.push_back({k, j, w});
-            }
+            const double half = std::tan(0.5 * std::atan2(sine, cosine));
+            out.push_back({i, j, half / ej.norm()});
+            out.push_back({i, k, half / ek.norm()});
         }
     return out;
 }

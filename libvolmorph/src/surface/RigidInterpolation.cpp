@@ -1,5 +1,6 @@
 #include "RigidInterpolation.h"
 
+#include "Cotangent.h"
 #include "mesh/DisjointSets.h"
 
 #include <Eigen/Geometry>
@@ -78,30 +79,20 @@ RigidInterpolation::Triangle decompose(const Mesh& source, const Mesh& target, c
 RigidInterpolation::RigidInterpolation(const Mesh& source, const Mesh& target)
 {
     findPieces(source, target);
-    std::vector<Eigen::Triplet<double>> entries;
     mTriangles.resize(source.triangles.size());
-    for (uint32_t j = 0; j < source.triangles.size(); ++j) {
-        const Vec3I& t = source.triangles[j];
-        mTriangles[j] = decompose(source, target, t);
-        // The cotangent weight of each edge, from the source's angle opposite it.
-        for (int c = 0; c < 3; ++c) {
-            const uint32_t k = t[c], a = t[(c + 1) % 3], b = t[(c + 2) % 3];
-            const Eigen::Vector3d pk = toEigen(source.points[k]);
-            const Eigen::Vector3d ea = toEigen(source.points[a]) - pk;
-            const Eigen::Vector3d eb = toEigen(source.points[b]) - pk;
-            const double area2 = ea.cross(eb).norm();
-            if (!(area2 > 1e-300)) continue;
-            const double w = 0.5 * ea.dot(eb) / area2;
-            mEdges.push_back({a, b, j, w, toEigen(source.points[a]) - toEigen(source.points[b])});
-            const int ra = mFree[a], rb = mFree[b];
-            if (ra >= 0) entries.emplace_back(ra, ra, w);
-            if (rb >= 0) entries.emplace_back(rb, rb, w);
-            if (ra >= 0 && rb >= 0) {
-                entries.emplace_back(ra, rb, -w);
-                entries.emplace_back(rb, ra, -w);
-            }
+    for (uint32_t j = 0; j < source.triangles.size(); ++j)
+        mTriangles[j] = decompose(source, target, source.triangles[j]);
+    std::vector<Eigen::Triplet<double>> entries;
+    forEachCotangentWeight(source, [&](uint32_t j, uint32_t a, uint32_t b, double w) {
+        mEdges.push_back({a, b, j, w, toEigen(source.points[a]) - toEigen(source.points[b])});
+        const int ra = mFree[a], rb = mFree[b];
+        if (ra >= 0) entries.emplace_back(ra, ra, w);
+        if (rb >= 0) entries.emplace_back(rb, rb, w);
+        if (ra >= 0 && rb >= 0) {
+            entries.emplace_back(ra, rb, -w);
+            entries.emplace_back(rb, ra, -w);
         }
-    }
+    });
     if (mRows == 0) return;
     Eigen::SparseMatrix<double> laplacian(mRows, mRows);
     laplacian.setFromTriplets(entries.begin(), entries.end());
@@ -143,40 +134,38 @@ void RigidInterpolation::findPieces(const Mesh& source, const Mesh& target)
     }
 }
 
-void RigidInterpolation::rightHandSide(double tau, bool derivative, Eigen::MatrixXd& rhs) const
+void RigidInterpolation::rightHandSide(double tau, Eigen::MatrixXd& rhs) const
 {
-    std::vector<Eigen::Matrix3d> g(mTriangles.size());
+    // Per triangle G(tau) and dG/dtau, from one rotation and one stretch.
+    std::vector<Eigen::Matrix3d> g(mTriangles.size()), dg(mTriangles.size());
     for (size_t j = 0; j < mTriangles.size(); ++j) {
         const Triangle& t = mTriangles[j];
         const Eigen::Matrix3d turn = Eigen::AngleAxisd(tau * t.angle, t.axis).toRotationMatrix();
         const Eigen::Matrix3d stretch = (1.0 - tau) * Eigen::Matrix3d::Identity() + tau * t.stretch;
-        g[j] = derivative ? Eigen::Matrix3d(t.angle * cross(t.axis) * turn * stretch +
-                                            turn * (t.stretch - Eigen::Matrix3d::Identity()))
-                          : Eigen::Matrix3d(turn * stretch);
+        g[j] = turn * stretch;
+        dg[j] = t.angle * cross(t.axis) * g[j] + turn * (t.stretch - Eigen::Matrix3d::Identity());
     }
-    rhs.setZero(mRows, 3);
+    rhs.setZero(mRows, 6);
     for (const Edge& e : mEdges) {
-        const Eigen::RowVector3d wg = e.weight * (g[e.triangle] * e.edge).transpose();
+        Eigen::Matrix<double, 1, 6> wg;
+        wg << (g[e.triangle] * e.edge).transpose(), (dg[e.triangle] * e.edge).transpose();
+        wg *= e.weight;
         if (mFree[e.a] >= 0) rhs.row(mFree[e.a]) += wg;
         if (mFree[e.b] >= 0) rhs.row(mFree[e.b]) -= wg;
     }
 }
 
-void RigidInterpolation::solve(const Eigen::MatrixXd& rhs, Eigen::MatrixXd& x) const
-{
-    x = rhs.rows() ? Eigen::MatrixXd(mSolver.solve(rhs)) : Eigen::MatrixXd(0, 3);
-}
-
 void RigidInterpolation::positions(double tau, std::vector<Vec3d>& out,
-                                   std::vector<Vec3d>* velocity) const
+                                   std::vector<Vec3d>& velocity) const
 {
     const size_t n = mFree.size();
-    auto assemble = [&](const Eigen::MatrixXd& solved, const std::vector<Eigen::Vector3d>& centre,
-                        std::vector<Vec3d>& dest) {
+    // Columns 0-2 of `solved` (or 3-5), the pieces moved so their means lie at `centre`.
+    auto assemble = [&](const Eigen::MatrixXd& solved, int column,
+                        const std::vector<Eigen::Vector3d>& centre, std::vector<Vec3d>& dest) {
         std::vector<Eigen::Vector3d> y(n, Eigen::Vector3d::Zero());
         std::vector<Eigen::Vector3d> mean(mPieceSize.size(), Eigen::Vector3d::Zero());
         for (size_t v = 0; v < n; ++v) {
-            if (mFree[v] >= 0) y[v] = solved.row(mFree[v]).transpose();
+            if (mFree[v] >= 0) y[v] = solved.block<1, 3>(mFree[v], column).transpose();
             mean[mPiece[v]] += y[v];
         }
         dest.resize(n);
@@ -186,18 +175,16 @@ void RigidInterpolation::positions(double tau, std::vector<Vec3d>& out,
             dest[v] = Vec3d(x.x(), x.y(), x.z());
         }
     };
-    Eigen::MatrixXd rhs, solved;
-    std::vector<Eigen::Vector3d> centre(mPieceSize.size());
-    rightHandSide(tau, false, rhs);
-    solve(rhs, solved);
-    for (size_t p = 0; p < centre.size(); ++p)
+    Eigen::MatrixXd rhs;
+    rightHandSide(tau, rhs);
+    const Eigen::MatrixXd solved = mRows ? Eigen::MatrixXd(mSolver.solve(rhs)) : rhs;
+    std::vector<Eigen::Vector3d> centre(mPieceSize.size()), drift(mPieceSize.size());
+    for (size_t p = 0; p < centre.size(); ++p) {
         centre[p] = (1.0 - tau) * mSourceMean[p] + tau * mTargetMean[p];
-    assemble(solved, centre, out);
-    if (!velocity) return;
-    rightHandSide(tau, true, rhs);
-    solve(rhs, solved);
-    for (size_t p = 0; p < centre.size(); ++p) centre[p] = mTargetMean[p] - mSourceMean[p];
-    assemble(solved, centre, *velocity);
+        drift[p] = mTargetMean[p] - mSourceMean[p];
+    }
+    assemble(solved, 0, centre, out);
+    assemble(solved, 3, drift, velocity);
 }
 
 } // namespace volmorph::detail

@@ -34,8 +34,8 @@ public:
     /// the Laplacian cannot be factored (a mesh made of degenerate triangles only).
     RigidInterpolation(const Mesh& source, const Mesh& target);
 
-    /// Positions at `tau`, and d position / d tau when `velocity` is not null.
-    void positions(double tau, std::vector<Vec3d>& out, std::vector<Vec3d>* velocity) const;
+    /// Positions at `tau` and d position / d tau (one solve for both).
+    void positions(double tau, std::vector<Vec3d>& out, std::vector<Vec3d>& velocity) const;
 
     /// One triangle's map from source to target, A = rotation * stretch.
     struct Triangle {
@@ -51,8 +51,9 @@ private:
         Eigen::Vector3d edge; ///< source p_a - p_b
     };
     void findPieces(const Mesh& source, const Mesh& target);
-    void rightHandSide(double tau, bool derivative, Eigen::MatrixXd& rhs) const;
-    void solve(const Eigen::MatrixXd& rhs, Eigen::MatrixXd& x) const;
+    /// The reduced system's right-hand sides at tau: columns 0-2 for the positions, 3-5 for
+    /// their derivative.
+    void rightHandSide(double tau, Eigen::MatrixXd& rhs) const;
 
     std::vector<Triangle> mTriangles;
     std::vector<Edge> mEdges;

@@ -78,7 +78,7 @@ SurfaceFrame SurfaceMorpher::frame(double shapeTau, double colorTau) const
     SurfaceFrame f;
     f.triangles = a.triangles;
     if (mImpl->rigid) {
-        mImpl->rigid->positions(shapeTau, f.points, &f.velocity);
+        mImpl->rigid->positions(shapeTau, f.points, f.velocity);
     } else {
         f.points.resize(a.points.size());
         f.velocity.resize(a.points.size());
