@@ -223,13 +223,23 @@ void printSurface(const Scene& scene, const SceneMeshes& meshes)
 {
     const SurfaceMorpher m(meshes.source, meshes.target, scene.surface); // or a UserError
     const std::string used = name(m.correspondence());
-    std::printf("surface %s correspondence%s: %zu vertices, %zu triangles at every frame; %s "
+    std::string merged;
+    if (m.correspondence() != Correspondence::Identity)
+        merged = " (" + std::to_string(m.vertexCount() - m.crossings()) + " of the inputs, " +
+                 std::to_string(m.crossings()) + " where their edges cross)";
+    std::printf("surface %s correspondence%s: %zu vertices%s, %zu triangles at every frame; %s "
                 "interpolation (positions on the sdf schedule, colours on the colour schedule)\n",
                 used.c_str(), scene.surface.correspondence == Correspondence::Auto ? " (auto)" : "",
-                m.vertexCount(), m.triangleCount(), name(scene.surface.interpolation));
+                m.vertexCount(), merged.c_str(), m.triangleCount(),
+                name(scene.surface.interpolation));
+    if (const auto k = m.kernels())
+        std::printf("        projected from %s (source) and %s (target), world units%s\n",
+                    fmt(k->first).c_str(), fmt(k->second).c_str(),
+                    scene.surface.kernel ? "" : ": each mesh's deepest kernel point");
     if (!scene.pairs.empty())
-        std::printf("        %zu landmark pairs: not used by the identity (vertex i is vertex i)\n",
-                    scene.pairs.size());
+        std::printf(
+            "        %zu landmark pairs: not used by the %s correspondence in this version\n",
+            scene.pairs.size(), used.c_str());
 }
 
 /// An environment light, and its sky map's size once read.

@@ -13,6 +13,8 @@
 #include <volmorph/SurfaceSettings.h>
 
 #include <memory>
+#include <optional>
+#include <utility>
 #include <vector>
 
 namespace volmorph {
@@ -37,7 +39,7 @@ public:
     /// the interpolation (for "arap", one sparse factorization for every frame). Throws UserError
     /// at `spec`'s location when the chosen correspondence does not apply to the meshes (naming
     /// the mesh file and what was found).
-    SurfaceMorpher(Mesh source, Mesh target, const SurfaceSpec& spec);
+    SurfaceMorpher(const Mesh& source, const Mesh& target, const SurfaceSpec& spec);
     ~SurfaceMorpher();
     SurfaceMorpher(SurfaceMorpher&&) noexcept;
     SurfaceMorpher& operator=(SurfaceMorpher&&) noexcept;
@@ -49,6 +51,11 @@ public:
     Correspondence correspondence() const; ///< the one used ("auto" resolved)
     size_t vertexCount() const;
     size_t triangleCount() const;
+    /// Merged correspondences: the vertices that are crossings of an edge of one input with an
+    /// edge of the other (the rest are the inputs' own vertices); 0 for the identity.
+    size_t crossings() const;
+    /// star: the point each mesh was projected from (given or found), world units.
+    std::optional<std::pair<Vec3d, Vec3d>> kernels() const;
 
 private:
     struct Impl;

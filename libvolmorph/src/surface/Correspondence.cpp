@@ -1,5 +1,7 @@
 #include "Correspondence.h"
 
+#include "StarMerge.h"
+
 #include <string>
 
 namespace volmorph::detail {
@@ -20,6 +22,31 @@ void requireManifold(const Mesh& mesh, const SourceLocation& where)
                                    "surface morph needs a manifold mesh");
 }
 
+std::vector<Vec3f> colorsOf(const Mesh& mesh, const Mesh& other)
+{
+    if (mesh.hasColors() || !other.hasColors()) return mesh.colors;
+    return std::vector<Vec3f>(mesh.points.size(), Vec3f(0.8f)); // Voxelize.cpp's grey
+}
+
+Corresponded identity(const Mesh& source, const Mesh& target)
+{
+    Corresponded c;
+    c.source.assign(source.points.begin(), source.points.end());
+    c.target.assign(target.points.begin(), target.points.end());
+    c.triangles = source.triangles;
+    c.sourceColors = colorsOf(source, target);
+    c.targetColors = colorsOf(target, source);
+    c.used = Correspondence::Identity;
+    return c;
+}
+
+[[noreturn]] void refuse(const SurfaceSpec& spec, const SourceLocation& where,
+                         const std::string& why)
+{
+    throw UserError(where, std::string("surface.correspondence = \"") + name(spec.correspondence) +
+                               "\": " + why);
+}
+
 } // namespace
 
 std::string identityMismatch(const Mesh& source, const Mesh& target)
@@ -34,26 +61,65 @@ std::string identityMismatch(const Mesh& source, const Mesh& target)
     return {};
 }
 
-Corresponded correspond(Mesh source, Mesh target, const SurfaceSpec& spec)
+std::string starMismatch(const Mesh& mesh)
+{
+    const MeshReport& r = mesh.report;
+    if (r.boundaryEdges > 0)
+        return mesh.file.string() + " is not closed (" + std::to_string(r.boundaryEdges) +
+               " boundary edges)";
+    if (r.components != 1)
+        return mesh.file.string() + " has " + std::to_string(r.components) + " pieces";
+    // Euler: V - E + F = 2 - 2 genus, with E = 3F / 2 on a closed manifold.
+    std::vector<char> used(mesh.points.size(), 0);
+    for (const Vec3I& t : mesh.triangles) used[t[0]] = used[t[1]] = used[t[2]] = 1;
+    long vertices = 0;
+    for (char u : used) vertices += u;
+    const long chi = vertices - long(mesh.triangles.size()) / 2;
+    if (chi != 2)
+        return mesh.file.string() + " has genus " + std::to_string((2 - chi) / 2) +
+               " (a sphere's is 0)";
+    if (!r.consistentlyOriented())
+        return mesh.file.string() + " is not consistently oriented (" +
+               std::to_string(r.misorientedEdges) + " edges)";
+    return {};
+}
+
+Corresponded correspond(const Mesh& source, const Mesh& target, const SurfaceSpec& spec)
 {
     const SourceLocation& where =
         spec.correspondenceWhere.file.empty() ? spec.where : spec.correspondenceWhere;
     requireManifold(source, where);
     requireManifold(target, where);
-    if (spec.correspondence != Correspondence::Auto &&
-        spec.correspondence != Correspondence::Identity)
-        throw UserError(where, std::string("surface.correspondence = \"") +
-                                   name(spec.correspondence) +
-                                   "\" is not in this version of volmorph; \"identity\" is (the "
-                                   "same vertices and triangles on both sides)");
-    if (const std::string why = identityMismatch(source, target); !why.empty())
-        throw UserError(where, std::string("surface.correspondence = \"") +
-                                   name(spec.correspondence) + "\": " + why +
-                                   (spec.correspondence == Correspondence::Auto
-                                        ? "; the identity is the only correspondence in this "
-                                          "version (it needs the same vertices and triangles)"
-                                        : "; the identity needs the same vertices and triangles"));
-    return {std::move(source), std::move(target), Correspondence::Identity};
+    const Correspondence c = spec.correspondence;
+    if (c == Correspondence::Sphere || c == Correspondence::Disk)
+        refuse(spec, where,
+               "not in this version of volmorph; \"identity\" (the same vertices and triangles) "
+               "and \"star\" (closed star-shaped meshes of genus 0) are");
+    const std::string notIdentity = identityMismatch(source, target);
+    if (c == Correspondence::Identity) {
+        if (!notIdentity.empty())
+            refuse(spec, where,
+                   notIdentity + "; the identity needs the same vertices and triangles");
+        return identity(source, target);
+    }
+    if (c == Correspondence::Auto && notIdentity.empty()) return identity(source, target);
+    std::string notStar = starMismatch(source);
+    if (notStar.empty()) notStar = starMismatch(target);
+    if (!notStar.empty())
+        refuse(spec, where,
+               c == Correspondence::Auto
+                   ? notIdentity + "; and " + notStar +
+                         ", which Kent's star-shaped merge needs (sdf and variational modes "
+                         "morph any shapes)"
+                   : notStar + "; Kent's star-shaped merge needs closed meshes of genus 0 (sdf and "
+                               "variational modes morph any shapes)");
+    try {
+        return starMerge(source, target, spec.kernel, where);
+    } catch (const UserError& e) {
+        const std::string& why = e.diagnostics().front().message;
+        if (e.diagnostics().size() != 1 || why.rfind("surface.kernel", 0) == 0) throw;
+        refuse(spec, where, c == Correspondence::Auto ? notIdentity + "; and " + why : why);
+    }
 }
 
 } // namespace volmorph::detail

@@ -1,26 +1,46 @@
-// Correspondence: two meshes become one connectivity with a place on each surface. What exists
-// today is the identity (the same vertices and triangles); Kent's star-shaped merge, the spherical
-// and the disk parameterizations are named by the scene's keys and refused until they exist.
+// Correspondence: two meshes become one connectivity with a place on each surface: the identity
+// (the same vertices and triangles) or Kent's star-shaped merge (StarMerge.h); the spherical and
+// the disk parameterizations are named by the scene's keys and refused until they exist.
 #pragma once
 
 #include <volmorph/Mesh.h>
 #include <volmorph/SurfaceSettings.h>
 
+#include <optional>
+#include <string>
+#include <utility>
+#include <vector>
+
 namespace volmorph::detail {
 
-/// The two sides on one connectivity: source.triangles == target.triangles, vertex i of each is
-/// the same point of the correspondence.
+/// The two sides on one connectivity: vertex i of `source` and of `target` is the same point of
+/// the correspondence, on each input's surface (world units, double precision: a merged vertex
+/// lies inside an input triangle, not at a float).
 struct Corresponded {
-    Mesh source, target;
+    std::vector<Vec3d> source, target;
+    std::vector<Vec3I> triangles;
+    /// Per vertex, linear RGB; both empty when neither input has colours (a side without them is
+    /// grey).
+    std::vector<Vec3f> sourceColors, targetColors;
     Correspondence used = Correspondence::Identity;
+    size_t crossings = 0; ///< merged: the points where an edge of one crossed an edge of the other
+    /// star: the points each side was projected from (world units)
+    std::optional<std::pair<Vec3d, Vec3d>> kernels;
+    /// merged: the merged triangles not strictly counter-clockwise on the sphere (by the exact
+    /// predicate on their grid directions); 0 for a valid merge.
+    size_t folded = 0;
 };
 
 /// Why the identity does not apply to these meshes ("" when it does).
 std::string identityMismatch(const Mesh& source, const Mesh& target);
 
+/// Why Kent's merge does not apply (not a closed genus-0 surface of one piece), "" when it may
+/// (whether the mesh is star-shaped is found by the merge).
+std::string starMismatch(const Mesh& mesh);
+
 /// Puts the meshes into correspondence as `spec` says. Throws UserError at spec.correspondenceWhere
 /// (else spec.where) naming the mesh file and what it found: a non-manifold edge, or meshes the
 /// chosen correspondence does not apply to.
-Corresponded correspond(Mesh source, Mesh target, const SurfaceSpec& spec);
+Corresponded correspond(const Mesh& source, const Mesh& target, const SurfaceSpec& spec);
 
 } // namespace volmorph::detail

@@ -55,10 +55,11 @@ std::vector<Weight> weights(const Mesh& mesh, bool meanValue)
     std::vector<Weight> out;
     out.reserve(mesh.triangles.size() * 6);
     if (!meanValue) { // each corner weighs the edge opposite it, both ways
-        forEachCotangentWeight(mesh, [&](uint32_t, uint32_t a, uint32_t b, double w) {
-            out.push_back({a, b, w});
-            out.push_back({b, a, w});
-        });
+        forEachCotangentWeight(mesh.points, mesh.triangles,
+                               [&](uint32_t, uint32_t a, uint32_t b, double w) {
+                                   out.push_back({a, b, w});
+                                   out.push_back({b, a, w});
+                               });
         return out;
     }
     for (const Vec3I& t : mesh.triangles)

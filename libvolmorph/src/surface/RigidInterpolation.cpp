@@ -6,25 +6,26 @@
 #include <Eigen/Geometry>
 #include <Eigen/SVD>
 
+#include <algorithm>
 #include <cmath>
 #include <stdexcept>
 
 namespace volmorph::detail {
 namespace {
 
-Eigen::Vector3d toEigen(const Vec3f& p)
+Eigen::Vector3d toEigen(const Vec3d& p)
 {
-    return {double(p.x()), double(p.y()), double(p.z())};
+    return {p.x(), p.y(), p.z()};
 }
 
 /// A triangle's frame: its two edges from its first vertex and a normal scaled by the square root
 /// of its double area (Sumner and Popovic 2004), so that the frame's volume grows with the area.
 /// Zero for a triangle without area.
-bool triangleFrame(const Mesh& mesh, const Vec3I& t, Eigen::Matrix3d& frame)
+bool triangleFrame(const std::vector<Vec3d>& points, const Vec3I& t, Eigen::Matrix3d& frame)
 {
-    const Eigen::Vector3d p0 = toEigen(mesh.points[t[0]]);
-    const Eigen::Vector3d e1 = toEigen(mesh.points[t[1]]) - p0;
-    const Eigen::Vector3d e2 = toEigen(mesh.points[t[2]]) - p0;
+    const Eigen::Vector3d p0 = toEigen(points[t[0]]);
+    const Eigen::Vector3d e1 = toEigen(points[t[1]]) - p0;
+    const Eigen::Vector3d e2 = toEigen(points[t[2]]) - p0;
     const Eigen::Vector3d c = e1.cross(e2);
     const double area2 = c.norm();
     if (!(area2 > 1e-300)) return false;
@@ -47,7 +48,8 @@ namespace {
 
 /// The polar decomposition of a triangle's map from source to target, and its rotation's axis and
 /// angle.
-RigidInterpolation::Triangle decompose(const Mesh& source, const Mesh& target, const Vec3I& t)
+RigidInterpolation::Triangle decompose(const std::vector<Vec3d>& source,
+                                       const std::vector<Vec3d>& target, const Vec3I& t)
 {
     RigidInterpolation::Triangle tri;
     Eigen::Matrix3d p, q;
@@ -76,37 +78,57 @@ RigidInterpolation::Triangle decompose(const Mesh& source, const Mesh& target, c
 
 } // namespace
 
-RigidInterpolation::RigidInterpolation(const Mesh& source, const Mesh& target)
+RigidInterpolation::RigidInterpolation(const std::vector<Vec3d>& source,
+                                       const std::vector<Vec3d>& target,
+                                       const std::vector<Vec3I>& triangles)
 {
-    findPieces(source, target);
-    mTriangles.resize(source.triangles.size());
-    for (uint32_t j = 0; j < source.triangles.size(); ++j)
-        mTriangles[j] = decompose(source, target, source.triangles[j]);
+    findPieces(source, target, triangles);
+    mTriangles.resize(triangles.size());
+    for (uint32_t j = 0; j < triangles.size(); ++j)
+        mTriangles[j] = decompose(source, target, triangles[j]);
+    double meanEdge = 0.0;
+    for (const Vec3I& t : triangles)
+        for (int c = 0; c < 3; ++c) meanEdge += (source[t[c]] - source[t[(c + 1) % 3]]).length();
+    meanEdge /= double(std::max<size_t>(1, 3 * triangles.size()));
     std::vector<Eigen::Triplet<double>> entries;
-    forEachCotangentWeight(source, [&](uint32_t j, uint32_t a, uint32_t b, double w) {
-        mEdges.push_back({a, b, j, w, toEigen(source.points[a]) - toEigen(source.points[b])});
-        const int ra = mFree[a], rb = mFree[b];
-        if (ra >= 0) entries.emplace_back(ra, ra, w);
-        if (rb >= 0) entries.emplace_back(rb, rb, w);
-        if (ra >= 0 && rb >= 0) {
-            entries.emplace_back(ra, rb, -w);
-            entries.emplace_back(rb, ra, -w);
-        }
-    });
-    if (mRows == 0) return;
-    Eigen::SparseMatrix<double> laplacian(mRows, mRows);
-    laplacian.setFromTriplets(entries.begin(), entries.end());
-    mSolver.compute(laplacian);
-    if (mSolver.info() != Eigen::Success)
-        throw std::runtime_error("the mesh's cotangent Laplacian cannot be factored");
+    const double delta = 1e-4 * meanEdge; // Sharp and Crane's choice
+    forEachMollifiedCotangentWeight(
+        source, triangles, delta, [&](uint32_t j, uint32_t a, uint32_t b, double w) {
+            mEdges.push_back({a, b, j, w, toEigen(source[a]) - toEigen(source[b])});
+            const int ra = mFree[a], rb = mFree[b];
+            if (ra >= 0) entries.emplace_back(ra, ra, w);
+            if (rb >= 0) entries.emplace_back(rb, rb, w);
+            if (ra >= 0 && rb >= 0) {
+                entries.emplace_back(ra, rb, -w);
+                entries.emplace_back(rb, ra, -w);
+            }
+        });
+    if (mRows > 0) {
+        Eigen::SparseMatrix<double> laplacian(mRows, mRows);
+        laplacian.setFromTriplets(entries.begin(), entries.end());
+        mSolver.compute(laplacian);
+        if (mSolver.info() != Eigen::Success)
+            throw std::runtime_error("the mesh's cotangent Laplacian cannot be factored");
+    }
+    // What the fit misses of each end (rounding, and triangles too thin to have a frame): taken
+    // out along the straight line, so that tau = 0 and 1 are the inputs.
+    std::vector<Vec3d> velocity;
+    solve(0.0, mMissed0, velocity);
+    solve(1.0, mMissed1, velocity);
+    for (size_t v = 0; v < source.size(); ++v) {
+        mMissed0[v] -= source[v];
+        mMissed1[v] -= target[v];
+    }
 }
 
-void RigidInterpolation::findPieces(const Mesh& source, const Mesh& target)
+void RigidInterpolation::findPieces(const std::vector<Vec3d>& source,
+                                    const std::vector<Vec3d>& target,
+                                    const std::vector<Vec3I>& triangles)
 {
-    const size_t n = source.points.size();
+    const size_t n = source.size();
     // A vertex of each piece is held at the origin (the energy does not see translations).
     DisjointSets sets(n);
-    for (const Vec3I& t : source.triangles) {
+    for (const Vec3I& t : triangles) {
         sets.unite(t[0], t[1]);
         sets.unite(t[1], t[2]);
     }
@@ -124,8 +146,8 @@ void RigidInterpolation::findPieces(const Mesh& source, const Mesh& target)
             mFree[v] = mRows++;
         }
         mPiece[v] = uint32_t(piece);
-        mSourceMean[piece] += toEigen(source.points[v]);
-        mTargetMean[piece] += toEigen(target.points[v]);
+        mSourceMean[piece] += toEigen(source[v]);
+        mTargetMean[piece] += toEigen(target[v]);
         mPieceSize[piece] += 1.0;
     }
     for (size_t i = 0; i < mPieceSize.size(); ++i) {
@@ -157,6 +179,16 @@ void RigidInterpolation::rightHandSide(double tau, Eigen::MatrixXd& rhs) const
 
 void RigidInterpolation::positions(double tau, std::vector<Vec3d>& out,
                                    std::vector<Vec3d>& velocity) const
+{
+    solve(tau, out, velocity);
+    for (size_t v = 0; v < out.size(); ++v) {
+        out[v] -= (1.0 - tau) * mMissed0[v] + tau * mMissed1[v];
+        velocity[v] -= mMissed1[v] - mMissed0[v];
+    }
+}
+
+void RigidInterpolation::solve(double tau, std::vector<Vec3d>& out,
+                               std::vector<Vec3d>& velocity) const
 {
     const size_t n = mFree.size();
     // Columns 0-2 of `solved` (or 3-5), the pieces moved so their means lie at `centre`.

@@ -15,6 +15,11 @@
 // exactly, so the ends are the inputs. A limb that turns by theta keeps its thickness, where the
 // straight line shrinks it by cos(theta / 2) half-way.
 //
+// The Laplacian's weights come from intrinsically mollified edge lengths (Cotangent.h), so that the
+// slivers of a merged mesh do not make it ill-conditioned; whatever the fit misses of the inputs at
+// tau = 0 and 1 (rounding, triangles too thin to have a frame) is taken out along the straight
+// line, so the ends are the inputs exactly.
+//
 // The velocity is exact: dG/dtau = theta [k]x R(tau) S(tau) + R(tau) (S - I) gives the right-hand
 // side's derivative, and the same factorization solves for dx/dtau.
 #pragma once
@@ -30,9 +35,11 @@ namespace volmorph::detail {
 
 class RigidInterpolation {
 public:
-    /// `source` and `target` have the same triangles (world units). Throws std::runtime_error when
-    /// the Laplacian cannot be factored (a mesh made of degenerate triangles only).
-    RigidInterpolation(const Mesh& source, const Mesh& target);
+    /// `source` and `target` are the positions of one connectivity, `triangles` (world units).
+    /// Throws std::runtime_error when the Laplacian cannot be factored (a mesh made of degenerate
+    /// triangles only).
+    RigidInterpolation(const std::vector<Vec3d>& source, const std::vector<Vec3d>& target,
+                       const std::vector<Vec3I>& triangles);
 
     /// Positions at `tau` and d position / d tau (one solve for both).
     void positions(double tau, std::vector<Vec3d>& out, std::vector<Vec3d>& velocity) const;
@@ -50,7 +57,10 @@ private:
         double weight;        ///< cot(opposite angle) / 2
         Eigen::Vector3d edge; ///< source p_a - p_b
     };
-    void findPieces(const Mesh& source, const Mesh& target);
+    void findPieces(const std::vector<Vec3d>& source, const std::vector<Vec3d>& target,
+                    const std::vector<Vec3I>& triangles);
+    /// The fit at tau, before the ends' misses are taken out.
+    void solve(double tau, std::vector<Vec3d>& out, std::vector<Vec3d>& velocity) const;
     /// The reduced system's right-hand sides at tau: columns 0-2 for the positions, 3-5 for
     /// their derivative.
     void rightHandSide(double tau, Eigen::MatrixXd& rhs) const;
@@ -63,6 +73,7 @@ private:
     std::vector<Eigen::Vector3d> mSourceMean, mTargetMean; ///< per piece
     std::vector<double> mPieceSize;
     Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> mSolver;
+    std::vector<Vec3d> mMissed0, mMissed1; ///< the fit's positions minus the inputs at 0 and 1
 };
 
 } // namespace volmorph::detail

@@ -46,25 +46,13 @@ struct SurfaceMorpher::Impl {
     std::optional<detail::RigidInterpolation> rigid; // "arap"
 };
 
-namespace {
-
-/// A side without vertex colours takes grey when the other has them (Voxelize.cpp's grey).
-void matchColors(Mesh& mesh, const Mesh& other)
-{
-    if (mesh.colors.empty() && !other.colors.empty())
-        mesh.colors.assign(mesh.points.size(), Vec3f(0.8f));
-}
-
-} // namespace
-
-SurfaceMorpher::SurfaceMorpher(Mesh source, Mesh target, const SurfaceSpec& spec)
+SurfaceMorpher::SurfaceMorpher(const Mesh& source, const Mesh& target, const SurfaceSpec& spec)
     : mImpl(std::make_unique<Impl>())
 {
-    mImpl->sides = detail::correspond(std::move(source), std::move(target), spec);
-    matchColors(mImpl->sides.source, mImpl->sides.target);
-    matchColors(mImpl->sides.target, mImpl->sides.source);
+    mImpl->sides = detail::correspond(source, target, spec);
+    const detail::Corresponded& s = mImpl->sides;
     if (spec.interpolation == SurfaceInterpolation::Arap)
-        mImpl->rigid.emplace(mImpl->sides.source, mImpl->sides.target);
+        mImpl->rigid.emplace(s.source, s.target, s.triangles);
 }
 
 SurfaceMorpher::~SurfaceMorpher() = default;
@@ -73,24 +61,23 @@ SurfaceMorpher& SurfaceMorpher::operator=(SurfaceMorpher&&) noexcept = default;
 
 SurfaceFrame SurfaceMorpher::frame(double shapeTau, double colorTau) const
 {
-    const Mesh& a = mImpl->sides.source;
-    const Mesh& b = mImpl->sides.target;
+    const detail::Corresponded& s = mImpl->sides;
     SurfaceFrame f;
-    f.triangles = a.triangles;
+    f.triangles = s.triangles;
     if (mImpl->rigid) {
         mImpl->rigid->positions(shapeTau, f.points, f.velocity);
     } else {
-        f.points.resize(a.points.size());
-        f.velocity.resize(a.points.size());
-        for (size_t i = 0; i < a.points.size(); ++i) {
-            const Vec3d p(a.points[i]), q(b.points[i]);
-            f.points[i] = (1.0 - shapeTau) * p + shapeTau * q;
-            f.velocity[i] = q - p;
+        f.points.resize(s.source.size());
+        f.velocity.resize(s.source.size());
+        for (size_t i = 0; i < s.source.size(); ++i) {
+            f.points[i] = (1.0 - shapeTau) * s.source[i] + shapeTau * s.target[i];
+            f.velocity[i] = s.target[i] - s.source[i];
         }
     }
-    f.colors.resize(a.colors.size());
-    for (size_t i = 0; i < a.colors.size(); ++i)
-        f.colors[i] = Vec3f((1.0 - colorTau) * Vec3d(a.colors[i]) + colorTau * Vec3d(b.colors[i]));
+    f.colors.resize(s.sourceColors.size());
+    for (size_t i = 0; i < f.colors.size(); ++i)
+        f.colors[i] = Vec3f((1.0 - colorTau) * Vec3d(s.sourceColors[i]) +
+                            colorTau * Vec3d(s.targetColors[i]));
     return f;
 }
 
@@ -100,11 +87,19 @@ Correspondence SurfaceMorpher::correspondence() const
 }
 size_t SurfaceMorpher::vertexCount() const
 {
-    return mImpl->sides.source.points.size();
+    return mImpl->sides.source.size();
 }
 size_t SurfaceMorpher::triangleCount() const
 {
-    return mImpl->sides.source.triangles.size();
+    return mImpl->sides.triangles.size();
+}
+size_t SurfaceMorpher::crossings() const
+{
+    return mImpl->sides.crossings;
+}
+std::optional<std::pair<Vec3d, Vec3d>> SurfaceMorpher::kernels() const
+{
+    return mImpl->sides.kernels;
 }
 
 } // namespace volmorph

@@ -3,6 +3,8 @@
 // volume (Pappus: pi r^2 L whatever the bend) where the straight line loses it.
 #include <volmorph/SurfaceMorph.h>
 
+#include "support/SurfaceShapes.h"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -10,51 +12,10 @@
 
 namespace volmorph {
 namespace {
+using test::bent;
+using test::tube;
 
 constexpr double kPi = 3.14159265358979323846;
-
-/// A closed tube along x from 0 to `length`, radius `radius`: `rings` rings of `around` vertices
-/// and a centre vertex closing each end, facing outward.
-Mesh tube(int rings, int around, double length, double radius)
-{
-    Mesh m;
-    for (int i = 0; i < rings; ++i)
-        for (int k = 0; k < around; ++k) {
-            const double a = 2.0 * kPi * k / around;
-            m.points.emplace_back(float(length * i / (rings - 1)), float(radius * std::cos(a)),
-                                  float(radius * std::sin(a)));
-        }
-    const uint32_t start = uint32_t(m.points.size()), end = start + 1;
-    m.points.emplace_back(0.0f, 0.0f, 0.0f);
-    m.points.emplace_back(float(length), 0.0f, 0.0f);
-    auto at = [&](int i, int k) { return uint32_t(i * around + (k % around)); };
-    for (int i = 0; i + 1 < rings; ++i)
-        for (int k = 0; k < around; ++k) {
-            m.triangles.emplace_back(at(i, k), at(i, k + 1), at(i + 1, k + 1));
-            m.triangles.emplace_back(at(i, k), at(i + 1, k + 1), at(i + 1, k));
-        }
-    for (int k = 0; k < around; ++k) {
-        m.triangles.emplace_back(start, at(0, k + 1), at(0, k));
-        m.triangles.emplace_back(end, at(rings - 1, k), at(rings - 1, k + 1));
-    }
-    m.file = "tube.obj";
-    analyzeTopology(m);
-    return m;
-}
-
-/// The tube bent in the x-y plane by `angle` radians over its length, its axis kept as long: a
-/// point at x turns by angle x / length about the centre of curvature (0, length / angle).
-Mesh bent(const Mesh& straight, double length, double angle)
-{
-    Mesh m = straight;
-    const double rc = length / angle;
-    for (Vec3f& p : m.points) {
-        const double phi = angle * p.x() / length, r = rc - p.y();
-        p = Vec3f(float(r * std::sin(phi)), float(rc - r * std::cos(phi)), p.z());
-    }
-    m.file = "bent.obj";
-    return m;
-}
 
 template <typename P>
 double volume(const std::vector<P>& points, const std::vector<Vec3I>& tris)
