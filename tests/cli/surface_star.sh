@@ -1,0 +1,101 @@
+#!/bin/sh
+# Kent's star-shaped merge through the command line (issue 57), on two meshes the merge was not
+# tuned on (CGAL's blobby and six-pointed star, scenes/meshes):
+# - check says "star", the merged size as the inputs' vertices plus the crossings, and the kernel
+#   points it found;
+# - morph -o .ply: every frame the same vertices and triangles; frame 1 encloses the blob's volume
+#   and has its area, the last frame the star's (a merged mesh is a refinement of each input, so
+#   both agree to float rounding, 1e-5), the colours red and blue at the ends;
+# - a point outside the star given as its kernel is refused at its file:line:col naming the mesh.
+# usage: surface_star.sh VOLMORPH SOURCE_DIR
+set -eu
+volmorph=$1
+src=$2
+out=$(mktemp -d)
+trap 'rm -rf "$out"' EXIT
+export VOLMORPH_CACHE="$out/cache"
+
+cat >"$out/scene.toml" <<EOF2
+[source]
+mesh = "$src/scenes/meshes/blobby.off"
+color = [1, 0, 0]
+[target]
+mesh = "$src/scenes/meshes/star.off"
+color = [0, 0, 1]
+transform = { translate = [3, 0, 0] }
+[volume]
+resolution = 32
+[blend]
+mode = "surface"
+[surface]
+correspondence = "star"
+[frames]
+range = "1-9"
+output = "out/frame.####.exr"
+EOF2
+
+"$volmorph" check "$out/scene.toml" >"$out/check.txt"
+grep -q "^surface star correspondence: [0-9]* vertices (2041 of the inputs, [0-9]* where their edges cross)" \
+    "$out/check.txt" || { echo "check:"; cat "$out/check.txt"; exit 1; }
+grep -q "projected from .*: each mesh's deepest kernel point" "$out/check.txt" ||
+    { echo "check:"; cat "$out/check.txt"; exit 1; }
+
+"$volmorph" morph "$out/scene.toml" -o "$out/m.####.ply" -q
+/usr/bin/python3 - "$out" "$src" <<'PY'
+import struct, sys
+out, src = sys.argv[1], sys.argv[2]
+
+
+def read_ply(path):
+    head, body = open(path, "rb").read().split(b"end_header\n", 1)
+    lines = head.decode().splitlines()
+    nv = int(next(l for l in lines if l.startswith("element vertex")).split()[2])
+    nf = int(next(l for l in lines if l.startswith("element face")).split()[2])
+    verts = [struct.unpack_from("<6f4B", body, i * 28) for i in range(nv)]
+    faces = [struct.unpack_from("<B3i", body, nv * 28 + 13 * k)[1:] for k in range(nf)]
+    return verts, faces
+
+
+def read_off(path, shift):
+    words = open(path).read().split()
+    nv, nf = int(words[1]), int(words[2])
+    vals = words[4:]
+    pts = [tuple(float(vals[3 * i + c]) + shift[c] for c in range(3)) for i in range(nv)]
+    k, tris = 3 * nv, []
+    for _ in range(nf):
+        n = int(vals[k]); idx = list(map(int, vals[k + 1:k + 1 + n])); k += 1 + n
+        tris += [(idx[0], idx[j], idx[j + 1]) for j in range(1, n - 1)]
+    return pts, tris
+
+
+def measure(pts, tris):
+    vol = area = 0.0
+    for a, b, c in tris:
+        (ax, ay, az), (bx, by, bz), (cx, cy, cz) = pts[a][:3], pts[b][:3], pts[c][:3]
+        vol += ax * (by * cz - bz * cy) - ay * (bx * cz - bz * cx) + az * (bx * cy - by * cx)
+        ux, uy, uz, vx, vy, vz = bx - ax, by - ay, bz - az, cx - ax, cy - ay, cz - az
+        area += 0.5 * ((uy * vz - uz * vy) ** 2 + (uz * vx - ux * vz) ** 2 + (ux * vy - uy * vx) ** 2) ** 0.5
+    return vol / 6, area
+
+
+frames = [read_ply("%s/m.%04d.ply" % (out, f)) for f in range(1, 10)]
+for verts, faces in frames:
+    assert len(verts) == len(frames[0][0]) and faces == frames[0][1], "connectivity differs"
+ends = ((0, read_off(src + "/scenes/meshes/blobby.off", (0, 0, 0)), (255, 0, 0, 255)),
+        (8, read_off(src + "/scenes/meshes/star.off", (3, 0, 0)), (0, 0, 255, 255)))
+for f, (pts, tris), colour in ends:
+    got, want = measure(frames[f][0], frames[f][1]), measure(pts, tris)
+    for g, w, what in zip(got, want, ("volume", "area")):
+        assert abs(g / w - 1) < 1e-5, "frame %d's %s %g, the input's %g" % (f + 1, what, g, w)
+    assert all(v[6:] == colour for v in frames[f][0]), "colour of frame %d" % (f + 1)
+print("star merge: %d vertices; the ends enclose the inputs' volumes and areas" % len(frames[0][0]))
+PY
+
+sed 's/^correspondence = "star"$/correspondence = "star"\nkernel = { source = [-0.12, 0, 0.08], target = [30, 0, 0] }/' \
+    "$out/scene.toml" >"$out/outside.toml"
+if "$volmorph" check "$out/outside.toml" >/dev/null 2>"$out/err.txt"; then
+    echo "a kernel outside the star was accepted"; exit 1
+fi
+grep -q "outside.toml:[0-9]*:[0-9]*: surface.kernel: .*star.off is not seen whole from (30, 0, 0)" "$out/err.txt" ||
+    { echo "stderr:"; cat "$out/err.txt"; exit 1; }
+echo "surface star: check, merged meshes on both inputs, a kernel outside refused"
