@@ -5,6 +5,7 @@
 
 #include <Eigen/Geometry>
 #include <Eigen/SVD>
+#include <tbb/parallel_for.h>
 
 #include <algorithm>
 #include <cmath>
@@ -84,8 +85,8 @@ RigidInterpolation::RigidInterpolation(const std::vector<Vec3d>& source,
 {
     findPieces(source, target, triangles);
     mTriangles.resize(triangles.size());
-    for (uint32_t j = 0; j < triangles.size(); ++j)
-        mTriangles[j] = decompose(source, target, triangles[j]);
+    tbb::parallel_for(size_t(0), triangles.size(),
+                      [&](size_t j) { mTriangles[j] = decompose(source, target, triangles[j]); });
     double meanEdge = 0.0;
     for (const Vec3I& t : triangles)
         for (int c = 0; c < 3; ++c) meanEdge += (source[t[c]] - source[t[(c + 1) % 3]]).length();
@@ -160,13 +161,13 @@ void RigidInterpolation::rightHandSide(double tau, Eigen::MatrixXd& rhs) const
 {
     // Per triangle G(tau) and dG/dtau, from one rotation and one stretch.
     std::vector<Eigen::Matrix3d> g(mTriangles.size()), dg(mTriangles.size());
-    for (size_t j = 0; j < mTriangles.size(); ++j) {
+    tbb::parallel_for(size_t(0), mTriangles.size(), [&](size_t j) {
         const Triangle& t = mTriangles[j];
         const Eigen::Matrix3d turn = Eigen::AngleAxisd(tau * t.angle, t.axis).toRotationMatrix();
         const Eigen::Matrix3d stretch = (1.0 - tau) * Eigen::Matrix3d::Identity() + tau * t.stretch;
         g[j] = turn * stretch;
         dg[j] = t.angle * cross(t.axis) * g[j] + turn * (t.stretch - Eigen::Matrix3d::Identity());
-    }
+    });
     rhs.setZero(mRows, 6);
     for (const Edge& e : mEdges) {
         Eigen::Matrix<double, 1, 6> wg;
@@ -209,7 +210,13 @@ void RigidInterpolation::solve(double tau, std::vector<Vec3d>& out,
     };
     Eigen::MatrixXd rhs;
     rightHandSide(tau, rhs);
-    const Eigen::MatrixXd solved = mRows ? Eigen::MatrixXd(mSolver.solve(rhs)) : rhs;
+    // The six columns are independent solves with one factor (read-only): one per task.
+    Eigen::MatrixXd solved = rhs;
+    if (mRows)
+        tbb::parallel_for(0, 6, [&](int c) {
+            const Eigen::VectorXd column = rhs.col(c);
+            solved.col(c) = mSolver.solve(column);
+        });
     std::vector<Eigen::Vector3d> centre(mPieceSize.size()), drift(mPieceSize.size());
     for (size_t p = 0; p < centre.size(); ++p) {
         centre[p] = (1.0 - tau) * mSourceMean[p] + tau * mTargetMean[p];

@@ -4,6 +4,7 @@
 
 #include <Eigen/Geometry>
 #include <Eigen/LU>
+#include <tbb/parallel_for.h>
 
 #include <sstream>
 #include <stdexcept>
@@ -199,13 +200,13 @@ Corresponded starMerge(const Mesh& source, const Mesh& target,
         out.sourceColors.resize(n);
         out.targetColors.resize(n);
     }
-    for (size_t v = 0; v < n; ++v) {
+    tbb::parallel_for(size_t(0), n, [&](size_t v) {
         const OverlayVertex& o = merged.vertices[v];
         const Vec3d& dir = merged.directions[v];
         place(a, ka.point, o, true, dir, out.source[v], colors ? &out.sourceColors[v] : nullptr);
         place(b, kb.point, o, false, apply(rotation.transpose(), dir), out.target[v],
               colors ? &out.targetColors[v] : nullptr);
-    }
+    });
     return out;
 }
 
