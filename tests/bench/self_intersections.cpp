@@ -2,8 +2,9 @@
 // intersect (sharing no vertex), for each mesh file given (a surface morph's PLY frames).
 //
 // Each edge is traced as a segment through the mesh with Embree, every hit kept by a filter; a
-// hit on a triangle that does not share a vertex with the edge means that triangle and both
-// triangles of the edge intersect. Two triangles in general position intersect exactly when an
+// hit on a triangle that does not share a vertex with the edge, with the edge's ends on opposite
+// sides of its plane (by more than float rounding), means that triangle and both triangles of the
+// edge intersect. Two triangles in general position intersect exactly when an
 // edge of one crosses the other, so every intersecting pair is found (pairs that share a vertex
 // and also cross elsewhere are not counted).
 //
@@ -13,7 +14,9 @@
 #include <embree3/rtcore.h>
 
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
+#include <limits>
 #include <set>
 #include <unordered_map>
 #include <vector>
@@ -32,6 +35,20 @@ void keepEveryHit(const RTCFilterFunctionNArguments* args)
     auto* hits = reinterpret_cast<Hits*>(args->context);
     hits->triangles.push_back(RTCHitN_primID(args->hit, args->N, 0));
     args->valid[0] = 0; // reject: the trace goes on to the next hit
+}
+
+/// The edge (a, b) has its ends on opposite sides of triangle u's plane, each by more than 1e-5 of
+/// the edge's length plus the points' float rounding (`rounding`, world units): a crossing, not a
+/// graze of a coplanar neighbour (a merged mesh's triangles within one input face are coplanar,
+/// and its slivers are shorter than a float's step).
+bool transversal(const Mesh& mesh, const Vec3I& u, uint32_t a, uint32_t b, double rounding)
+{
+    const Vec3d p0(mesh.points[u[0]]);
+    const Vec3d n = (Vec3d(mesh.points[u[1]]) - p0).cross(Vec3d(mesh.points[u[2]]) - p0).unitSafe();
+    const Vec3d pa(mesh.points[a]), pb(mesh.points[b]);
+    const double da = n.dot(pa - p0), db = n.dot(pb - p0),
+                 tol = 1e-5 * (pb - pa).length() + rounding;
+    return (da > tol && db < -tol) || (da < -tol && db > tol);
 }
 
 size_t intersectingPairs(const Mesh& mesh)
@@ -60,6 +77,10 @@ size_t intersectingPairs(const Mesh& mesh)
             const uint32_t a = mesh.triangles[i][c], b = mesh.triangles[i][(c + 1) % 3];
             edges[uint64_t(std::min(a, b)) << 32 | std::max(a, b)].push_back(i);
         }
+    const auto [lo, hi] = mesh.bounds();
+    const double rounding = 8.0 * std::numeric_limits<float>::epsilon() *
+                            std::max({std::abs(lo.x()), std::abs(lo.y()), std::abs(lo.z()),
+                                      std::abs(hi.x()), std::abs(hi.y()), std::abs(hi.z())});
     std::set<std::pair<unsigned, unsigned>> pairs;
     for (const auto& [key, sides] : edges) {
         const uint32_t a = uint32_t(key >> 32), b = uint32_t(key);
@@ -79,6 +100,7 @@ size_t intersectingPairs(const Mesh& mesh)
             const Vec3I& u = mesh.triangles[other];
             if (u[0] == a || u[1] == a || u[2] == a || u[0] == b || u[1] == b || u[2] == b)
                 continue;
+            if (!transversal(mesh, u, a, b, rounding)) continue;
             for (unsigned side : sides) {
                 const Vec3I& s = mesh.triangles[side];
                 bool shares = false;

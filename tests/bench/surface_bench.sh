@@ -6,7 +6,8 @@
 # edges' midpoints) and the same mesh moved by a known smooth map (a twist of 90 degrees about the
 # vertical axis over the mesh's height and a bend of 60 degrees), so that both have one
 # connectivity and the identity correspondence applies. Also prints the half-way frame's volume
-# over the ends' under arap and under linear (a twist and a bend keep the volume).
+# over the ends' under arap and under linear (a twist and a bend keep the volume), and the
+# intersecting triangle pairs of frame 12 under each (volmorph_bench_self_intersections).
 # usage: tests/bench/surface_bench.sh [BUILD_DIR [MESH [SUBDIVISIONS [RUNS]]]]
 #        defaults: build scenes/meshes/bunny.obj 2 3 (58,784 triangles)
 set -eu
@@ -121,3 +122,6 @@ ends = (volume(w + "/a.0001.ply") + volume(w + "/a.0024.ply")) / 2
 print("frame 12's volume over the ends': arap %.4f, linear %.4f" % (
     volume(w + "/a.0012.ply") / ends, volume(w + "/l.0012.ply") / ends))
 PY
+echo "frame 12, intersecting triangle pairs:"
+"$build/tests/bench/volmorph_bench_self_intersections" "$work/a.0012.ply" "$work/l.0012.ply" |
+    sed "s#$work/a.0012.ply#  arap#; s#$work/l.0012.ply#  linear#"
