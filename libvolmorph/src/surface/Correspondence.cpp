@@ -1,5 +1,6 @@
 #include "Correspondence.h"
 
+#include "DiskMerge.h"
 #include "StarMerge.h"
 
 #include <string>
@@ -84,6 +85,25 @@ std::string starMismatch(const Mesh& mesh)
     return {};
 }
 
+namespace {
+
+/// The message of a UserError with one diagnostic thrown at the correspondence's key ("" for
+/// anything else: a kernel's own error, several diagnostics).
+std::string reason(const UserError& e)
+{
+    const std::string& why = e.diagnostics().front().message;
+    return e.diagnostics().size() == 1 && why.rfind("surface.kernel", 0) != 0 ? why : std::string();
+}
+
+/// Why the disk merge does not apply before trying it: a closed mesh.
+std::string diskMismatch(const Mesh& mesh)
+{
+    return mesh.report.boundaryEdges == 0 ? mesh.file.string() + " has no boundary (a closed mesh)"
+                                          : std::string();
+}
+
+} // namespace
+
 Corresponded correspond(const Mesh& source, const Mesh& target, const SurfaceSpec& spec)
 {
     const SourceLocation& where =
@@ -91,10 +111,12 @@ Corresponded correspond(const Mesh& source, const Mesh& target, const SurfaceSpe
     requireManifold(source, where);
     requireManifold(target, where);
     const Correspondence c = spec.correspondence;
-    if (c == Correspondence::Sphere || c == Correspondence::Disk)
+    const bool automatic = c == Correspondence::Auto;
+    if (c == Correspondence::Sphere)
         refuse(spec, where,
-               "not in this version of volmorph; \"identity\" (the same vertices and triangles) "
-               "and \"star\" (closed star-shaped meshes of genus 0) are");
+               "not in this version of volmorph; \"identity\" (the same vertices and triangles), "
+               "\"star\" (closed star-shaped meshes of genus 0) and \"disk\" (one boundary loop "
+               "each) are");
     const std::string notIdentity = identityMismatch(source, target);
     if (c == Correspondence::Identity) {
         if (!notIdentity.empty())
@@ -102,24 +124,39 @@ Corresponded correspond(const Mesh& source, const Mesh& target, const SurfaceSpe
                    notIdentity + "; the identity needs the same vertices and triangles");
         return identity(source, target);
     }
-    if (c == Correspondence::Auto && notIdentity.empty()) return identity(source, target);
-    std::string notStar = starMismatch(source);
-    if (notStar.empty()) notStar = starMismatch(target);
-    if (!notStar.empty())
-        refuse(spec, where,
-               c == Correspondence::Auto
-                   ? notIdentity + "; and " + notStar +
-                         ", which Kent's star-shaped merge needs (sdf and variational modes "
-                         "morph any shapes)"
-                   : notStar + "; Kent's star-shaped merge needs closed meshes of genus 0 (sdf and "
-                               "variational modes morph any shapes)");
-    try {
-        return starMerge(source, target, spec.kernel, where);
-    } catch (const UserError& e) {
-        const std::string& why = e.diagnostics().front().message;
-        if (e.diagnostics().size() != 1 || why.rfind("surface.kernel", 0) == 0) throw;
-        refuse(spec, where, c == Correspondence::Auto ? notIdentity + "; and " + why : why);
+    if (automatic && notIdentity.empty()) return identity(source, target);
+    // Kent's merge, then the disk merge: each its refusal, or (auto) all of them.
+    std::string why = automatic ? notIdentity : std::string();
+    auto fail = [&](const std::string& more) { why += (why.empty() ? "" : "; and ") + more; };
+    if (c == Correspondence::Star || automatic) {
+        std::string notStar = starMismatch(source);
+        if (notStar.empty()) notStar = starMismatch(target);
+        if (notStar.empty()) {
+            try {
+                return starMerge(source, target, spec.kernel, where);
+            } catch (const UserError& e) {
+                if (reason(e).empty()) throw;
+                fail(reason(e));
+            }
+        } else {
+            fail(notStar + "; Kent's star-shaped merge needs closed meshes of genus 0");
+        }
     }
+    if (c == Correspondence::Disk || automatic) {
+        std::string notDisk = diskMismatch(source);
+        if (notDisk.empty()) notDisk = diskMismatch(target);
+        if (notDisk.empty()) {
+            try {
+                return diskMerge(source, target, where);
+            } catch (const UserError& e) {
+                if (reason(e).empty()) throw;
+                fail(reason(e));
+            }
+        } else {
+            fail(notDisk + "; the disk map needs one boundary loop");
+        }
+    }
+    refuse(spec, where, why + " (sdf and variational modes morph any shapes)");
 }
 
 } // namespace volmorph::detail

@@ -77,7 +77,7 @@ private:
     uint32_t locate(uint32_t sourceVertex) const;
     bool region(uint32_t a, uint32_t b, std::vector<uint32_t>& ring);
     uint32_t vertexOf(const Event& e, bool onSource, uint32_t a, uint32_t b);
-    void cut(const std::vector<uint32_t>& ring);
+    void cut(const std::vector<uint32_t>& ring, uint32_t a, uint32_t b);
 
     const SphereTriangulation &mA, &mB;
     Overlay mOut;
@@ -224,7 +224,7 @@ bool Builder::region(uint32_t a, uint32_t b, std::vector<uint32_t>& ring)
     throw std::runtime_error("a region of the overlay does not close");
 }
 
-void Builder::cut(const std::vector<uint32_t>& ringIn)
+void Builder::cut(const std::vector<uint32_t>& ringIn, uint32_t a, uint32_t b)
 {
     std::vector<uint32_t> ring = ringIn;
     const std::vector<GridDirection>& g = mOut.grid;
@@ -248,12 +248,13 @@ void Builder::cut(const std::vector<uint32_t>& ringIn)
         }
         if (!clipped) { // rounding made the region non-convex beyond an ear: a fan
             ++mOut.unclipped;
-            for (size_t i = 1; i + 1 < ring.size(); ++i)
+            for (size_t i = 1; i + 2 < ring.size(); ++i)
                 mOut.triangles.push_back(Vec3I(ring[0], ring[i], ring[i + 1]));
-            return;
+            ring = {ring[0], ring[ring.size() - 2], ring.back()};
         }
     }
     mOut.triangles.push_back(Vec3I(ring[0], ring[1], ring[2]));
+    mOut.regions.resize(mOut.triangles.size(), {a, b});
 }
 
 Overlay Builder::run()
@@ -276,7 +277,7 @@ Overlay Builder::run()
         const auto [a, b] = queue.front();
         queue.pop_front();
         if (!region(a, b, ring)) continue;
-        cut(ring);
+        cut(ring, a, b);
         for (int k = 0; k < 3; ++k) {
             if (visited.insert(key(acrossA[3 * a + k], b)).second)
                 queue.emplace_back(acrossA[3 * a + k], b);

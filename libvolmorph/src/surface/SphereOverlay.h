@@ -16,6 +16,7 @@
 #include "SpherePredicates.h"
 
 #include <cstdint>
+#include <utility>
 #include <vector>
 
 namespace volmorph::detail {
@@ -42,6 +43,8 @@ struct Overlay {
     std::vector<Vec3d> directions;       ///< per vertex, unit
     std::vector<GridDirection> grid;     ///< per vertex, as the predicates see it
     std::vector<Vec3I> triangles;        ///< counter-clockwise seen from outside
+    /// per triangle: the source's and the target's triangle whose intersection it is part of
+    std::vector<std::pair<uint32_t, uint32_t>> regions;
     size_t crossings = 0;
     size_t unclipped = 0; ///< regions cut by a fan because no exact ear was found (should be 0)
 };

@@ -1,55 +1,17 @@
 #include "StarMerge.h"
 
+#include "MergeSide.h"
 #include "SphereOverlay.h"
 
-#include <Eigen/Geometry>
 #include <Eigen/LU>
 #include <tbb/parallel_for.h>
 
-#include <sstream>
 #include <stdexcept>
 
 namespace volmorph::detail {
 namespace {
 
-/// One mesh as the merge sees it: the vertices its triangles use, in double precision.
-struct Side {
-    const Mesh* mesh = nullptr;
-    std::vector<Vec3d> points;
-    std::vector<Vec3I> triangles;
-    std::vector<uint32_t> original; ///< per vertex, its index in the mesh
-    double diagonal = 1.0;
-};
-
-Side compact(const Mesh& mesh)
-{
-    Side s;
-    s.mesh = &mesh;
-    // The used vertices in their order (all of them, for a mesh without strays: then the merged
-    // mesh's first vertices are the mesh's own, in its order).
-    std::vector<char> used(mesh.points.size(), 0);
-    for (const Vec3I& t : mesh.triangles) used[t[0]] = used[t[1]] = used[t[2]] = 1;
-    std::vector<uint32_t> local(mesh.points.size(), 0);
-    for (uint32_t v = 0; v < mesh.points.size(); ++v)
-        if (used[v]) {
-            local[v] = uint32_t(s.points.size());
-            s.points.emplace_back(mesh.points[v]);
-            s.original.push_back(v);
-        }
-    for (const Vec3I& t : mesh.triangles)
-        s.triangles.emplace_back(local[t[0]], local[t[1]], local[t[2]]);
-    const auto [lo, hi] = mesh.bounds();
-    s.diagonal = std::max((hi - lo).length(), 1e-300);
-    return s;
-}
-
-std::string point(const Vec3d& p)
-{
-    std::ostringstream os;
-    os.precision(6);
-    os << "(" << p.x() << ", " << p.y() << ", " << p.z() << ")";
-    return os.str();
-}
+using Side = MergeSide;
 
 KernelPoint kernelOf(const Side& s, const std::optional<Vec3d>& given)
 {
@@ -65,29 +27,16 @@ void requireStarShaped(const Side& s, const KernelPoint& k, bool given, const So
         "triangle " + std::to_string(k.worstTriangle) + " (vertices " +
         std::to_string(s.original[t[0]]) + ", " + std::to_string(s.original[t[1]]) + ", " +
         std::to_string(s.original[t[2]]) + ") faces away from it, so vertex " +
-        std::to_string(s.original[t[0]]) + " at " + point(s.points[t[0]]) + " cannot be seen";
+        std::to_string(s.original[t[0]]) + " at " + pointText(s.points[t[0]]) + " cannot be seen";
     if (given)
         throw UserError(where, "surface.kernel: " + s.mesh->file.string() +
-                                   " is not seen whole from " + point(k.point) + ": " + face);
-    throw UserError(where, s.mesh->file.string() +
-                               " is not star-shaped: no point sees all of its surface (from " +
-                               point(k.point) + ", the point nearest to it, " + face +
-                               "); correspondence = \"sphere\" maps any closed genus-0 mesh");
-}
-
-/// The turn of the target's sphere for a merge attempt: a millionth of a radian about an axis of
-/// no symmetry (another for each attempt).
-Eigen::Matrix3d turn(int attempt)
-{
-    static const Eigen::Vector3d axes[3] = {
-        {0.267, 0.535, 0.802}, {-0.711, 0.218, 0.669}, {0.498, -0.803, 0.327}};
-    return Eigen::AngleAxisd(1e-6, axes[attempt % 3].normalized()).toRotationMatrix();
-}
-
-Vec3d apply(const Eigen::Matrix3d& m, const Vec3d& v)
-{
-    const Eigen::Vector3d e = m * Eigen::Vector3d(v.x(), v.y(), v.z());
-    return {e.x(), e.y(), e.z()};
+                                   " is not seen whole from " + pointText(k.point) + ": " + face);
+    throw UserError(
+        where, s.mesh->file.string() +
+                   " is not star-shaped: no point sees all of its surface (from " +
+                   pointText(k.point) + ", the point nearest to it, " + face +
+                   "); the spherical map (correspondence = \"sphere\", not in this version yet) "
+                   "will map any closed genus-0 mesh");
 }
 
 SphereTriangulation project(const Side& s, const Vec3d& kernel, const Eigen::Matrix3d& turn,
@@ -98,13 +47,13 @@ SphereTriangulation project(const Side& s, const Vec3d& kernel, const Eigen::Mat
     for (const Vec3d& p : s.points) {
         Vec3d d = p - kernel;
         d.normalize();
-        out.directions.push_back(toGrid(apply(turn, d)));
+        out.directions.push_back(toGrid(turned(turn, d)));
     }
     for (uint32_t j = 0; j < s.triangles.size(); ++j) {
         const Vec3I& t = s.triangles[j];
         if (orientation(out.directions[t[0]], out.directions[t[1]], out.directions[t[2]]) <= 0)
             throw UserError(where, s.mesh->file.string() + ": triangle " + std::to_string(j) +
-                                       " is seen edge-on from " + point(kernel) +
+                                       " is seen edge-on from " + pointText(kernel) +
                                        " (too thin to project); correspondence = \"sphere\"");
     }
     return out;
@@ -134,9 +83,7 @@ void place(const Side& s, const Vec3d& kernel, const OverlayVertex& v, bool isSo
     const OverlayVertex::Kind own =
         isSource ? OverlayVertex::Kind::Source : OverlayVertex::Kind::Target;
     const uint32_t* ends = isSource ? v.source : v.target;
-    const auto rgb = [&](uint32_t i) {
-        return s.mesh->hasColors() ? Vec3d(s.mesh->colors[s.original[i]]) : Vec3d(0.8);
-    };
+    const auto rgb = [&](uint32_t i) { return s.color(i); };
     if (v.kind == own) {
         at = s.points[ends[0]];
         if (color) *color = Vec3f(rgb(ends[0]));
@@ -155,7 +102,7 @@ std::pair<KernelPoint, KernelPoint>
 starKernels(const Mesh& source, const Mesh& target,
             const std::optional<std::pair<Vec3d, Vec3d>>& kernels)
 {
-    const Side a = compact(source), b = compact(target);
+    const Side a(source), b(target);
     return {kernelOf(a, kernels ? std::optional<Vec3d>(kernels->first) : std::nullopt),
             kernelOf(b, kernels ? std::optional<Vec3d>(kernels->second) : std::nullopt)};
 }
@@ -164,7 +111,7 @@ Corresponded starMerge(const Mesh& source, const Mesh& target,
                        const std::optional<std::pair<Vec3d, Vec3d>>& kernels,
                        const SourceLocation& where)
 {
-    const Side a = compact(source), b = compact(target);
+    const Side a(source), b(target);
     const KernelPoint ka =
         kernelOf(a, kernels ? std::optional<Vec3d>(kernels->first) : std::nullopt);
     const KernelPoint kb =
@@ -178,7 +125,7 @@ Corresponded starMerge(const Mesh& source, const Mesh& target,
     Eigen::Matrix3d rotation;
     size_t folded = 0;
     for (int attempt = 0; attempt < 3; ++attempt) {
-        rotation = turn(attempt);
+        rotation = mergeTurn(attempt);
         merged = overlay(sa, project(b, kb.point, rotation, where));
         folded = invertedTriangles(merged.grid, merged.triangles);
         if (folded == 0) break;
@@ -204,7 +151,7 @@ Corresponded starMerge(const Mesh& source, const Mesh& target,
         const OverlayVertex& o = merged.vertices[v];
         const Vec3d& dir = merged.directions[v];
         place(a, ka.point, o, true, dir, out.source[v], colors ? &out.sourceColors[v] : nullptr);
-        place(b, kb.point, o, false, apply(rotation.transpose(), dir), out.target[v],
+        place(b, kb.point, o, false, turned(rotation.transpose(), dir), out.target[v],
               colors ? &out.targetColors[v] : nullptr);
     });
     return out;

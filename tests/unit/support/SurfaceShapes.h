@@ -1,6 +1,6 @@
-// Closed meshes for the surface stage's tests, all facing outward, in world units: a tube along x
-// with capped ends (and the same bent in a plane), a latitude-longitude sphere whose radius may
-// vary with direction (a star-shaped blob), and a cube.
+// Meshes for the surface stage's tests, in world units. Closed, facing outward: a tube along x with
+// capped ends (and the same bent in a plane), a latitude-longitude sphere whose radius may vary
+// with direction (a star-shaped blob), a cube. With one boundary loop: a dome and a bumpy sheet.
 #pragma once
 
 #include <volmorph/Mesh.h>
@@ -102,6 +102,55 @@ inline Mesh cube(double half, const Vec3d& centre)
         m.triangles.emplace_back(q[0], q[2], q[3]);
     }
     m.file = "cube.obj";
+    analyzeTopology(m);
+    return m;
+}
+
+/// The upper hemisphere of radius 1 without its pole's cap: `rings` latitude rings of `around`
+/// vertices from near the pole to the equator (the equator is the boundary), a pole vertex, faces
+/// outward.
+inline Mesh dome(int rings, int around)
+{
+    Mesh m;
+    m.points.emplace_back(0.0f, 1.0f, 0.0f);
+    for (int i = 1; i <= rings; ++i) {
+        const double polar = 0.5 * M_PI * i / rings;
+        for (int k = 0; k < around; ++k) {
+            const double a = 2.0 * M_PI * k / around;
+            m.points.emplace_back(float(std::sin(polar) * std::cos(a)), float(std::cos(polar)),
+                                  float(std::sin(polar) * std::sin(a)));
+        }
+    }
+    auto v = [&](int i, int k) { return uint32_t(1 + (i - 1) * around + (k % around)); };
+    for (int k = 0; k < around; ++k) m.triangles.emplace_back(0, v(1, k + 1), v(1, k));
+    for (int i = 1; i < rings; ++i)
+        for (int k = 0; k < around; ++k) {
+            m.triangles.emplace_back(v(i, k), v(i, k + 1), v(i + 1, k + 1));
+            m.triangles.emplace_back(v(i, k), v(i + 1, k + 1), v(i + 1, k));
+        }
+    m.file = "dome.obj";
+    analyzeTopology(m);
+    return m;
+}
+
+/// A square sheet of n x n quads over [-1, 1]^2 in x-z at height y = bump * exp(-2 r^2), facing +y:
+/// one boundary loop, a grid unlike dome()'s rings.
+inline Mesh bumpySheet(int n, double bump)
+{
+    Mesh m;
+    for (int i = 0; i <= n; ++i)
+        for (int k = 0; k <= n; ++k) {
+            const double x = -1.0 + 2.0 * k / n, z = -1.0 + 2.0 * i / n;
+            m.points.emplace_back(float(x), float(bump * std::exp(-2.0 * (x * x + z * z))),
+                                  float(z));
+        }
+    auto v = [&](int i, int k) { return uint32_t(i * (n + 1) + k); };
+    for (int i = 0; i < n; ++i)
+        for (int k = 0; k < n; ++k) {
+            m.triangles.emplace_back(v(i, k), v(i + 1, k + 1), v(i, k + 1));
+            m.triangles.emplace_back(v(i, k), v(i + 1, k), v(i + 1, k + 1));
+        }
+    m.file = "sheet.obj";
     analyzeTopology(m);
     return m;
 }

@@ -2,6 +2,8 @@
 // the interior where the cotangent springs balance, no fold; refusals naming the mesh.
 #include "surface/DiskMap.h"
 
+#include "support/SurfaceShapes.h"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -11,37 +13,13 @@ namespace {
 
 constexpr double kPi = 3.14159265358979323846;
 
-/// The upper hemisphere of radius 1 without its pole's cap: `rings` latitude rings of `around`
-/// vertices from near the pole to the equator (the equator is the boundary), a pole vertex, faces
-/// outward.
-Mesh hemisphere(int rings, int around)
-{
-    Mesh m;
-    m.points.emplace_back(0.0f, 1.0f, 0.0f);
-    for (int i = 1; i <= rings; ++i) {
-        const double polar = 0.5 * kPi * i / rings;
-        for (int k = 0; k < around; ++k) {
-            const double a = 2.0 * kPi * k / around;
-            m.points.emplace_back(float(std::sin(polar) * std::cos(a)), float(std::cos(polar)),
-                                  float(std::sin(polar) * std::sin(a)));
-        }
-    }
-    auto v = [&](int i, int k) { return uint32_t(1 + (i - 1) * around + (k % around)); };
-    for (int k = 0; k < around; ++k) m.triangles.emplace_back(0, v(1, k + 1), v(1, k));
-    for (int i = 1; i < rings; ++i)
-        for (int k = 0; k < around; ++k) {
-            m.triangles.emplace_back(v(i, k), v(i, k + 1), v(i + 1, k + 1));
-            m.triangles.emplace_back(v(i, k), v(i + 1, k + 1), v(i + 1, k));
-        }
-    m.file = "dome.obj";
-    return m;
-}
+using test::dome;
 
 const SourceLocation kWhere{"scene.toml", 4, 1};
 
 TEST(DiskMap, HemisphereMapsOntoTheDiskWithoutFolds)
 {
-    const Mesh dome = hemisphere(12, 32);
+    const Mesh dome = test::dome(12, 32);
     const DiskMap map = harmonicDiskMap(dome, kWhere);
     EXPECT_FALSE(map.meanValue);
     ASSERT_EQ(map.boundary.size(), 32u);
@@ -114,8 +92,8 @@ TEST(DiskMap, RefusesClosedMeshesSeveralLoopsAndPieces)
     tube.file = "tube.obj";
     EXPECT_NE(message(tube).find("tube.obj: 2 boundary loops"), std::string::npos) << message(tube);
 
-    const Mesh other = hemisphere(6, 8);
-    Mesh twoPieces = hemisphere(6, 8);
+    const Mesh other = dome(6, 8);
+    Mesh twoPieces = dome(6, 8);
     const uint32_t m = uint32_t(twoPieces.points.size());
     for (const Vec3f& p : other.points) twoPieces.points.emplace_back(p + Vec3f(3.0f, 0.0f, 0.0f));
     for (const Vec3I& t : other.triangles)

@@ -9,11 +9,10 @@
 #include "surface/StarMerge.h"
 
 #include "support/OpenMeshes.h"
+#include "support/SurfaceChecks.h"
 #include "support/SurfaceShapes.h"
 
 #include <volmorph/SurfaceMorph.h>
-
-#include <openvdb/math/Proximity.h>
 
 #include <Eigen/Geometry>
 #include <gtest/gtest.h>
@@ -56,33 +55,9 @@ SphereTriangulation onSphere(const Mesh& m, const Vec3d& centre, bool turned)
     return s;
 }
 
-/// The distance from `p` to the nearest triangle of `m`.
-double distanceTo(const std::vector<Vec3d>& points, const std::vector<Vec3I>& triangles,
-                  const Vec3d& p)
-{
-    double best = std::numeric_limits<double>::infinity();
-    for (const Vec3I& t : triangles) {
-        Vec3d uvw;
-        const Vec3d q = openvdb::math::closestPointOnTriangleToPoint(points[t[0]], points[t[1]],
-                                                                     points[t[2]], p, uvw);
-        best = std::min(best, (q - p).length());
-    }
-    return best;
-}
-
-double volume(const std::vector<Vec3d>& p, const std::vector<Vec3I>& tris)
-{
-    double v = 0.0;
-    for (const Vec3I& t : tris) v += p[t[0]].dot(p[t[1]].cross(p[t[2]]));
-    return v / 6.0;
-}
-
-double area(const std::vector<Vec3d>& p, const std::vector<Vec3I>& tris)
-{
-    double a = 0.0;
-    for (const Vec3I& t : tris) a += 0.5 * (p[t[1]] - p[t[0]]).cross(p[t[2]] - p[t[0]]).length();
-    return a;
-}
+using test::area;
+using test::distanceTo;
+using test::volume;
 
 TEST(SpherePredicates, ExactWhereDoubleRoundsAndTiesBrokenConsistently)
 {

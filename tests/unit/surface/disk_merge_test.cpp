@@ -1,0 +1,139 @@
+// The disk correspondence (surface/DiskMerge.h): two meshes with one boundary loop, differently
+// tessellated (a dome of rings, a square bumpy sheet of quads), merged in the plane. Checked
+// against the inputs themselves: each side's own vertices kept exactly, every merged vertex on
+// both surfaces (1e-9 of the diagonal), the merged mesh's area equal to each input's (it covers
+// both whole), its boundary on both boundaries, no triangle facing against the input it lies in.
+#include "surface/Correspondence.h"
+#include "surface/DiskMerge.h"
+
+#include "support/SurfaceChecks.h"
+#include "support/SurfaceShapes.h"
+
+#include <gtest/gtest.h>
+
+#include <map>
+
+namespace volmorph::detail {
+namespace {
+
+const SourceLocation kWhere{"scene.toml", 9, 18};
+
+std::vector<Vec3d> pointsOf(const Mesh& m)
+{
+    return {m.points.begin(), m.points.end()};
+}
+
+/// The edges used by one triangle only.
+std::vector<std::pair<uint32_t, uint32_t>> boundaryEdges(const std::vector<Vec3I>& tris)
+{
+    std::map<std::pair<uint32_t, uint32_t>, int> uses;
+    for (const Vec3I& t : tris)
+        for (int k = 0; k < 3; ++k)
+            ++uses[{std::min(t[k], t[(k + 1) % 3]), std::max(t[k], t[(k + 1) % 3])}];
+    std::vector<std::pair<uint32_t, uint32_t>> out;
+    for (const auto& [e, n] : uses)
+        if (n == 1) out.push_back(e);
+    return out;
+}
+
+/// The distance from `p` to the boundary polyline of `m`.
+double distanceToBoundary(const Mesh& m, const Vec3d& p)
+{
+    double best = 1e300;
+    for (const auto& [a, b] : boundaryEdges(m.triangles)) {
+        const Vec3d pa(m.points[a]), pb(m.points[b]);
+        const double t = std::clamp((p - pa).dot(pb - pa) / (pb - pa).lengthSqr(), 0.0, 1.0);
+        best = std::min(best, (pa + t * (pb - pa) - p).length());
+    }
+    return best;
+}
+
+TEST(DiskMerge, ADomeOfRingsAndASheetOfQuadsBoundaryOntoBoundary)
+{
+    const Mesh a = test::dome(9, 28);
+    Mesh sheet = test::bumpySheet(14, 0.4);
+    for (Vec3f& p : sheet.points)
+        p = Vec3f(1.3f * p.x() + 4.0f, p.y(), p.z()); // elsewhere, stretched
+    const Mesh& b = sheet;
+    const Corresponded c = diskMerge(a, b, kWhere);
+    EXPECT_EQ(c.used, Correspondence::Disk);
+    const size_t na = a.points.size(), nb = b.points.size();
+    ASSERT_EQ(c.source.size(), na + nb + c.crossings);
+    for (size_t i = 0; i < na; ++i) EXPECT_EQ(c.source[i], Vec3d(a.points[i]));
+    for (size_t j = 0; j < nb; ++j) EXPECT_EQ(c.target[na + j], Vec3d(b.points[j]));
+    const std::vector<std::pair<uint32_t, uint32_t>> rim = boundaryEdges(c.triangles);
+    for (const auto& [mesh, merged] : {std::pair{&a, &c.source}, std::pair{&b, &c.target}}) {
+        const std::vector<Vec3d> p = pointsOf(*mesh);
+        const auto [lo, hi] = mesh->bounds();
+        const double diagonal = (hi - lo).length();
+        double worst = 0.0, rimWorst = 0.0;
+        for (const Vec3d& x : *merged)
+            worst = std::max(worst, test::distanceTo(p, mesh->triangles, x));
+        EXPECT_LT(worst, 1e-9 * diagonal) << mesh->file;
+        EXPECT_NEAR(test::area(*merged, c.triangles) / test::area(p, mesh->triangles), 1.0, 1e-9)
+            << mesh->file;
+        for (const auto& [u, v] : rim)
+            for (uint32_t w : {u, v})
+                rimWorst = std::max(rimWorst, distanceToBoundary(*mesh, (*merged)[w]));
+        EXPECT_LT(rimWorst, 1e-9 * diagonal) << mesh->file << ": the merged boundary is off it";
+        // Every merged triangle with an area faces as the input's surface there does.
+        size_t against = 0;
+        for (const Vec3I& t : c.triangles) {
+            const Vec3d n =
+                ((*merged)[t[1]] - (*merged)[t[0]]).cross((*merged)[t[2]] - (*merged)[t[0]]);
+            if (n.length() < 1e-9 * diagonal * diagonal) continue;
+            const Vec3d centre = ((*merged)[t[0]] + (*merged)[t[1]] + (*merged)[t[2]]) / 3.0;
+            double best = 1e300;
+            Vec3d facing(0.0);
+            for (const Vec3I& u : mesh->triangles) {
+                Vec3d uvw;
+                const Vec3d q = openvdb::math::closestPointOnTriangleToPoint(p[u[0]], p[u[1]],
+                                                                             p[u[2]], centre, uvw);
+                if ((q - centre).length() < best) {
+                    best = (q - centre).length();
+                    facing = (p[u[1]] - p[u[0]]).cross(p[u[2]] - p[u[0]]);
+                }
+            }
+            against += n.dot(facing) <= 0.0;
+        }
+        EXPECT_EQ(against, 0u) << mesh->file;
+    }
+    std::printf("dome (%zu) and sheet (%zu): %zu merged vertices, %zu crossings\n", na, nb,
+                c.source.size(), c.crossings);
+}
+
+std::string refusal(const Mesh& a, const Mesh& b, Correspondence correspondence)
+{
+    SurfaceSpec spec;
+    spec.correspondence = correspondence;
+    spec.correspondenceWhere = kWhere;
+    try {
+        correspond(a, b, spec);
+    } catch (const UserError& e) {
+        return e.what();
+    }
+    return {};
+}
+
+TEST(DiskMerge, RefusesClosedMeshesAndSeveralLoopsNamingTheMesh)
+{
+    const Mesh sheet = test::bumpySheet(6, 0.2);
+    const Mesh ball = test::radialSphere(
+        5, 8, Vec3d(0.0), [](const Vec3d&) { return 1.0; }, "ball.obj");
+    EXPECT_NE(
+        refusal(sheet, ball, Correspondence::Disk)
+            .find("surface.correspondence = \"disk\": ball.obj has no boundary (a closed mesh); "
+                  "the disk map needs one boundary loop"),
+        std::string::npos);
+    Mesh pipe = test::tube(5, 8, 2.0, 0.3); // without its two end caps: two loops
+    pipe.triangles.resize(pipe.triangles.size() - 16);
+    analyzeTopology(pipe);
+    pipe.file = "pipe.obj";
+    const std::string loops = refusal(sheet, pipe, Correspondence::Disk);
+    EXPECT_NE(loops.find("pipe.obj: 2 boundary loops"), std::string::npos) << loops;
+    // auto on two open meshes: the disk merge.
+    EXPECT_EQ(refusal(sheet, test::dome(4, 10), Correspondence::Auto), "");
+}
+
+} // namespace
+} // namespace volmorph::detail
