@@ -236,10 +236,13 @@ void printSurface(const Scene& scene, const SceneMeshes& meshes)
         std::printf("        projected from %s (source) and %s (target), world units%s\n",
                     fmt(k->first).c_str(), fmt(k->second).c_str(),
                     scene.surface.kernel ? "" : ": each mesh's deepest kernel point");
-    if (!scene.pairs.empty())
-        std::printf(
-            "        %zu landmark pairs: not used by the %s correspondence in this version\n",
-            scene.pairs.size(), used.c_str());
+    if (!scene.pairs.empty() && m.correspondence() == Correspondence::Identity)
+        std::printf("        %zu landmark pairs: not used by the identity (vertex i is vertex i)\n",
+                    scene.pairs.size());
+    else if (!scene.pairs.empty())
+        std::printf("        %zu landmark pairs meet: each snapped to its surface, the target's "
+                    "point a vertex\n",
+                    scene.pairs.size());
 }
 
 /// An environment light, and its sky map's size once read.

@@ -7,6 +7,7 @@
 
 #include <optional>
 #include <utility>
+#include <vector>
 
 namespace volmorph {
 
@@ -29,12 +30,21 @@ enum class SurfaceInterpolation {
     Linear, ///< each vertex on the straight line between its two positions
 };
 
+/// A point of the source's surface that must meet a point of the target's (a scene's point
+/// [[pair]] in surface mode): each snapped to its mesh's nearest point, world units.
+struct SurfaceLandmark {
+    Vec3d source, target;
+    SourceLocation where; ///< the [[pair]]
+};
+
 struct SurfaceSpec {
     Correspondence correspondence = Correspondence::Auto;
     SurfaceInterpolation interpolation = SurfaceInterpolation::Arap;
     /// star only: a point inside each mesh from which all of its surface is seen (world units);
     /// unset: found from the mesh.
     std::optional<std::pair<Vec3d, Vec3d>> kernel;
+    /// The merged correspondences (star, disk) make each pair meet; the identity ignores them.
+    std::vector<SurfaceLandmark> landmarks;
     SourceLocation where; ///< the [surface] table, when the scene has one
     SourceLocation correspondenceWhere;
 };

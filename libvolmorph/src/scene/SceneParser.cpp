@@ -68,7 +68,7 @@ public:
             if (mScene.blend.mode != BlendMode::Surface)
                 r.error(r.at(*n), "[surface]: only used with blend.mode = \"surface\"");
         }
-        if (mScene.blend.mode == BlendMode::Surface) checkSurfaceMode();
+        if (mScene.blend.mode == BlendMode::Surface) checkSurfaceMode(root);
         if (const toml::node* n = root.get("render"))
             detail::parseRender(r, *n, mScene.folder, mScene.render);
         if (const toml::node* n = root.get("prop"))
@@ -85,8 +85,12 @@ public:
 
 private:
     /// Surface mode morphs two meshes; its point pairs are landmarks, other pairs have no meaning.
-    void checkSurfaceMode()
+    void checkSurfaceMode(const toml::table& root)
     {
+        // Without a [surface] table its errors are the mode's: blend.mode = "surface".
+        if (mScene.surface.where.file.empty())
+            if (const toml::table* blend = root.get_as<toml::table>("blend"))
+                if (const toml::node* mode = blend->get("mode")) mScene.surface.where = r.at(*mode);
         for (const ObjectSpec* side : {&mScene.source, &mScene.target})
             if (side->isVolume())
                 r.error(side->fileWhere, "blend.mode = \"surface\" morphs two meshes; " +
@@ -96,6 +100,8 @@ private:
             if (p.type != FeatureType::Point)
                 r.error(p.where, "[[pair]]: blend.mode = \"surface\" takes point pairs only "
                                  "(landmarks that meet)");
+            else
+                mScene.surface.landmarks.push_back({p.source.origin, p.target.origin, p.where});
     }
 
     void parseFrames(const toml::node& node)

@@ -87,12 +87,16 @@ std::string starMismatch(const Mesh& mesh)
 
 namespace {
 
-/// The message of a UserError with one diagnostic thrown at the correspondence's key ("" for
-/// anything else: a kernel's own error, several diagnostics).
-std::string reason(const UserError& e)
+/// The message of a UserError with one diagnostic thrown at the correspondence's key `where` (""
+/// for anything else: a kernel's own error, a landmark's, several diagnostics).
+std::string reason(const UserError& e, const SourceLocation& where)
 {
-    const std::string& why = e.diagnostics().front().message;
-    return e.diagnostics().size() == 1 && why.rfind("surface.kernel", 0) != 0 ? why : std::string();
+    const Diagnostic& d = e.diagnostics().front();
+    const bool here =
+        d.where.file == where.file && d.where.line == where.line && d.where.column == where.column;
+    return e.diagnostics().size() == 1 && here && d.message.rfind("surface.kernel", 0) != 0
+               ? d.message
+               : std::string();
 }
 
 /// Why the disk merge does not apply before trying it: a closed mesh.
@@ -133,10 +137,10 @@ Corresponded correspond(const Mesh& source, const Mesh& target, const SurfaceSpe
         if (notStar.empty()) notStar = starMismatch(target);
         if (notStar.empty()) {
             try {
-                return starMerge(source, target, spec.kernel, where);
+                return starMerge(source, target, spec.kernel, spec.landmarks, where);
             } catch (const UserError& e) {
-                if (reason(e).empty()) throw;
-                fail(reason(e));
+                if (reason(e, where).empty()) throw;
+                fail(reason(e, where));
             }
         } else {
             fail(notStar + "; Kent's star-shaped merge needs closed meshes of genus 0");
@@ -147,10 +151,10 @@ Corresponded correspond(const Mesh& source, const Mesh& target, const SurfaceSpe
         if (notDisk.empty()) notDisk = diskMismatch(target);
         if (notDisk.empty()) {
             try {
-                return diskMerge(source, target, where);
+                return diskMerge(source, target, spec.landmarks, where);
             } catch (const UserError& e) {
-                if (reason(e).empty()) throw;
-                fail(reason(e));
+                if (reason(e, where).empty()) throw;
+                fail(reason(e, where));
             }
         } else {
             fail(notDisk + "; the disk map needs one boundary loop");

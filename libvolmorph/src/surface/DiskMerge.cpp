@@ -1,6 +1,7 @@
 #include "DiskMerge.h"
 
 #include "DiskMap.h"
+#include "Landmarks.h"
 #include "MergeSide.h"
 #include "SphereOverlay.h"
 
@@ -43,6 +44,33 @@ void boundaryShape(const MergeSide& s, const Disk& d, std::vector<Vec3d>& points
     }
 }
 
+/// `turn` moved by at most a quarter of a degree so that the two loops' vertices are as far apart
+/// on the circle as they can be: loops spaced alike would otherwise put vertices on vertices and
+/// edges on edges (regions without area), which the merge's tie-breaking turn would then separate
+/// by a millionth only, landmarks included. `a` are the source's angles, `b` the target's sorted.
+double apart(const std::vector<double>& a, const std::vector<double>& b, double turn)
+{
+    auto separation = [&](double phi) {
+        double least = kPi;
+        for (double angle : a) {
+            const double x = std::remainder(angle - phi, 2.0 * kPi);
+            const size_t hi = size_t(std::lower_bound(b.begin(), b.end(), x) - b.begin());
+            for (size_t k : {hi % b.size(), (hi + b.size() - 1) % b.size()})
+                least = std::min(least, std::abs(std::remainder(x - b[k], 2.0 * kPi)));
+        }
+        return least;
+    };
+    double best = -1.0, out = turn;
+    for (int k = -50; k <= 50; ++k) {
+        const double phi = turn + kPi / 720.0 * k / 50.0;
+        if (const double sep = separation(phi); sep > best) {
+            best = sep;
+            out = phi;
+        }
+    }
+    return out;
+}
+
 /// The turn of b's disk that puts b's boundary nearest a's: least squares over the source's
 /// boundary points against the target's boundary at the same angle (interpolated along its loop).
 double bestTurn(const MergeSide& a, const Disk& da, const MergeSide& b, const Disk& db)
@@ -79,7 +107,7 @@ double bestTurn(const MergeSide& a, const Disk& da, const MergeSide& b, const Di
             turn = phi;
         }
     }
-    return turn;
+    return apart(ta, sorted, turn);
 }
 
 /// The side's disk lifted onto the sphere (gnomonic) and closed by a cap: its vertices, then the
@@ -167,14 +195,49 @@ void place(const MergeSide& s, const Disk& d, const OverlayVertex& v, bool isSou
                        w[2] * s.color(corner[2]));
 }
 
+/// The target's disk with each landmark's target point made a vertex and the disk warped
+/// (DiskWarp) so that it lands where the source's landmark point is in the source's disk; the
+/// target's disk turned by `turn` first. Throws UserError at the first landmark's pair when the
+/// landmarks fold the map.
+Disk warpedToLandmarks(const MergeSide& a, const Disk& da, MergeSide& b, double turn,
+                       const std::vector<SurfaceLandmark>& landmarks, const SourceLocation& where)
+{
+    std::vector<Eigen::Vector2d> to, from;
+    for (const MergeSide::Place& p : snapLandmarks(a, landmarks, true)) {
+        const Vec3I& t = a.triangles[p.triangle];
+        to.push_back(p.weights[0] * da.uv[t[0]] + p.weights[1] * da.uv[t[1]] +
+                     p.weights[2] * da.uv[t[2]]);
+    }
+    snapLandmarks(b, landmarks, false); // the checks; each is placed once the last is in
+    std::vector<uint32_t> held;
+    for (const SurfaceLandmark& l : landmarks) held.push_back(b.insert(b.nearest(l.target)));
+    const Mesh mesh = b.compacted();
+    Disk d = diskOf(b, where);
+    for (uint32_t v : held) from.push_back(rotate(d.uv[v], turn));
+    const DiskWarp warp(from, to);
+    for (Eigen::Vector2d& p : d.uv) p = warp(rotate(p, turn));
+    if (const size_t folded = foldedTriangles(mesh, d.uv); folded > 0)
+        throw UserError(landmarks.front().where,
+                        "[[pair]]: the landmarks (" + landmarkPlaces(landmarks) + ") fold " +
+                            std::to_string(folded) + " triangles of " + b.mesh->file.string() +
+                            "'s disk map: they cannot meet without folding it");
+    return d;
+}
+
 } // namespace
 
-Corresponded diskMerge(const Mesh& source, const Mesh& target, const SourceLocation& where)
+Corresponded diskMerge(const Mesh& source, const Mesh& target,
+                       const std::vector<SurfaceLandmark>& landmarks, const SourceLocation& where)
 {
-    const MergeSide a(source), b(target);
+    const MergeSide a(source);
+    MergeSide b(target);
     const Disk da = diskOf(a, where);
     Disk db = diskOf(b, where);
-    const double fit = bestTurn(a, da, b, db);
+    double fit = bestTurn(a, da, b, db);
+    if (!landmarks.empty()) { // turned by the fit, then warped onto the landmarks
+        db = warpedToLandmarks(a, da, b, fit, landmarks, where);
+        fit = 0.0;
+    }
     // The caps' poles apart (the regions in both caps are dropped, but must have areas).
     Vec3d poleB(1e-3, 2e-3, -1.0);
     poleB.normalize();
@@ -183,7 +246,7 @@ Corresponded diskMerge(const Mesh& source, const Mesh& target, const SourceLocat
     Overlay merged;
     std::vector<Vec3I> kept;
     db.turn = fit;
-    for (int attempt = 0; attempt < 3; ++attempt) {
+    for (int attempt = 0; attempt < kMergeAttempts; ++attempt) {
         db.sphere = mergeTurn(attempt);
         merged = overlay(sa, lift(b, db, poleB));
         // Keep the regions inside either disk.

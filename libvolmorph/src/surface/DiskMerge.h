@@ -12,16 +12,21 @@
 // boundaries. Regions in both caps are dropped.
 //
 // The target's disk is turned about its centre to best fit the source's boundary (the boundary
-// points' positions, each taken about its loop's mean, least squares over 720 turns), then by a
-// millionth of a radian so no vertex of one lies exactly on an edge of the other.
+// points' positions, each taken about its loop's mean, least squares over 720 turns). Exact ties
+// (two symmetric disks both put a vertex at the centre) are broken as in the star merge
+// (MergeSide.h's mergeTurn).
 #pragma once
 
 #include "Correspondence.h"
 
 namespace volmorph::detail {
 
-/// The disk merge of `source` and `target`. Throws UserError at `where` naming the mesh when it
-/// does not have exactly one boundary loop and one piece, or when its disk map folds.
-Corresponded diskMerge(const Mesh& source, const Mesh& target, const SourceLocation& where);
+/// The disk merge of `source` and `target`. With landmarks, each target point becomes a vertex of
+/// the target, and the target's disk (turned as without them) is warped (DiskWarp) so that each
+/// lands where the source's point is in the source's disk. Throws UserError at `where` naming the
+/// mesh when it does not have exactly one boundary loop and one piece, or when its disk map folds;
+/// at a landmark's pair when a point is off its surface or the landmarks fold the map.
+Corresponded diskMerge(const Mesh& source, const Mesh& target,
+                       const std::vector<SurfaceLandmark>& landmarks, const SourceLocation& where);
 
 } // namespace volmorph::detail

@@ -16,25 +16,38 @@ struct MergeSide {
     const Mesh* mesh = nullptr;
     std::vector<Vec3d> points;      ///< world units
     std::vector<Vec3I> triangles;   ///< into `points`
-    std::vector<uint32_t> original; ///< per vertex, its index in the mesh
+    std::vector<uint32_t> original; ///< per vertex, its index in the mesh (kNone: inserted)
+    std::vector<Vec3d> colors;      ///< per vertex, linear RGB (grey when the mesh has none)
     double diagonal = 1.0;          ///< of the mesh's bounds, world units
+
+    static constexpr uint32_t kNone = ~0u;
 
     /// The used vertices in the mesh's order (all of them, for a mesh without strays: then the
     /// merged mesh's first vertices are the mesh's own, in its order).
     explicit MergeSide(const Mesh& m);
 
-    /// Vertex v's colour, grey (Voxelize.cpp's) when the mesh has none.
-    Vec3d color(uint32_t v) const
-    {
-        return mesh->hasColors() ? Vec3d(mesh->colors[original[v]]) : Vec3d(0.8);
-    }
-    /// `mesh` with only the used vertices (for the maps that take a Mesh).
+    Vec3d color(uint32_t v) const { return colors[v]; }
+    /// The used vertices (and any inserted), as a Mesh for the maps that take one.
     Mesh compacted() const;
+
+    /// The nearest point of the surface to `p`: its triangle and barycentric weights there.
+    struct Place {
+        uint32_t triangle = 0;
+        Vec3d weights;
+        Vec3d point;
+        double distance = 0.0;
+    };
+    Place nearest(const Vec3d& p) const;
+    /// Makes `at` a vertex, splitting its triangle (or the edge it lies on; a vertex it is at is
+    /// returned as it is), the surface unchanged. Returns the vertex.
+    uint32_t insert(const Place& at);
 };
 
-/// The turn of the target's sphere for a merge attempt: a millionth of a radian about an axis of
-/// no symmetry (another for each attempt), so that no vertex of one side lies exactly on a vertex
-/// or edge of the other (which would leave regions without area).
+/// The turn of the target's sphere for a merge attempt (kMergeAttempts): none at first, so that
+/// landmarks meet exactly; then, when a vertex of one side lies exactly on a vertex or edge of the
+/// other (which leaves regions without area), a millionth of a radian about an axis of no
+/// symmetry, another for each attempt.
+inline constexpr int kMergeAttempts = 4;
 Eigen::Matrix3d mergeTurn(int attempt);
 Vec3d turned(const Eigen::Matrix3d& m, const Vec3d& v);
 

@@ -4,12 +4,11 @@
 // merged network mapped back onto both surfaces by the same projections: one connectivity, each
 // vertex with a place on each surface. Vertex colours follow through barycentric coordinates.
 //
-// The target's sphere is turned by a millionth of a radian about a fixed axis of no symmetry before
-// the merge, so that a vertex of one mesh exactly on an edge or vertex of the other (a sphere's
-// pole on a cube face's diagonal) does not leave regions without area; the exact predicates'
-// simulated ties would keep the network valid but not its triangles' areas. The places on the
-// surfaces are unaffected (each side is mapped back through its own projection); the
-// correspondence moves by a millionth of the radius.
+// A vertex of one mesh exactly on an edge or vertex of the other (a sphere's pole on a cube face's
+// diagonal) leaves regions without area; the merge is then made again with the target's sphere
+// turned by a millionth of a radian about an axis of no symmetry (MergeSide.h's mergeTurn). The
+// places on the surfaces are unaffected (each side is mapped back through its own projection);
+// the correspondence moves by a millionth of the radius.
 #pragma once
 
 #include "Correspondence.h"
@@ -18,14 +17,17 @@
 namespace volmorph::detail {
 
 /// Kent's merge of `source` and `target` (closed, genus 0, outward-facing), projected from
-/// `kernels` (world units) when given, else from each mesh's deepest kernel point. Throws
+/// `kernels` (world units) when given, else from each mesh's deepest kernel point. Each landmark's
+/// target point becomes a vertex of the target, and the target's sphere is warped (SphereWarp) so
+/// that it meets the source's point; a landmark off its surface, or landmarks that would turn a
+/// triangle over, are refused at their pair. Throws
 /// UserError at `where` naming the mesh when it is not star-shaped from the given point (the
 /// message starts "surface.kernel: ") or from any (a triangle seen from behind and its vertex that
 /// cannot be seen; the message starts with the mesh file), or when the merge leaves a triangle
-/// without area on the sphere after three turns.
+/// without area on the sphere after every turn.
 Corresponded starMerge(const Mesh& source, const Mesh& target,
                        const std::optional<std::pair<Vec3d, Vec3d>>& kernels,
-                       const SourceLocation& where);
+                       const std::vector<SurfaceLandmark>& landmarks, const SourceLocation& where);
 
 /// The kernel points starMerge would use (for `volmorph check`): given, or the deepest.
 std::pair<KernelPoint, KernelPoint>

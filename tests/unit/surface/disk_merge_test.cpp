@@ -55,7 +55,7 @@ TEST(DiskMerge, ADomeOfRingsAndASheetOfQuadsBoundaryOntoBoundary)
     for (Vec3f& p : sheet.points)
         p = Vec3f(1.3f * p.x() + 4.0f, p.y(), p.z()); // elsewhere, stretched
     const Mesh& b = sheet;
-    const Corresponded c = diskMerge(a, b, kWhere);
+    const Corresponded c = diskMerge(a, b, {}, kWhere);
     EXPECT_EQ(c.used, Correspondence::Disk);
     const size_t na = a.points.size(), nb = b.points.size();
     ASSERT_EQ(c.source.size(), na + nb + c.crossings);
@@ -133,6 +133,58 @@ TEST(DiskMerge, RefusesClosedMeshesAndSeveralLoopsNamingTheMesh)
     EXPECT_NE(loops.find("pipe.obj: 2 boundary loops"), std::string::npos) << loops;
     // auto on two open meshes: the disk merge.
     EXPECT_EQ(refusal(sheet, test::dome(4, 10), Correspondence::Auto), "");
+}
+
+TEST(DiskMerge, LandmarksMeetAndFoldingOnesAreRefused)
+{
+    const Mesh a = test::dome(9, 28);
+    const Mesh b = test::bumpySheet(14, 0.4);
+    auto nearest = [](const Mesh& m, const Vec3d& p) {
+        const std::vector<Vec3d> pts = pointsOf(m);
+        Vec3d best = p;
+        for (const Vec3I& t : m.triangles) {
+            Vec3d uvw;
+            const Vec3d q = openvdb::math::closestPointOnTriangleToPoint(pts[t[0]], pts[t[1]],
+                                                                         pts[t[2]], p, uvw);
+            if ((q - p).length() < (best - p).length() || best == p) best = q;
+        }
+        return best;
+    };
+    // Two points of the dome onto two of the sheet, on the same side of the centre as each other.
+    const std::vector<SurfaceLandmark> marks = {
+        {Vec3d(0.5, 0.85, 0.1), Vec3d(0.6, 0.2, 0.1), {"scene.toml", 12, 1}},
+        {Vec3d(-0.3, 0.9, -0.3), Vec3d(-0.4, 0.3, -0.5), {"scene.toml", 16, 1}}};
+    const Corresponded c = diskMerge(a, b, marks, kWhere);
+    for (const SurfaceLandmark& l : marks) {
+        const Vec3d pa = nearest(a, l.source), pb = nearest(b, l.target);
+        double apart = 1e300; // the source's distance where the target's point is
+        for (size_t v = 0; v < c.source.size(); ++v)
+            if ((c.target[v] - pb).length() < 1e-9)
+                apart = std::min(apart, (c.source[v] - pa).length());
+        EXPECT_LT(apart, 1e-9) << l.where.str() << " does not meet";
+    }
+    EXPECT_NEAR(test::area(c.source, c.triangles) / test::area(pointsOf(a), a.triangles), 1.0,
+                1e-9);
+    EXPECT_NEAR(test::area(c.target, c.triangles) / test::area(pointsOf(b), b.triangles), 1.0,
+                1e-9);
+
+    // The same two landmarks with their target points swapped, and a third pinning the middle:
+    // the map would have to turn the disk inside out between them.
+    const std::vector<SurfaceLandmark> crossed = {
+        {Vec3d(0.6, 0.8, 0.0), Vec3d(-0.8, 0.1, 0.0), {"scene.toml", 12, 1}},
+        {Vec3d(-0.6, 0.8, 0.0), Vec3d(0.8, 0.1, 0.0), {"scene.toml", 16, 1}},
+        {Vec3d(0.0, 1.0, 0.0), Vec3d(0.0, 0.4, 0.0), {"scene.toml", 20, 1}},
+        {Vec3d(0.0, 0.8, 0.6), Vec3d(0.0, 0.1, 0.8), {"scene.toml", 24, 1}}};
+    try {
+        diskMerge(a, b, crossed, kWhere);
+        ADD_FAILURE() << "landmarks that fold the disk were accepted";
+    } catch (const UserError& e) {
+        EXPECT_NE(std::string(e.what()).find(
+                      "scene.toml:12:1: [[pair]]: the landmarks (scene.toml:12:1, "),
+                  std::string::npos)
+            << e.what();
+        EXPECT_NE(std::string(e.what()).find("cannot meet without folding it"), std::string::npos);
+    }
 }
 
 } // namespace

@@ -182,7 +182,7 @@ TEST(StarMerge, ACubeIntoASphere)
     const Mesh a = test::cube(1.0, Vec3d(2.0, 0.0, 0.0));
     const Mesh b = test::radialSphere(
         16, 24, Vec3d(-1.0, 0.5, 0.0), [](const Vec3d&) { return 1.2; }, "sphere.obj");
-    const Corresponded c = starMerge(a, b, std::nullopt, kWhere);
+    const Corresponded c = starMerge(a, b, std::nullopt, {}, kWhere);
     EXPECT_EQ(c.used, Correspondence::Star);
     checkMerge(a, b, c);
     std::printf("cube (8) into sphere (%zu): %zu merged vertices, %zu crossings\n", b.points.size(),
@@ -193,7 +193,7 @@ TEST(StarMerge, TheSameMeshOnBothSidesDespiteEveryVertexCoinciding)
 {
     const Mesh a = test::radialSphere(
         7, 10, Vec3d(0.0), [](const Vec3d&) { return 1.0; }, "a.obj");
-    checkMerge(a, a, starMerge(a, a, std::nullopt, kWhere));
+    checkMerge(a, a, starMerge(a, a, std::nullopt, {}, kWhere));
 }
 
 TEST(StarMerge, ABlobIntoAnEllipsoidCarriesItsColours)
@@ -213,7 +213,7 @@ TEST(StarMerge, ABlobIntoAnEllipsoidCarriesItsColours)
     };
     for (const Vec3f& p : a.points) a.colors.emplace_back(rgb(Vec3d(p)));
     const Corresponded c =
-        starMerge(a, b, std::pair{Vec3d(0.1, 0.0, 1.1), Vec3d(5.2, 0.1, 0.0)}, kWhere);
+        starMerge(a, b, std::pair{Vec3d(0.1, 0.0, 1.1), Vec3d(5.2, 0.1, 0.0)}, {}, kWhere);
     checkMerge(a, b, c);
     ASSERT_EQ(c.sourceColors.size(), c.source.size());
     for (size_t v = 0; v < c.source.size(); ++v) {
@@ -285,7 +285,7 @@ TEST(StarMerge, RigidInBetweensOfAMergeStartAndEndOnTheInputs)
     spec.correspondence = Correspondence::Auto; // not the identity: the star merge
     const SurfaceMorpher m(a, b, spec);
     EXPECT_EQ(m.correspondence(), Correspondence::Star);
-    const Corresponded c = starMerge(a, b, std::nullopt, kWhere);
+    const Corresponded c = starMerge(a, b, std::nullopt, {}, kWhere);
     ASSERT_EQ(m.vertexCount(), c.source.size());
     for (const auto& [tau, side] : {std::pair{0.0, &c.source}, std::pair{1.0, &c.target}}) {
         const SurfaceFrame f = m.frame(tau, tau);
@@ -305,6 +305,97 @@ TEST(StarMerge, RigidInBetweensOfAMergeStartAndEndOnTheInputs)
         scale = std::max(scale, fd.length());
     }
     EXPECT_LT(worst, 0.01 * scale);
+}
+
+namespace landmarks {
+
+/// The nearest point of `m` to `p`.
+Vec3d snapped(const Mesh& m, const Vec3d& p)
+{
+    const std::vector<Vec3d> pts = pointsOf(m);
+    Vec3d best = p;
+    double d = 1e300;
+    for (const Vec3I& t : m.triangles) {
+        Vec3d uvw;
+        const Vec3d q =
+            openvdb::math::closestPointOnTriangleToPoint(pts[t[0]], pts[t[1]], pts[t[2]], p, uvw);
+        if ((q - p).length() < d) {
+            d = (q - p).length();
+            best = q;
+        }
+    }
+    return best;
+}
+
+/// The merged vertex where landmark `l` meets: at the snapped source point on the source side and
+/// the snapped target point on the target side (1e-9 of the size), or -1.
+int meeting(const Corresponded& c, const Mesh& a, const Mesh& b, const SurfaceLandmark& l)
+{
+    const Vec3d pa = snapped(a, l.source), pb = snapped(b, l.target);
+    for (size_t v = 0; v < c.source.size(); ++v)
+        if ((c.source[v] - pa).length() < 1e-9 && (c.target[v] - pb).length() < 1e-9) return int(v);
+    return -1;
+}
+
+} // namespace landmarks
+
+TEST(StarMerge, LandmarksMeet)
+{
+    const Mesh a = test::cube(1.0, Vec3d(2.0, 0.0, 0.0));
+    const Mesh b = test::radialSphere(
+        16, 24, Vec3d(-1.0, 0.5, 0.0), [](const Vec3d&) { return 1.2; }, "sphere.obj");
+    // The top face onto the sphere's pole (a vertex), a point near a corner (off the cube, snapped)
+    // onto its side, one more; none on a cube edge (there, the merge's tie-breaking turn would
+    // leave the pair a millionth of the size apart).
+    const std::vector<SurfaceLandmark> marks = {
+        {Vec3d(2.3, 0.4, 1.0), Vec3d(-1.0, 0.5, 1.25), {"scene.toml", 10, 1}},
+        {Vec3d(2.9, 0.9, 0.3), Vec3d(-1.0, 1.75, 0.0), {"scene.toml", 14, 1}},
+        {Vec3d(1.0, -0.5, -0.2), Vec3d(-2.2, 0.5, -0.1), {"scene.toml", 18, 1}}};
+    const Corresponded c = starMerge(a, b, std::nullopt, marks, kWhere);
+    EXPECT_EQ(c.folded, 0u);
+    for (const SurfaceLandmark& l : marks)
+        EXPECT_GE(landmarks::meeting(c, a, b, l), 0) << l.where.str() << " does not meet";
+    // Still a merge of the two surfaces: the target got a vertex per landmark not at one of its
+    // own (the pole is), the surfaces are whole.
+    ASSERT_EQ(c.source.size(), a.points.size() + b.points.size() + 2 + c.crossings);
+    const std::vector<Vec3d> pa = pointsOf(a), pb = pointsOf(b);
+    EXPECT_NEAR(volume(c.source, c.triangles) / volume(pa, a.triangles), 1.0, 1e-9);
+    EXPECT_NEAR(volume(c.target, c.triangles) / volume(pb, b.triangles), 1.0, 1e-9);
+}
+
+TEST(StarMerge, LandmarksOffTheSurfaceOrFoldingTheMapAreRefusedAtTheirPair)
+{
+    const Mesh a = test::radialSphere(
+        10, 16, Vec3d(0.0), [](const Vec3d&) { return 1.0; }, "a.obj");
+    const Mesh b = test::radialSphere(
+        12, 14, Vec3d(0.0), [](const Vec3d&) { return 1.0; }, "b.obj");
+    try {
+        starMerge(a, b, std::nullopt,
+                  {{Vec3d(0.0, 0.0, 1.5), Vec3d(0.0, 0.0, 1.0), {"s.toml", 5, 1}}}, kWhere);
+        ADD_FAILURE() << "a landmark half a radius off the surface was accepted";
+    } catch (const UserError& e) {
+        EXPECT_NE(
+            std::string(e.what()).find("s.toml:5:1: [[pair]]: the source landmark (0, 0, 1.5) is"),
+            std::string::npos)
+            << e.what();
+    }
+    // Mirrored: three landmarks counter-clockwise on one side, clockwise on the other.
+    const double r = 1.0 / std::sqrt(3.0);
+    const std::vector<SurfaceLandmark> mirrored = {
+        {Vec3d(1.0, 0.0, 0.0), Vec3d(1.0, 0.0, 0.0), {"s.toml", 5, 1}},
+        {Vec3d(0.0, 1.0, 0.0), Vec3d(0.0, 0.0, 1.0), {"s.toml", 9, 1}},
+        {Vec3d(0.0, 0.0, 1.0), Vec3d(0.0, 1.0, 0.0), {"s.toml", 13, 1}},
+        {Vec3d(r, r, r), Vec3d(r, r, r), {"s.toml", 17, 1}}};
+    try {
+        starMerge(a, b, std::nullopt, mirrored, kWhere);
+        ADD_FAILURE() << "mirrored landmarks were accepted";
+    } catch (const UserError& e) {
+        EXPECT_NE(std::string(e.what()).find("s.toml:5:1: [[pair]]: the landmarks (s.toml:5:1, "),
+                  std::string::npos)
+            << e.what();
+        EXPECT_NE(std::string(e.what()).find("cannot meet without folding the map"),
+                  std::string::npos);
+    }
 }
 
 } // namespace
