@@ -26,9 +26,6 @@ struct Corresponded {
     size_t crossings = 0; ///< merged: the points where an edge of one crossed an edge of the other
     /// star: the points each side was projected from (world units)
     std::optional<std::pair<Vec3d, Vec3d>> kernels;
-    /// merged: the merged triangles not strictly counter-clockwise on the sphere (by the exact
-    /// predicate on their grid directions); 0 for a valid merge.
-    size_t folded = 0;
 };
 
 /// Why the identity does not apply to these meshes ("" when it does).

@@ -74,7 +74,7 @@ private:
         return orientationSoS(mA.directions[p], p, mA.directions[q], q, mB.directions[targetVertex],
                               nA() + targetVertex);
     }
-    uint32_t locate(uint32_t sourceVertex) const;
+    uint32_t locate(uint32_t sourceVertex, const std::vector<uint32_t>& across) const;
     bool region(uint32_t a, uint32_t b, std::vector<uint32_t>& ring);
     uint32_t vertexOf(const Event& e, bool onSource, uint32_t a, uint32_t b);
     void cut(const std::vector<uint32_t>& ring, uint32_t a, uint32_t b);
@@ -85,9 +85,8 @@ private:
     std::unordered_map<uint64_t, std::unordered_map<uint64_t, uint32_t>> mCrossings;
 };
 
-uint32_t Builder::locate(uint32_t sourceVertex) const
+uint32_t Builder::locate(uint32_t sourceVertex, const std::vector<uint32_t>& across) const
 {
-    const std::vector<uint32_t> across = neighbours(mB.triangles);
     uint32_t t = 0;
     for (size_t step = 0; step < 4 * mB.triangles.size() + 16; ++step) {
         int out = -1;
@@ -269,7 +268,7 @@ Overlay Builder::run()
     auto key = [nB](uint32_t a, uint32_t b) { return uint64_t(a) * nB + b; };
     std::unordered_set<uint64_t> visited;
     std::deque<std::pair<uint32_t, uint32_t>> queue;
-    const uint32_t seedB = locate(0);
+    const uint32_t seedB = locate(0, acrossB);
     queue.emplace_back(seedA, seedB);
     visited.insert(key(seedA, seedB));
     std::vector<uint32_t> ring;

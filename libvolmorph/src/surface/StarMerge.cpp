@@ -115,15 +115,6 @@ std::string edgeOn(const Side& s, const Vec3d& kernel, uint32_t triangle)
 
 } // namespace
 
-std::pair<KernelPoint, KernelPoint>
-starKernels(const Mesh& source, const Mesh& target,
-            const std::optional<std::pair<Vec3d, Vec3d>>& kernels)
-{
-    const Side a(source), b(target);
-    return {kernelOf(a, kernels ? std::optional<Vec3d>(kernels->first) : std::nullopt),
-            kernelOf(b, kernels ? std::optional<Vec3d>(kernels->second) : std::nullopt)};
-}
-
 namespace {
 
 /// The target's landmarks made vertices, and the warp of its sphere that takes each onto the

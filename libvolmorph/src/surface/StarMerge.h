@@ -29,9 +29,4 @@ Corresponded starMerge(const Mesh& source, const Mesh& target,
                        const std::optional<std::pair<Vec3d, Vec3d>>& kernels,
                        const std::vector<SurfaceLandmark>& landmarks, const SourceLocation& where);
 
-/// The kernel points starMerge would use (for `volmorph check`): given, or the deepest.
-std::pair<KernelPoint, KernelPoint>
-starKernels(const Mesh& source, const Mesh& target,
-            const std::optional<std::pair<Vec3d, Vec3d>>& kernels);
-
 } // namespace volmorph::detail

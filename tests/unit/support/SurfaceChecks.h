@@ -41,4 +41,32 @@ inline double area(const std::vector<Vec3d>& p, const std::vector<Vec3I>& tris)
     return a;
 }
 
+/// The merged triangles (`merged` positions on one input, `triangles`) with an area that face
+/// against the input triangle nearest their centre (`points`, `inputTriangles`): 0 when the merged
+/// mesh lies on the input as it faces (nothing folded over).
+inline size_t facingAgainst(const std::vector<Vec3d>& merged, const std::vector<Vec3I>& triangles,
+                            const std::vector<Vec3d>& points,
+                            const std::vector<Vec3I>& inputTriangles, double diagonal)
+{
+    size_t against = 0;
+    for (const Vec3I& t : triangles) {
+        const Vec3d n = (merged[t[1]] - merged[t[0]]).cross(merged[t[2]] - merged[t[0]]);
+        if (n.length() < 1e-9 * diagonal * diagonal) continue;
+        const Vec3d centre = (merged[t[0]] + merged[t[1]] + merged[t[2]]) / 3.0;
+        double best = std::numeric_limits<double>::infinity();
+        Vec3d facing(0.0);
+        for (const Vec3I& u : inputTriangles) {
+            Vec3d uvw;
+            const Vec3d q = openvdb::math::closestPointOnTriangleToPoint(points[u[0]], points[u[1]],
+                                                                         points[u[2]], centre, uvw);
+            if ((q - centre).length() < best) {
+                best = (q - centre).length();
+                facing = (points[u[1]] - points[u[0]]).cross(points[u[2]] - points[u[0]]);
+            }
+        }
+        against += n.dot(facing) <= 0.0;
+    }
+    return against;
+}
+
 } // namespace volmorph::test

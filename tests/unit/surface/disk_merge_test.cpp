@@ -77,26 +77,8 @@ TEST(DiskMerge, ADomeOfRingsAndASheetOfQuadsBoundaryOntoBoundary)
                 rimWorst = std::max(rimWorst, distanceToBoundary(*mesh, (*merged)[w]));
         EXPECT_LT(rimWorst, 1e-9 * diagonal) << mesh->file << ": the merged boundary is off it";
         // Every merged triangle with an area faces as the input's surface there does.
-        size_t against = 0;
-        for (const Vec3I& t : c.triangles) {
-            const Vec3d n =
-                ((*merged)[t[1]] - (*merged)[t[0]]).cross((*merged)[t[2]] - (*merged)[t[0]]);
-            if (n.length() < 1e-9 * diagonal * diagonal) continue;
-            const Vec3d centre = ((*merged)[t[0]] + (*merged)[t[1]] + (*merged)[t[2]]) / 3.0;
-            double best = 1e300;
-            Vec3d facing(0.0);
-            for (const Vec3I& u : mesh->triangles) {
-                Vec3d uvw;
-                const Vec3d q = openvdb::math::closestPointOnTriangleToPoint(p[u[0]], p[u[1]],
-                                                                             p[u[2]], centre, uvw);
-                if ((q - centre).length() < best) {
-                    best = (q - centre).length();
-                    facing = (p[u[1]] - p[u[0]]).cross(p[u[2]] - p[u[0]]);
-                }
-            }
-            against += n.dot(facing) <= 0.0;
-        }
-        EXPECT_EQ(against, 0u) << mesh->file;
+        EXPECT_EQ(test::facingAgainst(*merged, c.triangles, p, mesh->triangles, diagonal), 0u)
+            << mesh->file;
     }
     std::printf("dome (%zu) and sheet (%zu): %zu merged vertices, %zu crossings\n", na, nb,
                 c.source.size(), c.crossings);
