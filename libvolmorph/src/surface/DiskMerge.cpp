@@ -5,8 +5,6 @@
 #include "MergeSide.h"
 #include "SphereOverlay.h"
 
-#include <tbb/parallel_for.h>
-
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -275,23 +273,13 @@ Corresponded diskMerge(const Mesh& source, const Mesh& target,
     for (Vec3I& t : kept)
         t = Vec3I(uint32_t(index[t[0]]), uint32_t(index[t[1]]), uint32_t(index[t[2]]));
     out.triangles = std::move(kept);
-    const size_t n = vertices.size();
-    out.crossings = n - a.points.size() - b.points.size();
-    out.source.resize(n);
-    out.target.resize(n);
-    const bool colors = source.hasColors() || target.hasColors();
-    if (colors) {
-        out.sourceColors.resize(n);
-        out.targetColors.resize(n);
-    }
-    tbb::parallel_for(size_t(0), n, [&](size_t i) {
-        const uint32_t v = vertices[i];
-        const OverlayVertex& o = merged.vertices[v];
-        place(a, da, o, true, merged.directions[v], out.source[i],
-              colors ? &out.sourceColors[i] : nullptr);
-        place(b, db, o, false, merged.directions[v], out.target[i],
-              colors ? &out.targetColors[i] : nullptr);
-    });
+    out.crossings = vertices.size() - a.points.size() - b.points.size();
+    placeMergedVertices(out, vertices.size(), source.hasColors() || target.hasColors(),
+                        [&](size_t i, bool isSource, Vec3d& at, Vec3f* color) {
+                            const uint32_t v = vertices[i];
+                            place(isSource ? a : b, isSource ? da : db, merged.vertices[v],
+                                  isSource, merged.directions[v], at, color);
+                        });
     return out;
 }
 

@@ -2,9 +2,12 @@
 // the vertices its triangles use, in double precision, with their colours.
 #pragma once
 
+#include "Correspondence.h"
+
 #include <volmorph/Mesh.h>
 
 #include <Eigen/Core>
+#include <tbb/parallel_for.h>
 
 #include <cstdint>
 #include <string>
@@ -50,6 +53,24 @@ struct MergeSide {
 inline constexpr int kMergeAttempts = 4;
 Eigen::Matrix3d mergeTurn(int attempt);
 Vec3d turned(const Eigen::Matrix3d& m, const Vec3d& v);
+
+/// Sizes `out`'s two sides (and their colours when `colors`) for `n` merged vertices and fills
+/// vertex i of each with place(i, isSource, point, colour or null), in parallel (per index: the
+/// same bits at any thread count).
+template <typename Place>
+void placeMergedVertices(Corresponded& out, size_t n, bool colors, Place&& place)
+{
+    out.source.resize(n);
+    out.target.resize(n);
+    if (colors) {
+        out.sourceColors.resize(n);
+        out.targetColors.resize(n);
+    }
+    tbb::parallel_for(size_t(0), n, [&](size_t i) {
+        place(i, true, out.source[i], colors ? &out.sourceColors[i] : nullptr);
+        place(i, false, out.target[i], colors ? &out.targetColors[i] : nullptr);
+    });
+}
 
 /// "(x, y, z)" with six significant digits, for messages.
 std::string pointText(const Vec3d& p);

@@ -5,7 +5,6 @@
 #include "SphereOverlay.h"
 
 #include <Eigen/LU>
-#include <tbb/parallel_for.h>
 
 #include <stdexcept>
 
@@ -182,22 +181,15 @@ Corresponded starMerge(const Mesh& source, const Mesh& target,
     out.triangles = merged.triangles;
     out.crossings = merged.crossings;
     out.kernels = std::pair{ka.point, kb.point};
-    const size_t n = merged.vertices.size();
-    out.source.resize(n);
-    out.target.resize(n);
-    const bool colors = source.hasColors() || target.hasColors();
-    if (colors) {
-        out.sourceColors.resize(n);
-        out.targetColors.resize(n);
-    }
-    tbb::parallel_for(size_t(0), n, [&](size_t v) {
-        const OverlayVertex& o = merged.vertices[v];
-        const Vec3d& dir = merged.directions[v];
-        place(a, da, ka.point, o, true, dir, out.source[v],
-              colors ? &out.sourceColors[v] : nullptr);
-        place(b, db, kb.point, o, false, turned(rotation.transpose(), dir), out.target[v],
-              colors ? &out.targetColors[v] : nullptr);
-    });
+    placeMergedVertices(out, merged.vertices.size(), source.hasColors() || target.hasColors(),
+                        [&](size_t v, bool isSource, Vec3d& at, Vec3f* color) {
+                            const Vec3d& dir = merged.directions[v];
+                            if (isSource)
+                                place(a, da, ka.point, merged.vertices[v], true, dir, at, color);
+                            else
+                                place(b, db, kb.point, merged.vertices[v], false,
+                                      turned(rotation.transpose(), dir), at, color);
+                        });
     return out;
 }
 
