@@ -70,27 +70,12 @@ for name, points in (("source", pts), ("target", [moved(p) for p in pts])):
 print("%d vertices, %d triangles" % (len(pts), len(tris)))
 PY
 
-scene() { # MODE [SURFACE TABLE]
-    printf '[source]\nmesh = "source.obj"\n[target]\nmesh = "target.obj"\n[volume]\nresolution = 256\n'
-    printf '[blend]\nmode = "%s"\n%s\n[frames]\nrange = "1-24"\noutput = "out/f.####.exr"\n' "$1" "${2:-}"
-}
+. "$src/tests/bench/morph_measure.sh"
 scene surface >"$work/surface.toml"
 scene surface '[surface]
 interpolation = "linear"' >"$work/linear.toml"
 scene sdf >"$work/sdf.toml"
 
-median() { tr ' ' '\n' | grep . | sort -g | awk '{ v[NR] = $1 } END { print v[int((NR + 1) / 2)] }'; }
-measure() { # SCENE OUTPUT: "seconds peak-MB", medians
-    times="" peaks=""
-    i=0
-    while [ "$i" -lt "$runs" ]; do
-        rm -rf "$work/o" "$work/cache"
-        VOLMORPH_CACHE="$work/cache" /usr/bin/time -f "%e %M" -o "$work/t" "$vm" morph "$1" -o "$work/o/$2" -q
-        times="$times $(cut -d' ' -f1 "$work/t")" peaks="$peaks $(cut -d' ' -f2 "$work/t")"
-        i=$((i + 1))
-    done
-    echo "$(echo "$times" | median) $(echo "$(echo "$peaks" | median) / 1024" | bc)"
-}
 set -- $(measure "$work/surface.toml" "m.####.ply")
 ts=$1 ms=$2
 set -- $(measure "$work/sdf.toml" "v.####.vdb")
