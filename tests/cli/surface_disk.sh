@@ -58,41 +58,12 @@ grep -q "^surface disk correspondence (auto): [0-9]* vertices (362 of the inputs
     "$out/check.txt" || { echo "check:"; cat "$out/check.txt"; exit 1; }
 
 "$volmorph" morph "$out/scene.toml" -o "$out/m.####.ply" -q
-/usr/bin/python3 - "$out" <<'PY'
-import struct, sys
+/usr/bin/python3 - "$out" "$(dirname "$0")" <<'PY'
+import sys
 out = sys.argv[1]
-
-
-def read_ply(path):
-    head, body = open(path, "rb").read().split(b"end_header\n", 1)
-    lines = head.decode().splitlines()
-    nv = int(next(l for l in lines if l.startswith("element vertex")).split()[2])
-    nf = int(next(l for l in lines if l.startswith("element face")).split()[2])
-    stride = 28 if "property uchar red" in lines else 24
-    verts = [struct.unpack_from("<3f", body, i * stride) for i in range(nv)]
-    faces = [struct.unpack_from("<B3i", body, nv * stride + 13 * k)[1:] for k in range(nf)]
-    return verts, faces
-
-
-def area(pts, faces):
-    total = 0.0
-    for a, b, c in faces:
-        u = [pts[b][i] - pts[a][i] for i in range(3)]
-        v = [pts[c][i] - pts[a][i] for i in range(3)]
-        x = (u[1] * v[2] - u[2] * v[1], u[2] * v[0] - u[0] * v[2], u[0] * v[1] - u[1] * v[0])
-        total += 0.5 * sum(t * t for t in x) ** 0.5
-    return total
-
-
-def read_obj(path):
-    pts, faces = [], []
-    for l in open(path):
-        w = l.split()
-        if w and w[0] == "v": pts.append(tuple(map(float, w[1:4])))
-        if w and w[0] == "f":
-            idx = [int(x) - 1 for x in w[1:]]
-            faces += [(idx[0], idx[j], idx[j + 1]) for j in range(1, len(idx) - 1)]
-    return pts, faces
+sys.path.insert(0, sys.argv[2])
+sys.dont_write_bytecode = True  # nothing written into the source tree
+from surface_frames import measure, read_obj, read_ply
 
 
 frames = [read_ply("%s/m.%04d.ply" % (out, f)) for f in range(1, 6)]
@@ -105,7 +76,7 @@ for a, b, c in frames[0][1]:
 rim = {v for e, n in uses.items() if n == 1 for v in e}
 dome, sheet = read_obj(out + "/dome.obj"), read_obj(out + "/sheet.obj")
 for f, (pts, faces) in ((0, dome), (4, sheet)):
-    got, want = area(frames[f][0], frames[f][1]), area(pts, faces)
+    got, want = measure(frames[f][0], frames[f][1])[1], measure(pts, faces)[1]
     assert abs(got / want - 1) < 1e-5, "frame %d's area %g, the input's %g" % (f + 1, got, want)
 import math
 chords = [((math.cos(2 * math.pi * k / 24), math.sin(2 * math.pi * k / 24)),
@@ -119,10 +90,10 @@ def to_chord(x, z, a, b):
 
 
 for v in rim:
-    x, y, z = frames[0][0][v]
+    x, y, z = frames[0][0][v][:3]
     off = min(to_chord(x, z, a, b) for a, b in chords)
     assert abs(y) < 1e-5 and off < 1e-5, ("off the dome's rim", x, y, z)
-    x, y, z = frames[4][0][v]
+    x, y, z = frames[4][0][v][:3]
     height = 0.4 * math.exp(-(x * x + z * z))  # along a rim edge the sheet is its chord: 1e-3
     assert abs(y - height) < 1e-3 and abs(max(abs(x), abs(z)) - 1.5) < 1e-5, ("off the sheet's rim", x, y, z)
 print("disk merge: %d vertices, %d on the boundary; the ends cover the inputs" % (len(frames[0][0]), len(rim)))

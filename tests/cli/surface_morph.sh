@@ -74,28 +74,12 @@ grep -q "^surface identity correspondence (auto): 338 vertices, 672 triangles at
     "$out/check.txt" || { echo "check:"; cat "$out/check.txt"; exit 1; }
 
 "$volmorph" morph "$out/scene.toml" -o "$out/m.####.ply" -q
-/usr/bin/python3 - "$out" <<'PY'
-import struct, sys
+/usr/bin/python3 - "$out" "$(dirname "$0")" <<'PY'
+import sys
 out = sys.argv[1]
-
-
-def read_ply(path):
-    data = open(path, "rb").read()
-    head, body = data.split(b"end_header\n", 1)
-    lines = head.decode().splitlines()
-    assert lines[1] == "format binary_little_endian 1.0", lines[1]
-    nv = int(next(l for l in lines if l.startswith("element vertex")).split()[2])
-    nf = int(next(l for l in lines if l.startswith("element face")).split()[2])
-    props = [l.split()[2] for l in lines if l.startswith("property float")]
-    assert props == ["x", "y", "z", "vx", "vy", "vz"], props
-    verts = [struct.unpack_from("<6f4B", body, i * 28) for i in range(nv)]
-    faces = body[nv * 28:]
-    assert len(faces) == nf * 13, (len(faces), nf)
-    return verts, faces
-
-
-def read_obj(path):
-    return [tuple(map(float, l.split()[1:4])) for l in open(path) if l.startswith("v ")]
+sys.path.insert(0, sys.argv[2])
+sys.dont_write_bytecode = True  # nothing written into the source tree
+from surface_frames import read_obj, read_ply
 
 
 frames = [read_ply("%s/m.%04d.ply" % (out, f)) for f in range(1, 34)]
@@ -103,7 +87,7 @@ for verts, faces in frames:
     assert len(verts) == len(frames[0][0]) and faces == frames[0][1], "connectivity differs"
 # The importer may order vertices its own way (Assimp's welding): vertex i of the frames is the
 # file's vertex at frame 1's position, and must be the target file's same vertex at the last frame.
-tube, bent = read_obj(out + "/tube.obj"), read_obj(out + "/bent.obj")
+tube, bent = read_obj(out + "/tube.obj")[0], read_obj(out + "/bent.obj")[0]
 index = {tuple(round(c, 5) for c in p): j for j, p in enumerate(tube)}
 order = [index[tuple(round(c, 5) for c in v[:3])] for v in frames[0][0]]
 assert sorted(order) == list(range(len(tube))), "frame 1 is not the source's vertices"

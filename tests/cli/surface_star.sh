@@ -42,40 +42,11 @@ grep -q "projected from .*: each mesh's deepest kernel point" "$out/check.txt" |
 
 "$volmorph" morph "$out/scene.toml" -o "$out/m.####.ply" -q
 /usr/bin/python3 - "$out" "$src" <<'PY'
-import struct, sys
+import sys
 out, src = sys.argv[1], sys.argv[2]
-
-
-def read_ply(path):
-    head, body = open(path, "rb").read().split(b"end_header\n", 1)
-    lines = head.decode().splitlines()
-    nv = int(next(l for l in lines if l.startswith("element vertex")).split()[2])
-    nf = int(next(l for l in lines if l.startswith("element face")).split()[2])
-    verts = [struct.unpack_from("<6f4B", body, i * 28) for i in range(nv)]
-    faces = [struct.unpack_from("<B3i", body, nv * 28 + 13 * k)[1:] for k in range(nf)]
-    return verts, faces
-
-
-def read_off(path, shift):
-    words = open(path).read().split()
-    nv, nf = int(words[1]), int(words[2])
-    vals = words[4:]
-    pts = [tuple(float(vals[3 * i + c]) + shift[c] for c in range(3)) for i in range(nv)]
-    k, tris = 3 * nv, []
-    for _ in range(nf):
-        n = int(vals[k]); idx = list(map(int, vals[k + 1:k + 1 + n])); k += 1 + n
-        tris += [(idx[0], idx[j], idx[j + 1]) for j in range(1, n - 1)]
-    return pts, tris
-
-
-def measure(pts, tris):
-    vol = area = 0.0
-    for a, b, c in tris:
-        (ax, ay, az), (bx, by, bz), (cx, cy, cz) = pts[a][:3], pts[b][:3], pts[c][:3]
-        vol += ax * (by * cz - bz * cy) - ay * (bx * cz - bz * cx) + az * (bx * cy - by * cx)
-        ux, uy, uz, vx, vy, vz = bx - ax, by - ay, bz - az, cx - ax, cy - ay, cz - az
-        area += 0.5 * ((uy * vz - uz * vy) ** 2 + (uz * vx - ux * vz) ** 2 + (ux * vy - uy * vx) ** 2) ** 0.5
-    return vol / 6, area
+sys.path.insert(0, src + "/tests/cli")
+sys.dont_write_bytecode = True  # nothing written into the source tree
+from surface_frames import measure, read_off, read_ply
 
 
 frames = [read_ply("%s/m.%04d.ply" % (out, f)) for f in range(1, 10)]
