@@ -221,7 +221,11 @@ void printSettings(const Scene& scene)
 /// Surface mode: the correspondence the meshes get (auto resolved) and how vertices travel.
 void printSurface(const Scene& scene, const SceneMeshes& meshes)
 {
-    const SurfaceMorpher m(meshes.source, meshes.target, scene.surface); // or a UserError
+    // The correspondence is what check tries (or a UserError); the in-betweens' factorization
+    // is the morph's work, so the straight line stands in for it here.
+    SurfaceSpec correspondenceOnly = scene.surface;
+    correspondenceOnly.interpolation = SurfaceInterpolation::Linear;
+    const SurfaceMorpher m(meshes.source, meshes.target, correspondenceOnly);
     const std::string used = name(m.correspondence());
     std::string merged;
     if (m.correspondence() != Correspondence::Identity)
