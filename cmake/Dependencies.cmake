@@ -14,6 +14,8 @@ find_package(assimp CONFIG REQUIRED)
 find_package(tomlplusplus CONFIG REQUIRED)
 find_package(CLI11 CONFIG REQUIRED)
 find_package(Eigen3 3.3 REQUIRED NO_MODULE)
+# OpenMesh (BSD): half-edge meshes and their decimater, for the spherical parameterization.
+find_package(OpenMesh CONFIG REQUIRED)
 # The editor (volmorph edit): its JSON API and its local HTTP server. Debian's cpp-httplib is the
 # split build (a header and libcpp-httplib.so, built with OpenSSL, zlib and Brotli); it has a
 # pkg-config file and no CMake config.

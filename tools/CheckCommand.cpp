@@ -240,6 +240,10 @@ void printSurface(const Scene& scene, const SceneMeshes& meshes)
         std::printf("        projected from %s (source) and %s (target), world units%s\n",
                     fmt(k->first).c_str(), fmt(k->second).c_str(),
                     scene.surface.kernel ? "" : ": each mesh's deepest kernel point");
+    if (const auto s = m.stretchEfficiency())
+        std::printf("        spherical maps' L2 stretch efficiency %.3f (source), %.3f (target); 1 "
+                    "would be no stretch\n",
+                    s->first, s->second);
     if (!scene.pairs.empty() && m.correspondence() == Correspondence::Identity)
         std::printf("        %zu landmark pairs: not used by the identity (vertex i is vertex i)\n",
                     scene.pairs.size());

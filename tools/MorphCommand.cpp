@@ -70,7 +70,7 @@ void writeSurfaceFrames(const Scene& scene, const std::vector<int>& frames,
     Interrupter interrupter(false, args.verbose);
     StopSignals signals(interrupter);
     interrupter.start("surface correspondence");
-    const SceneSurface surface(scene);
+    const SceneSurface surface(scene, &interrupter);
     interrupter.end();
     FrameLoop loop(scene, frames, 1, args.quiet, true, interrupter);
     loop.run([&](const FrameStep& step) {

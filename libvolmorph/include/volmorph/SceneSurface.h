@@ -16,8 +16,9 @@ namespace volmorph {
 class SceneSurface {
 public:
     /// Imports both meshes (UserError at their `mesh` keys when they cannot be read) and puts them
-    /// into correspondence (UserError at [surface] when it does not apply).
-    explicit SceneSurface(const Scene& scene);
+    /// into correspondence (UserError at [surface] when it does not apply; Interrupted when
+    /// `interrupter` asks to stop).
+    explicit SceneSurface(const Scene& scene, Interrupter* interrupter = nullptr);
 
     /// Frame `frame`'s in-between; its velocity in world units per second (zero for a scene of one
     /// frame, where t stands still).
@@ -33,7 +34,7 @@ public:
     double voxelSize() const { return mVoxelSize; }
 
 private:
-    SceneSurface(const Scene& scene, std::pair<Mesh, Mesh> meshes);
+    SceneSurface(const Scene& scene, std::pair<Mesh, Mesh> meshes, Interrupter* interrupter);
 
     BlendSpec mBlend;
     FramesSpec mFrames;

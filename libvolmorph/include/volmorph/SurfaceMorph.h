@@ -10,6 +10,7 @@
 #pragma once
 
 #include <volmorph/Mesh.h>
+#include <volmorph/core/Interrupter.h>
 #include <volmorph/SurfaceSettings.h>
 
 #include <memory>
@@ -38,8 +39,9 @@ public:
     /// Puts `source` and `target` (world units) into correspondence as `spec` says and prepares
     /// the interpolation (for "arap", one sparse factorization for every frame). Throws UserError
     /// at `spec`'s location when the chosen correspondence does not apply to the meshes (naming
-    /// the mesh file and what was found).
-    SurfaceMorpher(const Mesh& source, const Mesh& target, const SurfaceSpec& spec);
+    /// the mesh file and what was found); Interrupted when `interrupter` asks to stop.
+    SurfaceMorpher(const Mesh& source, const Mesh& target, const SurfaceSpec& spec,
+                   Interrupter* interrupter = nullptr);
     ~SurfaceMorpher();
     SurfaceMorpher(SurfaceMorpher&&) noexcept;
     SurfaceMorpher& operator=(SurfaceMorpher&&) noexcept;
@@ -56,6 +58,9 @@ public:
     size_t crossings() const;
     /// star: the point each mesh was projected from (given or found), world units.
     std::optional<std::pair<Vec3d, Vec3d>> kernels() const;
+    /// sphere: each mesh's spherical map's L2 stretch efficiency (Praun and Hoppe 2003: 1 for a
+    /// map without stretch, lower for more).
+    std::optional<std::pair<double, double>> stretchEfficiency() const;
 
 private:
     struct Impl;

@@ -211,11 +211,6 @@ void parseSurface(Reader& r, const toml::node& node, SurfaceSpec& s)
                                : *c == "sphere" ? Correspondence::Sphere
                                : *c == "disk"   ? Correspondence::Disk
                                                 : Correspondence::Auto;
-            if (*c == "sphere")
-                r.error(r.at(*n), "surface.correspondence: \"sphere\" is not in this version of "
-                                  "volmorph; \"identity\" (the same vertices and triangles on "
-                                  "both sides), \"star\" (closed star-shaped meshes of genus 0), "
-                                  "\"disk\" (one boundary loop each) and \"auto\" are");
         }
     }
     if (const toml::node* n = t->get("interpolation"))

@@ -29,12 +29,16 @@ std::pair<Mesh, Mesh> sceneMeshes(const Scene& scene)
 
 } // namespace
 
-SceneSurface::SceneSurface(const Scene& scene) : SceneSurface(scene, sceneMeshes(scene)) {}
+SceneSurface::SceneSurface(const Scene& scene, Interrupter* interrupter)
+    : SceneSurface(scene, sceneMeshes(scene), interrupter)
+{
+}
 
-SceneSurface::SceneSurface(const Scene& scene, std::pair<Mesh, Mesh> meshes)
+SceneSurface::SceneSurface(const Scene& scene, std::pair<Mesh, Mesh> meshes,
+                           Interrupter* interrupter)
     : mBlend(scene.blend), mFrames(scene.frames),
       mVoxelSize(sceneVoxelSize(scene.volume, extentOf(meshes.first), extentOf(meshes.second))),
-      mMorpher(std::move(meshes.first), std::move(meshes.second), scene.surface)
+      mMorpher(std::move(meshes.first), std::move(meshes.second), scene.surface, interrupter)
 {
 }
 

@@ -1,6 +1,7 @@
 #include "Correspondence.h"
 
 #include "DiskMerge.h"
+#include "SphereMerge.h"
 #include "StarMerge.h"
 
 #include <string>
@@ -108,7 +109,8 @@ std::string diskMismatch(const Mesh& mesh)
 
 } // namespace
 
-Corresponded correspond(const Mesh& source, const Mesh& target, const SurfaceSpec& spec)
+Corresponded correspond(const Mesh& source, const Mesh& target, const SurfaceSpec& spec,
+                        Interrupter* interrupter)
 {
     const SourceLocation& where =
         spec.correspondenceWhere.file.empty() ? spec.where : spec.correspondenceWhere;
@@ -116,11 +118,6 @@ Corresponded correspond(const Mesh& source, const Mesh& target, const SurfaceSpe
     requireManifold(target, where);
     const Correspondence c = spec.correspondence;
     const bool automatic = c == Correspondence::Auto;
-    if (c == Correspondence::Sphere)
-        refuse(spec, where,
-               "not in this version of volmorph; \"identity\" (the same vertices and triangles), "
-               "\"star\" (closed star-shaped meshes of genus 0) and \"disk\" (one boundary loop "
-               "each) are");
     const std::string notIdentity = identityMismatch(source, target);
     if (c == Correspondence::Identity) {
         if (!notIdentity.empty())
@@ -146,7 +143,17 @@ Corresponded correspond(const Mesh& source, const Mesh& target, const SurfaceSpe
             fail(notStar + "; Kent's star-shaped merge needs closed meshes of genus 0");
         }
     }
+    if (c == Correspondence::Sphere || automatic) {
+        throwIfInterrupted(interrupter);
+        std::string notGenus0 = starMismatch(source);
+        if (notGenus0.empty()) notGenus0 = starMismatch(target);
+        if (notGenus0.empty())
+            return sphereMerge(source, target, spec.landmarks, where, interrupter);
+        if (!automatic || why.find(notGenus0) == std::string::npos)
+            fail(notGenus0 + "; the spherical map needs closed meshes of genus 0");
+    }
     if (c == Correspondence::Disk || automatic) {
+        throwIfInterrupted(interrupter);
         std::string notDisk = diskMismatch(source);
         if (notDisk.empty()) notDisk = diskMismatch(target);
         if (notDisk.empty()) {

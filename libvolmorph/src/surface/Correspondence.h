@@ -1,8 +1,9 @@
 // Correspondence: two meshes become one connectivity with a place on each surface: the identity
-// (the same vertices and triangles) or Kent's star-shaped merge (StarMerge.h); the spherical and
-// the disk parameterizations are named by the scene's keys and refused until they exist.
+// (the same vertices and triangles), Kent's star-shaped merge (StarMerge.h), the spherical map's
+// merge (SphereMerge.h) or the disk map's (DiskMerge.h).
 #pragma once
 
+#include <volmorph/core/Interrupter.h>
 #include <volmorph/Mesh.h>
 #include <volmorph/SurfaceSettings.h>
 
@@ -26,18 +27,22 @@ struct Corresponded {
     size_t crossings = 0; ///< merged: the points where an edge of one crossed an edge of the other
     /// star: the points each side was projected from (world units)
     std::optional<std::pair<Vec3d, Vec3d>> kernels;
+    /// sphere: each map's L2 stretch efficiency (Praun and Hoppe; 1 = no stretch)
+    std::optional<std::pair<double, double>> stretch;
 };
 
 /// Why the identity does not apply to these meshes ("" when it does).
 std::string identityMismatch(const Mesh& source, const Mesh& target);
 
-/// Why Kent's merge does not apply (not a closed genus-0 surface of one piece), "" when it may
-/// (whether the mesh is star-shaped is found by the merge).
+/// Why Kent's merge and the spherical map do not apply (not a closed genus-0 surface of one
+/// piece), "" when they may (whether the mesh is star-shaped is found by the merge).
 std::string starMismatch(const Mesh& mesh);
 
 /// Puts the meshes into correspondence as `spec` says. Throws UserError at spec.correspondenceWhere
 /// (else spec.where) naming the mesh file and what it found: a non-manifold edge, or meshes the
 /// chosen correspondence does not apply to.
-Corresponded correspond(const Mesh& source, const Mesh& target, const SurfaceSpec& spec);
+/// Interrupted when `interrupter` asks to stop (between the merges, and inside the spherical map).
+Corresponded correspond(const Mesh& source, const Mesh& target, const SurfaceSpec& spec,
+                        Interrupter* interrupter = nullptr);
 
 } // namespace volmorph::detail

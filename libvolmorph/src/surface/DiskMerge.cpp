@@ -4,6 +4,7 @@
 #include "Landmarks.h"
 #include "MergeSide.h"
 #include "SphereOverlay.h"
+#include "SphereSides.h"
 
 #include <algorithm>
 #include <cmath>
@@ -144,14 +145,8 @@ Disk diskOf(const MergeSide& s, const SourceLocation& where)
 void place(const MergeSide& s, const Disk& d, const OverlayVertex& v, bool isSource,
            const Vec3d& dir, Vec3d& at, Vec3f* color)
 {
-    const OverlayVertex::Kind own =
-        isSource ? OverlayVertex::Kind::Source : OverlayVertex::Kind::Target;
+    if (placeOwnVertex(s, v, isSource, at, color)) return;
     const uint32_t* ends = isSource ? v.source : v.target;
-    if (v.kind == own) {
-        at = s.points[ends[0]];
-        if (color) *color = Vec3f(s.color(ends[0]));
-        return;
-    }
     const Vec3d lifted = turned(d.sphere.transpose(), dir);
     const Eigen::Vector2d x =
         rotate(Eigen::Vector2d(lifted.x() / lifted.z(), lifted.y() / lifted.z()), -d.turn);

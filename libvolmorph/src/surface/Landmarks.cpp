@@ -32,9 +32,11 @@ Eigen::Vector3d eig(const Vec3d& v)
     return {v.x(), v.y(), v.z()};
 }
 
-/// The rotation that best takes `from` onto `to` (least squares), or for one pair the least turn.
-Eigen::Matrix3d alignment(const std::vector<Vec3d>& from, const std::vector<Vec3d>& to)
+} // namespace
+
+Eigen::Matrix3d landmarkTurn(const std::vector<Vec3d>& from, const std::vector<Vec3d>& to)
 {
+    if (from.empty()) return Eigen::Matrix3d::Identity();
     if (from.size() == 1)
         return Eigen::Quaterniond::FromTwoVectors(eig(from[0]), eig(to[0])).toRotationMatrix();
     Eigen::Matrix3d h = Eigen::Matrix3d::Zero();
@@ -45,12 +47,10 @@ Eigen::Matrix3d alignment(const std::vector<Vec3d>& from, const std::vector<Vec3
     return svd.matrixV() * d * svd.matrixU().transpose();
 }
 
-} // namespace
-
 SphereWarp::SphereWarp(const std::vector<Vec3d>& from, const std::vector<Vec3d>& to)
 {
     if (from.empty()) return;
-    mRotation = alignment(from, to);
+    mRotation = landmarkTurn(from, to);
     const size_t n = from.size();
     std::vector<Eigen::Vector3d> at(n);
     for (size_t i = 0; i < n; ++i) at[i] = mRotation * eig(from[i]);

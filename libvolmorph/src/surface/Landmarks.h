@@ -19,6 +19,10 @@ namespace volmorph::detail {
 std::vector<MergeSide::Place>
 snapLandmarks(const MergeSide& side, const std::vector<SurfaceLandmark>& landmarks, bool source);
 
+/// The turn that best takes each from[i] onto to[i] (unit vectors; Kabsch, for one pair the
+/// least turn; the identity for none).
+Eigen::Matrix3d landmarkTurn(const std::vector<Vec3d>& from, const std::vector<Vec3d>& to);
+
 /// A smooth map of the unit sphere that takes each from[i] to to[i] (unit vectors): the rotation
 /// that best aligns them (Kabsch; for one pair, the least turn), then a flow of kSteps small
 /// warps, each a sum of Gaussian bumps fitted so that every landmark moves a step along its great

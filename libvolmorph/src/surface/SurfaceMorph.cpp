@@ -46,10 +46,12 @@ struct SurfaceMorpher::Impl {
     std::optional<detail::RigidInterpolation> rigid; // "arap"
 };
 
-SurfaceMorpher::SurfaceMorpher(const Mesh& source, const Mesh& target, const SurfaceSpec& spec)
+SurfaceMorpher::SurfaceMorpher(const Mesh& source, const Mesh& target, const SurfaceSpec& spec,
+                               Interrupter* interrupter)
     : mImpl(std::make_unique<Impl>())
 {
-    mImpl->sides = detail::correspond(source, target, spec);
+    mImpl->sides = detail::correspond(source, target, spec, interrupter);
+    throwIfInterrupted(interrupter);
     const detail::Corresponded& s = mImpl->sides;
     if (spec.interpolation == SurfaceInterpolation::Arap)
         mImpl->rigid.emplace(s.source, s.target, s.triangles);
@@ -100,6 +102,10 @@ size_t SurfaceMorpher::crossings() const
 std::optional<std::pair<Vec3d, Vec3d>> SurfaceMorpher::kernels() const
 {
     return mImpl->sides.kernels;
+}
+std::optional<std::pair<double, double>> SurfaceMorpher::stretchEfficiency() const
+{
+    return mImpl->sides.stretch;
 }
 
 } // namespace volmorph

@@ -6,6 +6,7 @@
 #include "surface/Correspondence.h"
 #include "surface/DiskMerge.h"
 
+#include "support/MergeChecks.h"
 #include "support/SurfaceChecks.h"
 #include "support/SurfaceShapes.h"
 
@@ -89,12 +90,7 @@ std::string refusal(const Mesh& a, const Mesh& b, Correspondence correspondence)
     SurfaceSpec spec;
     spec.correspondence = correspondence;
     spec.correspondenceWhere = kWhere;
-    try {
-        correspond(a, b, spec);
-    } catch (const UserError& e) {
-        return e.what();
-    }
-    return {};
+    return test::refusal(a, b, spec);
 }
 
 TEST(DiskMerge, RefusesClosedMeshesAndSeveralLoopsNamingTheMesh)

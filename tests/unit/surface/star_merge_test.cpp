@@ -8,6 +8,7 @@
 #include "surface/StarKernel.h"
 #include "surface/StarMerge.h"
 
+#include "support/MergeChecks.h"
 #include "support/OpenMeshes.h"
 #include "support/SurfaceChecks.h"
 #include "support/SurfaceShapes.h"
@@ -23,11 +24,6 @@
 
 namespace volmorph::detail {
 namespace {
-
-std::vector<Vec3d> pointsOf(const Mesh& m)
-{
-    return {m.points.begin(), m.points.end()};
-}
 
 double sphericalArea(const Vec3d& a, const Vec3d& b, const Vec3d& c)
 {
@@ -56,7 +52,10 @@ SphereTriangulation onSphere(const Mesh& m, const Vec3d& centre, bool turned)
 }
 
 using test::area;
+using test::checkMerge;
 using test::distanceTo;
+using test::pointsOf;
+using test::refusal;
 using test::volume;
 
 TEST(SpherePredicates, ExactWhereDoubleRoundsAndTiesBrokenConsistently)
@@ -155,30 +154,6 @@ TEST(SphereOverlay, TwoSpheresMergeIntoOneTriangulation)
 
 const SourceLocation kWhere{"scene.toml", 7, 18};
 
-/// Checks a merge of `a` into `b`: each side's own vertices kept exactly, every merged vertex on
-/// both surfaces, the merged meshes enclosing the inputs' volumes and areas, none of their
-/// triangles facing against the input's.
-void checkMerge(const Mesh& a, const Mesh& b, const Corresponded& c)
-{
-    const size_t na = a.points.size(), nb = b.points.size();
-    ASSERT_EQ(c.source.size(), na + nb + c.crossings);
-    ASSERT_EQ(c.target.size(), c.source.size());
-    for (size_t i = 0; i < na; ++i) EXPECT_EQ(c.source[i], Vec3d(a.points[i]));
-    for (size_t j = 0; j < nb; ++j) EXPECT_EQ(c.target[na + j], Vec3d(b.points[j]));
-    for (const auto& [mesh, merged] : {std::pair{&a, &c.source}, std::pair{&b, &c.target}}) {
-        const std::vector<Vec3d> p = pointsOf(*mesh);
-        const auto [lo, hi] = mesh->bounds();
-        const double diagonal = (hi - lo).length();
-        double worst = 0.0;
-        for (const Vec3d& x : *merged) worst = std::max(worst, distanceTo(p, mesh->triangles, x));
-        EXPECT_LT(worst, 1e-9 * diagonal) << mesh->file;
-        EXPECT_NEAR(volume(*merged, c.triangles) / volume(p, mesh->triangles), 1.0, 1e-9);
-        EXPECT_NEAR(area(*merged, c.triangles) / area(p, mesh->triangles), 1.0, 1e-9);
-        EXPECT_EQ(test::facingAgainst(*merged, c.triangles, p, mesh->triangles, diagonal), 0u)
-            << mesh->file << ": merged triangles folded over";
-    }
-}
-
 TEST(StarMerge, ACubeIntoASphere)
 {
     const Mesh a = test::cube(1.0, Vec3d(2.0, 0.0, 0.0));
@@ -227,17 +202,6 @@ TEST(StarMerge, ABlobIntoAnEllipsoidCarriesItsColours)
     }
 }
 
-/// The UserError `correspond` throws for these meshes with `spec`, "" when none.
-std::string refusal(const Mesh& a, const Mesh& b, const SurfaceSpec& spec)
-{
-    try {
-        correspond(a, b, spec);
-    } catch (const UserError& e) {
-        return e.what();
-    }
-    return {};
-}
-
 TEST(StarMerge, RefusesWhatItCannotMergeNamingTheMeshAndWhatWasFound)
 {
     SurfaceSpec star;
@@ -269,13 +233,15 @@ TEST(StarMerge, RefusesWhatItCannotMergeNamingTheMeshAndWhatWasFound)
               std::string::npos)
         << outside;
 
-    SurfaceSpec automatic; // auto: not the identity, not star-shaped
+    SurfaceSpec automatic; // auto: not the identity, not genus 0, not a disk
     automatic.where = kWhere;
-    const std::string neither = refusal(c, ball, automatic);
+    const std::string neither = refusal(torus, ball, automatic);
     EXPECT_NE(neither.find("surface.correspondence = \"auto\": the meshes differ in size"),
               std::string::npos)
         << neither;
-    EXPECT_NE(neither.find("; and c.obj is not star-shaped"), std::string::npos) << neither;
+    EXPECT_NE(neither.find("; and torus.obj has genus 1"), std::string::npos) << neither;
+    EXPECT_NE(neither.find("torus.obj has no boundary"), std::string::npos) << neither;
+    EXPECT_NE(neither.find("sdf and variational"), std::string::npos) << neither;
 }
 
 TEST(StarMerge, RigidInBetweensOfAMergeStartAndEndOnTheInputs)
@@ -288,14 +254,7 @@ TEST(StarMerge, RigidInBetweensOfAMergeStartAndEndOnTheInputs)
     const SurfaceMorpher m(a, b, spec);
     EXPECT_EQ(m.correspondence(), Correspondence::Star);
     const Corresponded c = starMerge(a, b, std::nullopt, {}, kWhere);
-    ASSERT_EQ(m.vertexCount(), c.source.size());
-    for (const auto& [tau, side] : {std::pair{0.0, &c.source}, std::pair{1.0, &c.target}}) {
-        const SurfaceFrame f = m.frame(tau, tau);
-        double worst = 0.0;
-        for (size_t v = 0; v < f.points.size(); ++v)
-            worst = std::max(worst, (f.points[v] - (*side)[v]).length());
-        EXPECT_LT(worst, 1e-9) << "tau " << tau;
-    }
+    test::expectEndsOnSides(m, c);
     // The velocity is the derivative of the positions.
     const double h = 1e-5;
     const SurfaceFrame mid = m.frame(0.4, 0.4), lo = m.frame(0.4 - h, 0.4),
@@ -308,38 +267,6 @@ TEST(StarMerge, RigidInBetweensOfAMergeStartAndEndOnTheInputs)
     }
     EXPECT_LT(worst, 0.01 * scale);
 }
-
-namespace landmarks {
-
-/// The nearest point of `m` to `p`.
-Vec3d snapped(const Mesh& m, const Vec3d& p)
-{
-    const std::vector<Vec3d> pts = pointsOf(m);
-    Vec3d best = p;
-    double d = 1e300;
-    for (const Vec3I& t : m.triangles) {
-        Vec3d uvw;
-        const Vec3d q =
-            openvdb::math::closestPointOnTriangleToPoint(pts[t[0]], pts[t[1]], pts[t[2]], p, uvw);
-        if ((q - p).length() < d) {
-            d = (q - p).length();
-            best = q;
-        }
-    }
-    return best;
-}
-
-/// The merged vertex where landmark `l` meets: at the snapped source point on the source side and
-/// the snapped target point on the target side (1e-9 of the size), or -1.
-int meeting(const Corresponded& c, const Mesh& a, const Mesh& b, const SurfaceLandmark& l)
-{
-    const Vec3d pa = snapped(a, l.source), pb = snapped(b, l.target);
-    for (size_t v = 0; v < c.source.size(); ++v)
-        if ((c.source[v] - pa).length() < 1e-9 && (c.target[v] - pb).length() < 1e-9) return int(v);
-    return -1;
-}
-
-} // namespace landmarks
 
 TEST(StarMerge, LandmarksMeet)
 {
@@ -355,7 +282,7 @@ TEST(StarMerge, LandmarksMeet)
         {Vec3d(1.0, -0.5, -0.2), Vec3d(-2.2, 0.5, -0.1), {"scene.toml", 18, 1}}};
     const Corresponded c = starMerge(a, b, std::nullopt, marks, kWhere);
     for (const SurfaceLandmark& l : marks)
-        EXPECT_GE(landmarks::meeting(c, a, b, l), 0) << l.where.str() << " does not meet";
+        EXPECT_GE(test::meeting(c, a, b, l), 0) << l.where.str() << " does not meet";
     // Still a merge of the two surfaces: the target got a vertex per landmark not at one of its
     // own (the pole is), the surfaces are whole.
     ASSERT_EQ(c.source.size(), a.points.size() + b.points.size() + 2 + c.crossings);
