@@ -64,15 +64,19 @@ std::optional<std::array<size_t, 3>> mirroredLandmarks(const std::vector<Vec3d>&
     const auto det = [](const std::vector<Vec3d>& p, size_t i, size_t j, size_t k) {
         return p[i].dot(p[j].cross(p[k]));
     };
+    // Two maps of one shape can differ enough to turn a few triples round (a long thin shape's
+    // do); a mirrored placement turns every one.
+    std::optional<std::array<size_t, 3>> first;
     const size_t n = from.size();
     for (size_t i = 0; i < n; ++i)
         for (size_t j = i + 1; j < n; ++j)
             for (size_t k = j + 1; k < n; ++k) {
                 const double a = det(from, i, j, k), b = det(goals, i, j, k);
-                if (std::abs(a) > kClearTriple && std::abs(b) > kClearTriple && a * b < 0.0)
-                    return std::array<size_t, 3>{i, j, k};
+                if (std::abs(a) <= kClearTriple || std::abs(b) <= kClearTriple) continue;
+                if (a * b > 0.0) return std::nullopt;
+                if (!first) first = std::array<size_t, 3>{i, j, k};
             }
-    return std::nullopt;
+    return first;
 }
 
 bool pullToLandmarks(const std::vector<Vec3d>& points, const std::vector<Vec3I>& triangles,

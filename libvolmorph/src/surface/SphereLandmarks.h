@@ -15,10 +15,10 @@
 
 namespace volmorph::detail {
 
-/// Three landmarks that go round each other one way on one map and the other way on the other
-/// (`from`: the landmarks on the target's map, `goals`: on the source's), each triangle clear of a
-/// great circle (|det| > kClearTriple) on both: a mirrored placement, which a one-to-one map could
-/// only meet by twisting the surface round itself. None when there are no such three.
+/// Landmarks placed mirrored: every three of them whose triangles are clear of a great circle
+/// on both maps (|det| > kClearTriple) go round each other one way on one map (`from`, the
+/// target's) and the other way on the other (`goals`, the source's). A one-to-one map could only
+/// meet them by twisting the surface round itself. The first such three, or none.
 inline constexpr double kClearTriple = 0.02;
 std::optional<std::array<size_t, 3>> mirroredLandmarks(const std::vector<Vec3d>& from,
                                                        const std::vector<Vec3d>& goals);
