@@ -12,18 +12,17 @@ import sys
 
 
 def to_m(off, out):
-    words = open(off).read().split()
-    nv, nf = int(words[1]), int(words[2])
-    vals = words[4:]
+    lines = [l.split("#")[0].split() for l in open(off)]
+    lines = [l for l in lines if l]
+    head = lines[0][1:] if len(lines[0]) > 1 else lines[1]  # "OFF nv nf ne" or "OFF" then counts
+    start = 1 if len(lines[0]) > 1 else 2
+    nv, nf = int(head[0]), int(head[1])
     with open(out, "w") as f:
-        for i in range(nv):
-            f.write("Vertex %d  %s %s %s\n" % (i + 1, vals[3 * i], vals[3 * i + 1], vals[3 * i + 2]))
-        k = 3 * nv
-        for j in range(nf):
-            n = int(vals[k])
-            idx = [int(v) + 1 for v in vals[k + 1:k + 1 + n]]
-            k += 1 + n
-            f.write("Face %d  %s\n" % (j + 1, " ".join(map(str, idx))))
+        for i, l in enumerate(lines[start:start + nv]):  # x y z, then any colour
+            f.write("Vertex %d  %s %s %s\n" % (i + 1, l[0], l[1], l[2]))
+        for j, l in enumerate(lines[start + nv:start + nv + nf]):
+            n = int(l[0])
+            f.write("Face %d  %s\n" % (j + 1, " ".join(str(int(v) + 1) for v in l[1:1 + n])))
 
 
 def sub(a, b):

@@ -23,7 +23,7 @@ param=$build/tests/bench/volmorph_bench_sphere_param
 count=$build/tests/bench/volmorph_bench_self_intersections
 work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
-ANCHORED=${ANCHORED:-"hand blobby dino homer bull camel bear armadillo"}
+ANCHORED=${ANCHORED:-"hand blobby dino homer bull fandisk camel bear man armadillo"}
 
 (cd "$work" && apt-get download libcgal-demo >/dev/null 2>&1 && dpkg-deb -x libcgal-demo_*.deb deb &&
     tar xzf deb/usr/share/doc/libcgal-dev/data.tar.gz data/meshes)
@@ -57,7 +57,7 @@ PY
 
 echo "== volmorph's spherical map, per mesh"
 "$param" "$meshes"/*.off "$work/bear4.off" 2>"$work/refused.txt" | sed "s#$meshes/##; s#$work/##"
-echo "($(wc -l <"$work/refused.txt") meshes refused: not closed, not genus 0 or not manifold)"
+echo "($(grep -c "^$meshes/" "$work/refused.txt") meshes refused: not closed, not genus 0 or not manifold)"
 
 if [ -n "${MPL:-}" ]; then
     echo "== Hoppe's SphereParam (anchor), same meshes"

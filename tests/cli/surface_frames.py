@@ -16,9 +16,47 @@ def read_ply(path):
     colours = "property uchar red" in lines
     layout, stride = ("<6f4B", 28) if colours else ("<6f", 24)
     verts = [struct.unpack_from(layout, body, i * stride) for i in range(nv)]
-    assert len(body) == nv * stride + nf * 13, (len(body), nv, nf)
-    faces = [struct.unpack_from("<B3i", body, nv * stride + 13 * k)[1:] for k in range(nf)]
+    face = 13 + 25 * len(uv_sets(lines))  # each texture coordinate set: a count and six floats
+    assert len(body) == nv * stride + nf * face, (len(body), nv, nf)
+    faces = [struct.unpack_from("<B3i", body, nv * stride + face * k)[1:] for k in range(nf)]
     return verts, faces
+
+
+def uv_sets(lines):
+    return [l.split()[4] for l in lines if l.startswith("property list uchar float")]
+
+
+def read_ply_uvs(path):
+    """A frame's texture coordinate sets by name (texcoord, texcoord_source, texcoord_target), each
+    a list of (u, v) per triangle corner."""
+    head, body = open(path, "rb").read().split(b"end_header\n", 1)
+    lines = head.decode().splitlines()
+    nv = int(next(l for l in lines if l.startswith("element vertex")).split()[2])
+    nf = int(next(l for l in lines if l.startswith("element face")).split()[2])
+    stride = 28 if "property uchar red" in lines else 24
+    names = uv_sets(lines)
+    out = {n: [] for n in names}
+    at = nv * stride
+    for _ in range(nf):
+        at += 13
+        for n in names:
+            assert body[at] == 6
+            vals = struct.unpack_from("<6f", body, at + 1)
+            out[n] += [(vals[0], vals[1]), (vals[2], vals[3]), (vals[4], vals[5])]
+            at += 25
+    return out
+
+
+def read_obj_uvs(path):
+    """Per triangle corner, the (u, v) its `f` line names (OBJ with vt)."""
+    vt, out = [], []
+    for l in open(path):
+        w = l.split()
+        if w and w[0] == "vt":
+            vt.append((float(w[1]), float(w[2])))
+        if w and w[0] == "f":
+            out += [vt[int(x.split("/")[1]) - 1] for x in w[1:4]]
+    return out
 
 
 def read_obj(path):

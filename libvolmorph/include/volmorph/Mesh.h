@@ -35,10 +35,15 @@ struct Mesh {
     std::vector<Vec3f> points;
     std::vector<Vec3I> triangles;
     std::vector<Vec3f> colors; ///< per vertex, linear RGB; empty when the file has none
+    /// Per triangle corner (3 per triangle, in `triangles`' order), the file's first set of texture
+    /// coordinates (u, v): a seam's vertices stay welded, each triangle keeps its own. Empty when
+    /// the file has none (and after code that adds triangles without them, such as hole filling).
+    std::vector<Vec2f> uvs;
     MeshReport report;
     std::filesystem::path file;
 
     bool hasColors() const { return !colors.empty(); }
+    bool hasUVs() const { return !uvs.empty() && uvs.size() == 3 * triangles.size(); }
     /// Axis-aligned bounds of the points; {+inf, -inf} for an empty mesh.
     std::pair<Vec3d, Vec3d> bounds() const;
 };

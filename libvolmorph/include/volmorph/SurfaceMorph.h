@@ -30,8 +30,14 @@ struct SurfaceFrame {
     /// d position / d tau of each vertex, world units per unit of the shape's tau (exact: the
     /// derivative of what `points` holds, not a difference of frames).
     std::vector<Vec3d> velocity;
+    /// Per triangle corner (3 per triangle), texture coordinates: `uvs` at the colour's tau, the
+    /// source's and the target's in `sourceUVs` and `targetUVs` (a shader blends the two
+    /// textures by the same tau); all empty when neither input has them.
+    std::vector<Vec2f> uvs, sourceUVs, targetUVs;
 
-    Mesh mesh() const; ///< points rounded to float, the triangles and colours, topology analysed
+    /// Points rounded to float, the triangles, colours and (at tau) texture coordinates, topology
+    /// analysed.
+    Mesh mesh() const;
 };
 
 class SurfaceMorpher {

@@ -285,6 +285,7 @@ HoleFillStats fillHoles(Mesh& mesh, double spacing)
         stats.patchTriangles += patch.triangles.size();
         ++stats.holes;
     }
+    if (stats.patchTriangles > 0) mesh.uvs.clear(); // the patches have no texture coordinates
     analyzeTopology(mesh);
     return stats;
 }

@@ -116,6 +116,7 @@ namespace {
 /// polygons split into fans. Indices are into `positions` (3 floats per vertex).
 struct RawMesh {
     std::vector<float> positions, colors; ///< colors: 3 per vertex, or empty
+    std::vector<float> uvs;               ///< 2 per vertex (Assimp splits seams), or empty
     std::vector<uint32_t> triangles;      ///< 3 per triangle
     std::string error;                    ///< set when the file could not be read
 };
@@ -138,7 +139,7 @@ std::string assimpError(const Assimp::Importer& importer)
 /// Appends one mesh placed by `node`: its vertices (and colours, grey where it has none, when
 /// `anyColors`), its polygons as fans (exact when convex); points and lines are of no use to a
 /// voxelizer. Sets raw.error on a face that names a missing vertex.
-void addMesh(RawMesh& raw, const aiMesh* am, const aiMatrix4x4& node, bool anyColors)
+void addMesh(RawMesh& raw, const aiMesh* am, const aiMatrix4x4& node, bool anyColors, bool anyUVs)
 {
     const uint32_t base = uint32_t(raw.positions.size() / 3);
     for (unsigned v = 0; v < am->mNumVertices; ++v) {
@@ -152,6 +153,10 @@ void addMesh(RawMesh& raw, const aiMesh* am, const aiMatrix4x4& node, bool anyCo
             const aiColor4D c =
                 am->HasVertexColors(0) ? am->mColors[0][v] : aiColor4D(0.8f, 0.8f, 0.8f, 1.0f);
             raw.colors.insert(raw.colors.end(), {c.r, c.g, c.b});
+        }
+        if (anyUVs) {
+            const aiVector3D uv = am->HasTextureCoords(0) ? am->mTextureCoords[0][v] : aiVector3D();
+            raw.uvs.insert(raw.uvs.end(), {uv.x, uv.y});
         }
     }
     for (unsigned f = 0; f < am->mNumFaces; ++f) {
@@ -188,9 +193,11 @@ RawMesh readWithAssimp(const std::filesystem::path& file)
         raw.error = "the mesh file is incomplete or malformed";
         return raw;
     }
-    bool anyColors = false;
-    for (unsigned mi = 0; mi < scene->mNumMeshes; ++mi)
+    bool anyColors = false, anyUVs = false;
+    for (unsigned mi = 0; mi < scene->mNumMeshes; ++mi) {
         anyColors = anyColors || scene->mMeshes[mi]->HasVertexColors(0);
+        anyUVs = anyUVs || scene->mMeshes[mi]->HasTextureCoords(0);
+    }
     // Every mesh as often as the node hierarchy places it (what PreTransformVertices would do).
     std::vector<std::pair<const aiNode*, aiMatrix4x4>> stack;
     if (scene->mRootNode) stack.emplace_back(scene->mRootNode, scene->mRootNode->mTransformation);
@@ -200,7 +207,7 @@ RawMesh readWithAssimp(const std::filesystem::path& file)
         stack.pop_back();
         for (unsigned i = 0; i < node->mNumMeshes; ++i)
             if (node->mMeshes[i] < scene->mNumMeshes) {
-                addMesh(raw, scene->mMeshes[node->mMeshes[i]], xf, anyColors);
+                addMesh(raw, scene->mMeshes[node->mMeshes[i]], xf, anyColors, anyUVs);
                 ++placed;
             }
         if (stack.size() + node->mNumChildren > 100000) {
@@ -212,7 +219,7 @@ RawMesh readWithAssimp(const std::filesystem::path& file)
     }
     if (placed == 0 && raw.error.empty()) // no node hierarchy: the meshes as stored
         for (unsigned mi = 0; mi < scene->mNumMeshes; ++mi)
-            addMesh(raw, scene->mMeshes[mi], aiMatrix4x4(), anyColors);
+            addMesh(raw, scene->mMeshes[mi], aiMatrix4x4(), anyColors, anyUVs);
     return raw;
 }
 
@@ -299,7 +306,7 @@ RawMesh readIsolated(const std::filesystem::path& file, uintmax_t bytes)
         const RawMesh r = readWithAssimp(file);
         const bool ok = writeVector(fds[1], std::vector<char>(r.error.begin(), r.error.end())) &&
                         writeVector(fds[1], r.positions) && writeVector(fds[1], r.colors) &&
-                        writeVector(fds[1], r.triangles);
+                        writeVector(fds[1], r.uvs) && writeVector(fds[1], r.triangles);
         ::_exit(ok ? 0 : 1);
     }
     ::close(fds[1]);
@@ -311,6 +318,7 @@ RawMesh readIsolated(const std::filesystem::path& file, uintmax_t bytes)
     const bool ok = readVector(fds[0], error, deadline, timedOut) &&
                     readVector(fds[0], raw.positions, deadline, timedOut) &&
                     readVector(fds[0], raw.colors, deadline, timedOut) &&
+                    readVector(fds[0], raw.uvs, deadline, timedOut) &&
                     readVector(fds[0], raw.triangles, deadline, timedOut);
     ::close(fds[0]);
     if (!ok) ::kill(child, SIGKILL);
@@ -358,6 +366,7 @@ Mesh importMesh(const std::filesystem::path& file, const ObjectTransform& transf
     std::unordered_map<Vec3f, uint32_t, PositionHash> index;
     const size_t vertices = raw.positions.size() / 3;
     const bool anyColors = raw.colors.size() == raw.positions.size() && !raw.colors.empty();
+    const bool anyUVs = raw.uvs.size() == 2 * vertices && !raw.uvs.empty();
     std::vector<uint32_t> remap(vertices, 0);
     for (size_t v = 0; v < vertices; ++v) {
         const float* a = &raw.positions[3 * v];
@@ -397,6 +406,11 @@ Mesh importMesh(const std::filesystem::path& file, const ObjectTransform& transf
             continue;
         }
         mesh.triangles.push_back(tri);
+        if (anyUVs)
+            for (int c = 0; c < 3; ++c) {
+                const size_t v = raw.triangles[t + size_t(c)];
+                mesh.uvs.emplace_back(raw.uvs[2 * v], raw.uvs[2 * v + 1]);
+            }
     }
     if (mesh.report.inputTriangles == 0) throw UserError(place, pre + "the mesh has no triangles");
     if (mesh.triangles.empty())

@@ -38,6 +38,13 @@ Corresponded identity(const Mesh& source, const Mesh& target)
     c.triangles = source.triangles;
     c.sourceColors = colorsOf(source, target);
     c.targetColors = colorsOf(target, source);
+    if (source.hasUVs() || target.hasUVs())
+        for (const auto& [mesh, uvs] :
+             {std::pair{&source, &c.sourceUVs}, std::pair{&target, &c.targetUVs}}) {
+            uvs->assign(3 * source.triangles.size(), Vec2d(0.0));
+            if (mesh->hasUVs())
+                for (size_t k = 0; k < uvs->size(); ++k) (*uvs)[k] = Vec2d(mesh->uvs[k]);
+        }
     c.used = Correspondence::Identity;
     return c;
 }

@@ -23,6 +23,9 @@ struct Corresponded {
     /// Per vertex, linear RGB; both empty when neither input has colours (a side without them is
     /// grey).
     std::vector<Vec3f> sourceColors, targetColors;
+    /// Per triangle corner (3 per triangle), each side's texture coordinates there; both empty
+    /// when neither input has them (a side without them has (0, 0)).
+    std::vector<Vec2d> sourceUVs, targetUVs;
     Correspondence used = Correspondence::Identity;
     size_t crossings = 0; ///< merged: the points where an edge of one crossed an edge of the other
     /// star: the points each side was projected from (world units)

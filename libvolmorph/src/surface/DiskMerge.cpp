@@ -238,15 +238,19 @@ Corresponded diskMerge(const Mesh& source, const Mesh& target,
     const uint32_t capA = uint32_t(a.triangles.size()), capB = uint32_t(b.triangles.size());
     Overlay merged;
     std::vector<Vec3I> kept;
+    std::vector<std::pair<uint32_t, uint32_t>> keptRegions;
     db.turn = fit;
     for (int attempt = 0; attempt < kMergeAttempts; ++attempt) {
         db.sphere = mergeTurn(attempt);
         merged = overlay(sa, lift(b, db, poleB));
         // Keep the regions inside either disk.
         kept.clear();
+        keptRegions.clear();
         for (size_t t = 0; t < merged.triangles.size(); ++t)
-            if (merged.regions[t].first < capA || merged.regions[t].second < capB)
+            if (merged.regions[t].first < capA || merged.regions[t].second < capB) {
                 kept.push_back(merged.triangles[t]);
+                keptRegions.push_back(merged.regions[t]);
+            }
         if (invertedTriangles(merged.grid, kept) == 0) break;
     }
     if (const size_t folded = invertedTriangles(merged.grid, kept); folded > 0)
@@ -275,6 +279,7 @@ Corresponded diskMerge(const Mesh& source, const Mesh& target,
                             place(isSource ? a : b, isSource ? da : db, merged.vertices[v],
                                   isSource, merged.directions[v], at, color);
                         });
+    placeMergedUVs(out, keptRegions, a, b);
     return out;
 }
 

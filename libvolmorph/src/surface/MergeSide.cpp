@@ -24,6 +24,9 @@ MergeSide::MergeSide(const Mesh& m) : mesh(&m)
     for (const Vec3I& t : m.triangles)
         triangles.emplace_back(local[t[0]], local[t[1]], local[t[2]]);
     for (uint32_t v : original) colors.push_back(m.hasColors() ? Vec3d(m.colors[v]) : Vec3d(0.8));
+    if (m.hasUVs())
+        for (size_t j = 0; j < m.triangles.size(); ++j)
+            uvs.push_back({Vec2d(m.uvs[3 * j]), Vec2d(m.uvs[3 * j + 1]), Vec2d(m.uvs[3 * j + 2])});
     const auto [lo, hi] = m.bounds();
     diagonal = std::max((hi - lo).length(), 1e-300);
 }
@@ -59,10 +62,19 @@ uint32_t MergeSide::insert(const Place& at)
         triangles[at.triangle] = Vec3I(t[0], t[1], m);
         triangles.emplace_back(t[1], t[2], m);
         triangles.emplace_back(t[2], t[0], m);
+        if (!uvs.empty()) {
+            const std::array<Vec2d, 3> uv = uvs[at.triangle];
+            const Vec2d um = w[0] * uv[0] + w[1] * uv[1] + w[2] * uv[2];
+            uvs[at.triangle] = {uv[0], uv[1], um};
+            uvs.push_back({uv[1], uv[2], um});
+            uvs.push_back({uv[2], uv[0], um});
+        }
         return m;
     }
     // On edge (u, v): each of its triangles (u, v, x) becomes (u, m, x) and (m, v, x).
     const uint32_t u = t[(onEdge + 1) % 3], v = t[(onEdge + 2) % 3];
+    // The point is (1 - lambda) u + lambda v.
+    const double lambda = w[(onEdge + 2) % 3] / (w[(onEdge + 1) % 3] + w[(onEdge + 2) % 3]);
     const size_t count = triangles.size();
     for (size_t j = 0; j < count; ++j)
         for (int c = 0; c < 3; ++c) {
@@ -71,9 +83,44 @@ uint32_t MergeSide::insert(const Place& at)
             if (!((a == u && b == v) || (a == v && b == u))) continue;
             triangles[j] = Vec3I(a, m, x);
             triangles.emplace_back(m, b, x);
+            if (!uvs.empty()) { // this triangle's own coordinates along the edge (a seam's differ)
+                const std::array<Vec2d, 3> uv = uvs[j];
+                const Vec2d& ua = uv[size_t(c)];
+                const Vec2d& ub = uv[size_t((c + 1) % 3)];
+                const Vec2d um =
+                    a == u ? (1.0 - lambda) * ua + lambda * ub : lambda * ua + (1.0 - lambda) * ub;
+                uvs[j] = {ua, um, uv[size_t((c + 2) % 3)]};
+                uvs.push_back({um, ub, uv[size_t((c + 2) % 3)]});
+            }
             break;
         }
     return m;
+}
+
+Vec2d MergeSide::uvAt(uint32_t triangle, const Vec3d& p) const
+{
+    if (uvs.empty()) return Vec2d(0.0);
+    if (triangle >= triangles.size()) triangle = nearest(p).triangle;
+    const Vec3I& t = triangles[triangle];
+    Vec3d w;
+    openvdb::math::closestPointOnTriangleToPoint(points[t[0]], points[t[1]], points[t[2]], p, w);
+    const std::array<Vec2d, 3>& uv = uvs[triangle];
+    return w[0] * uv[0] + w[1] * uv[1] + w[2] * uv[2];
+}
+
+void placeMergedUVs(Corresponded& out, const std::vector<std::pair<uint32_t, uint32_t>>& regions,
+                    const MergeSide& a, const MergeSide& b)
+{
+    if (a.uvs.empty() && b.uvs.empty()) return;
+    out.sourceUVs.resize(3 * out.triangles.size());
+    out.targetUVs.resize(3 * out.triangles.size());
+    tbb::parallel_for(size_t(0), out.triangles.size(), [&](size_t j) {
+        for (size_t c = 0; c < 3; ++c) {
+            const uint32_t v = out.triangles[j][c];
+            out.sourceUVs[3 * j + c] = a.uvAt(regions[j].first, out.source[v]);
+            out.targetUVs[3 * j + c] = b.uvAt(regions[j].second, out.target[v]);
+        }
+    });
 }
 
 Mesh MergeSide::compacted() const
@@ -84,6 +131,8 @@ Mesh MergeSide::compacted() const
     if (mesh->hasColors())
         for (const Vec3d& c : colors) out.colors.emplace_back(Vec3f(c));
     out.triangles = triangles;
+    for (const std::array<Vec2d, 3>& uv : uvs)
+        for (const Vec2d& c : uv) out.uvs.emplace_back(Vec2f(c));
     out.report = mesh->report;
     analyzeTopology(out);
     return out;

@@ -9,6 +9,7 @@
 #include <Eigen/Core>
 #include <tbb/parallel_for.h>
 
+#include <array>
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -21,7 +22,9 @@ struct MergeSide {
     std::vector<Vec3I> triangles;   ///< into `points`
     std::vector<uint32_t> original; ///< per vertex, its index in the mesh (kNone: inserted)
     std::vector<Vec3d> colors;      ///< per vertex, linear RGB (grey when the mesh has none)
-    double diagonal = 1.0;          ///< of the mesh's bounds, world units
+    /// Per triangle, its corners' texture coordinates; empty when the mesh has none.
+    std::vector<std::array<Vec2d, 3>> uvs;
+    double diagonal = 1.0; ///< of the mesh's bounds, world units
 
     static constexpr uint32_t kNone = ~0u;
 
@@ -30,6 +33,10 @@ struct MergeSide {
     explicit MergeSide(const Mesh& m);
 
     Vec3d color(uint32_t v) const { return colors[v]; }
+    /// The texture coordinates of point `p` (on triangle `triangle`, world units) by its
+    /// barycentric weights there; of the nearest point of the surface when `triangle` is not one
+    /// of the side's (a disk's cap). (0, 0) when the mesh has none.
+    Vec2d uvAt(uint32_t triangle, const Vec3d& p) const;
     /// The used vertices (and any inserted), as a Mesh for the maps that take one.
     Mesh compacted() const;
 
@@ -71,6 +78,12 @@ void placeMergedVertices(Corresponded& out, size_t n, bool colors, Place&& place
         place(i, false, out.target[i], colors ? &out.targetColors[i] : nullptr);
     });
 }
+
+/// Fills `out`'s texture coordinates from `a` (source) and `b` (target) when either has them:
+/// each merged triangle's corners at their places on each side, in the side's triangle its region
+/// lies in (`regions`, per merged triangle). Needs out.source, out.target and out.triangles.
+void placeMergedUVs(Corresponded& out, const std::vector<std::pair<uint32_t, uint32_t>>& regions,
+                    const MergeSide& a, const MergeSide& b);
 
 /// "(x, y, z)" with six significant digits, for messages.
 std::string pointText(const Vec3d& p);

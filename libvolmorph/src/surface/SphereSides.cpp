@@ -108,6 +108,7 @@ Corresponded mergeSides(const SphereSide& a, const SphereSide& b, Correspondence
             else
                 place(b, merged.vertices[v], false, turned(rotation.transpose(), dir), at, color);
         });
+    placeMergedUVs(out, merged.regions, *a.side, *b.side);
     return out;
 }
 

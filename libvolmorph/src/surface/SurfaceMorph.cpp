@@ -36,6 +36,7 @@ Mesh SurfaceFrame::mesh() const
     for (const Vec3d& p : points) m.points.emplace_back(Vec3f(p));
     m.triangles = triangles;
     m.colors = colors;
+    m.uvs = uvs;
     m.report.inputTriangles = triangles.size();
     analyzeTopology(m);
     return m;
@@ -80,6 +81,11 @@ SurfaceFrame SurfaceMorpher::frame(double shapeTau, double colorTau) const
     for (size_t i = 0; i < f.colors.size(); ++i)
         f.colors[i] = Vec3f((1.0 - colorTau) * Vec3d(s.sourceColors[i]) +
                             colorTau * Vec3d(s.targetColors[i]));
+    for (size_t k = 0; k < s.sourceUVs.size(); ++k) {
+        f.uvs.emplace_back((1.0 - colorTau) * s.sourceUVs[k] + colorTau * s.targetUVs[k]);
+        f.sourceUVs.emplace_back(s.sourceUVs[k]);
+        f.targetUVs.emplace_back(s.targetUVs[k]);
+    }
     return f;
 }
 

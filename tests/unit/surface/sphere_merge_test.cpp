@@ -20,6 +20,8 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <functional>
+#include <tuple>
 
 namespace volmorph::detail {
 namespace {
@@ -110,6 +112,55 @@ TEST(SphereMerge, TheMergedMeshLiesOnBothInputs)
     const SurfaceMorpher m(a, b, automatic);
     EXPECT_EQ(m.correspondence(), Correspondence::Sphere);
     test::expectEndsOnSides(m, c);
+}
+
+/// `m` with texture coordinates per triangle corner: `f` of the corner's point plus an offset of
+/// `step` x (triangle index mod 3), islands as an atlas's seams make them.
+Mesh withUVs(Mesh m, const std::function<Vec2d(const Vec3d&)>& f, double step)
+{
+    m.uvs.clear();
+    for (size_t j = 0; j < m.triangles.size(); ++j)
+        for (int c = 0; c < 3; ++c)
+            m.uvs.emplace_back(f(Vec3d(m.points[m.triangles[j][c]])) + Vec2d(step * double(j % 3)));
+    return m;
+}
+
+TEST(SphereMerge, TextureCoordinatesFollowEachSideAcrossItsSeams)
+{
+    const auto fa = [](const Vec3d& p) { return Vec2d(p.x(), p.y()); };
+    const auto fb = [](const Vec3d& p) { return Vec2d(p.y() + p.z(), p.x()); };
+    const Mesh a = withUVs(cShape(31, 12), fa, 10.0);
+    const Mesh b =
+        withUVs(test::radialSphere(
+                    9, 14, Vec3d(0.5, 1.0, 0.0), [](const Vec3d&) { return 1.1; }, "ball.obj"),
+                fb, 10.0);
+    const Corresponded c = sphereMerge(a, b, {}, kWhere);
+    ASSERT_EQ(c.sourceUVs.size(), 3 * c.triangles.size());
+    ASSERT_EQ(c.targetUVs.size(), 3 * c.triangles.size());
+    // Each corner: the side's linear function at the vertex's place there, plus the island offset
+    // of the side's triangle the merged triangle lies in, the same at its three corners.
+    double worst = 0.0;
+    for (size_t j = 0; j < c.triangles.size(); ++j)
+        for (const auto& [uvs, points, f] :
+             {std::tuple{&c.sourceUVs, &c.source, +fa}, std::tuple{&c.targetUVs, &c.target, +fb}}) {
+            const Vec2d island = (*uvs)[3 * j] - f((*points)[c.triangles[j][0]]);
+            EXPECT_NEAR(std::remainder(island.x(), 10.0), 0.0, 1e-6);
+            for (size_t k = 0; k < 3; ++k) {
+                const Vec2d want = f((*points)[c.triangles[j][k]]) + island;
+                worst = std::max(worst, ((*uvs)[3 * j + k] - want).length());
+            }
+        }
+    EXPECT_LT(worst, 1e-5); // the inputs' coordinates are floats up to 22: 2e-6 apart there
+    // The frames: the source's at tau 0, the target's at 1, both ends in every frame.
+    const SurfaceMorpher m(a, b, SurfaceSpec{});
+    const SurfaceFrame f0 = m.frame(0.0, 0.0), f1 = m.frame(1.0, 1.0), half = m.frame(0.5, 0.5);
+    ASSERT_EQ(f0.uvs.size(), c.sourceUVs.size());
+    for (size_t k = 0; k < c.sourceUVs.size(); ++k) {
+        EXPECT_EQ(f0.uvs[k], Vec2f(c.sourceUVs[k]));
+        EXPECT_EQ(f1.uvs[k], Vec2f(c.targetUVs[k]));
+        EXPECT_EQ(half.sourceUVs[k], Vec2f(c.sourceUVs[k]));
+        EXPECT_EQ(half.targetUVs[k], Vec2f(c.targetUVs[k]));
+    }
 }
 
 /// A smooth map of space, one-to-one on the C: a stretch, a shear and a swell.
