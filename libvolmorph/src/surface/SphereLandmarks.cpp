@@ -94,7 +94,7 @@ bool pullToLandmarks(const std::vector<Vec3d>& points, const std::vector<Vec3I>&
     const std::vector<Fan> fan = fans(points.size(), triangles);
     std::vector<char> pinned(points.size(), 0);
     for (uint32_t v : vertices) pinned[v] = 1;
-    const StretchMesh m{&points, &directions, StretchMesh::evenShapeWeight(points, triangles)};
+    const StretchMesh m{&points, &directions, StretchMesh::evenStretch(points, triangles)};
     for (int step = 0; step < kSteps + kExtraSteps; ++step) {
         throwIfInterrupted(interrupter);
         const double share = step < kSteps ? 1.0 / double(kSteps - step) : 1.0;

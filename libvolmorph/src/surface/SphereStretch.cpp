@@ -46,11 +46,12 @@ double StretchMesh::energy(uint32_t a, const Vec3d& pa, uint32_t b, uint32_t c) 
     // triangle and 0 for one whose corners lie on a great circle (flat on the sphere, however
     // large its chord triangle): the coarse levels' large triangles are kept from that too.
     const double height = det / (2.0 * chordArea);
-    return (0.5 * (qb - qa).cross(qc - qa).length() * 0.5 * j2 + shapeWeight * shape) / height;
+    return (0.5 * (qb - qa).cross(qc - qa).length() * 0.5 * j2 + kShapeWeight * even * shape) /
+           height;
 }
 
-double StretchMesh::evenShapeWeight(const std::vector<Vec3d>& points,
-                                    const std::vector<Vec3I>& triangles)
+double StretchMesh::evenStretch(const std::vector<Vec3d>& points,
+                                const std::vector<Vec3I>& triangles)
 {
     // An even map gives each triangle 4 pi / F of the sphere and stretches it by the mesh's
     // area over that: a stretch energy of (A / F)^2 / (4 pi / F) per triangle.
@@ -58,10 +59,8 @@ double StretchMesh::evenShapeWeight(const std::vector<Vec3d>& points,
     for (const Vec3I& t : triangles)
         area += 0.5 * (points[t[1]] - points[t[0]]).cross(points[t[2]] - points[t[0]]).length();
     const double f = double(std::max<size_t>(triangles.size(), 1));
-    return 1e-3 * (area / f) * (area / f) / (4.0 * M_PI / f);
+    return (area / f) * (area / f) / (4.0 * M_PI / f);
 }
-
-namespace {
 
 double fanEnergy(const StretchMesh& m, uint32_t v, const Vec3d& at, const Fan& fan)
 {
@@ -72,6 +71,8 @@ double fanEnergy(const StretchMesh& m, uint32_t v, const Vec3d& at, const Fan& f
     }
     return e;
 }
+
+namespace {
 
 /// The derivative of the fan's energy along `axis` (a tangent at `at`), by central differences
 /// (one-sided next to a triangle about to turn over); 0 when neither side is allowed.

@@ -25,15 +25,17 @@ inline constexpr double kMinTripleProduct = 1e-13;
 struct StretchMesh {
     const std::vector<Vec3d>* points = nullptr; ///< the mesh, world units
     std::vector<Vec3d>* directions = nullptr;   ///< the map: per vertex, a unit vector
-    /// The weight of each chord triangle's shape term, (sum of squared edges) / (4 sqrt 3 area),
-    /// 1 for an equilateral triangle and unbounded for a sliver. A thin mesh triangle (the coarse
-    /// levels of a quadric decimation have many) stretches little onto a thin chord triangle, so
-    /// stretch alone lets the map's triangles go flat; this term, a thousandth of the stretch of
-    /// an even map (evenShapeWeight()), keeps them from it.
-    double shapeWeight = 0.0;
-    /// That weight for `triangles` of `points`.
-    static double evenShapeWeight(const std::vector<Vec3d>& points,
-                                  const std::vector<Vec3I>& triangles);
+    /// The stretch energy of one triangle of an even map (each triangle 4 pi / F of the sphere,
+    /// stretched by the mesh's area over that): evenStretch().
+    double even = 0.0;
+    /// Each chord triangle's shape term, (sum of squared edges) / (4 sqrt 3 area), 1 for an
+    /// equilateral triangle and unbounded for a sliver, weighs kShapeWeight x `even`. A thin mesh
+    /// triangle (the coarse levels of a quadric decimation have many) stretches little onto a thin
+    /// chord triangle, so stretch alone lets the map's triangles go flat; the term keeps them from
+    /// it.
+    static constexpr double kShapeWeight = 1e-3;
+    static double evenStretch(const std::vector<Vec3d>& points,
+                              const std::vector<Vec3I>& triangles);
 
     /// (mesh area) x (L2 stretch)^2 of triangle (a, b, c) with `pa` in place of a's direction, plus
     /// its shape term; +infinity when the chord triangle is turned over or thinner than
@@ -43,6 +45,9 @@ struct StretchMesh {
 
 /// The triangles around one vertex v, each (b, c) with (v, b, c) counter-clockwise.
 using Fan = std::vector<std::pair<uint32_t, uint32_t>>;
+
+/// The sum of energy() over the triangles of `fan` with `at` in place of v's direction.
+double fanEnergy(const StretchMesh& m, uint32_t v, const Vec3d& at, const Fan& fan);
 
 /// Moves vertex `v` of `m` by up to `iterations` descent steps (a finite-difference gradient in
 /// the tangent plane, then a backtracking line search that accepts only a lower energy with every
