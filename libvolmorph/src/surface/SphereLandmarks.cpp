@@ -23,13 +23,6 @@ std::vector<Fan> fans(size_t vertices, const std::vector<Vec3I>& triangles)
     return out;
 }
 
-bool fanValid(const StretchMesh& m, uint32_t v, const Vec3d& at, const Fan& fan)
-{
-    for (const auto& [b, c] : fan)
-        if (!std::isfinite(m.energy(v, at, b, c))) return false;
-    return true;
-}
-
 /// The point `share` of the way from `a` to `b` along their great circle (unit vectors).
 Vec3d along(const Vec3d& a, const Vec3d& b, double share)
 {

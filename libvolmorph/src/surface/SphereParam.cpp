@@ -26,10 +26,9 @@ namespace {
 
 struct Traits : OpenMesh::DefaultTraits {
     using Point = OpenMesh::Vec3d;
-    using Normal = OpenMesh::Vec3d;
     VertexAttributes(OpenMesh::Attributes::Status);
     EdgeAttributes(OpenMesh::Attributes::Status);
-    FaceAttributes(OpenMesh::Attributes::Status | OpenMesh::Attributes::Normal);
+    FaceAttributes(OpenMesh::Attributes::Status);
 };
 using PolyMesh = OpenMesh::TriMesh_ArrayKernelT<Traits>;
 using Collapse = OpenMesh::Decimater::ModProgMeshT<PolyMesh>::Info;
@@ -48,7 +47,6 @@ PolyMesh openMesh(const std::vector<Vec3d>& points, const std::vector<Vec3I>& tr
                            PolyMesh::VertexHandle(int(t[2])))
                  .is_valid())
             throw std::runtime_error("the spherical map needs a manifold mesh");
-    mesh.update_face_normals();
     return mesh;
 }
 
@@ -95,14 +93,6 @@ void placeBase(const PolyMesh& mesh, std::vector<Vec3d>& directions)
     const Vec3d& p = directions[base[0]];
     if (p.dot(directions[fan[0].first].cross(directions[fan[0].second])) < 0.0)
         std::swap(directions[base[2]], directions[base[3]]); // the mirror image
-}
-
-bool fanValid(const StretchMesh& m, uint32_t v, const Fan& fan)
-{
-    for (const auto& [b, c] : fan)
-        if (m.energy(v, (*m.directions)[v], b, c) == std::numeric_limits<double>::infinity())
-            return false;
-    return true;
 }
 
 /// The deepest point of the kernel of v's ring (where v sees every ring edge on its left), the
@@ -168,7 +158,7 @@ void placeSplit(const StretchMesh& m, uint32_t v0, uint32_t v1, const Fan& fan)
     std::vector<Vec3d>& dir = *m.directions;
     if (const std::optional<Vec3d> centre = kernelCentre(dir, fan)) {
         dir[v0] = *centre;
-        if (fanValid(m, v0, fan)) return;
+        if (fanValid(m, v0, dir[v0], fan)) return;
     }
     const Vec3d& s1 = dir[v1];
     Vec3d wedge(0.0);
@@ -181,7 +171,7 @@ void placeSplit(const StretchMesh& m, uint32_t v0, uint32_t v1, const Fan& fan)
     for (double step = 0.25 * nearest; step > 1e-9 * nearest; step *= 0.5) {
         const Vec3d p = s1 + step * wedge / wedge.length();
         dir[v0] = p / p.length();
-        if (fanValid(m, v0, fan)) return;
+        if (fanValid(m, v0, dir[v0], fan)) return;
     }
     throw std::runtime_error("the spherical map found no place for vertex " + std::to_string(v0));
 }

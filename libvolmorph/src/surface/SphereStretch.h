@@ -13,6 +13,7 @@
 #include <volmorph/core/Math.h>
 
 #include <cstdint>
+#include <limits>
 #include <utility>
 #include <vector>
 
@@ -48,6 +49,13 @@ using Fan = std::vector<std::pair<uint32_t, uint32_t>>;
 
 /// The sum of energy() over the triangles of `fan` with `at` in place of v's direction.
 double fanEnergy(const StretchMesh& m, uint32_t v, const Vec3d& at, const Fan& fan);
+
+/// Whether every triangle of `fan` stays counter-clockwise (and thicker than kMinTripleProduct)
+/// with `at` in place of v's direction.
+inline bool fanValid(const StretchMesh& m, uint32_t v, const Vec3d& at, const Fan& fan)
+{
+    return fanEnergy(m, v, at, fan) < std::numeric_limits<double>::infinity();
+}
 
 /// Moves vertex `v` of `m` by up to `iterations` descent steps (a finite-difference gradient in
 /// the tangent plane, then a backtracking line search that accepts only a lower energy with every
