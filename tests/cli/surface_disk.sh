@@ -63,12 +63,10 @@ import sys
 out = sys.argv[1]
 sys.path.insert(0, sys.argv[2])
 sys.dont_write_bytecode = True  # nothing written into the source tree
-from surface_frames import measure, read_obj, read_ply
+from surface_frames import measure, read_frames, read_obj
 
 
-frames = [read_ply("%s/m.%04d.ply" % (out, f)) for f in range(1, 6)]
-for verts, faces in frames:
-    assert len(verts) == len(frames[0][0]) and faces == frames[0][1], "connectivity differs"
+frames = read_frames(out, 5)
 uses = {}
 for a, b, c in frames[0][1]:
     for e in ((a, b), (b, c), (c, a)):

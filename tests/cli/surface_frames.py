@@ -22,6 +22,24 @@ def read_ply(path):
     return verts, faces
 
 
+def read_frames(out, count):
+    """Frames m.0001.ply .. m.COUNT.ply in `out`, asserted to share one connectivity."""
+    frames = [read_ply("%s/m.%04d.ply" % (out, f)) for f in range(1, count + 1)]
+    for verts, faces in frames:
+        assert len(verts) == len(frames[0][0]) and faces == frames[0][1], "connectivity differs"
+    return frames
+
+
+def check_ends(frames, ends):
+    """Each end (frame index, (points, triangles) of its input, rgba): the frame encloses the
+    input's volume and has its area (1e-5: float PLY), every vertex that colour."""
+    for f, (pts, tris), colour in ends:
+        got, want = measure(frames[f][0], frames[f][1]), measure(pts, tris)
+        for g, w, what in zip(got, want, ("volume", "area")):
+            assert abs(g / w - 1) < 1e-5, "frame %d's %s %g, the input's %g" % (f + 1, what, g, w)
+        assert all(v[6:] == colour for v in frames[f][0]), "colour of frame %d" % (f + 1)
+
+
 def uv_sets(lines):
     return [l.split()[4] for l in lines if l.startswith("property list uchar float")]
 

@@ -79,12 +79,10 @@ import sys
 out = sys.argv[1]
 sys.path.insert(0, sys.argv[2])
 sys.dont_write_bytecode = True  # nothing written into the source tree
-from surface_frames import read_obj, read_ply
+from surface_frames import read_frames, read_obj
 
 
-frames = [read_ply("%s/m.%04d.ply" % (out, f)) for f in range(1, 34)]
-for verts, faces in frames:
-    assert len(verts) == len(frames[0][0]) and faces == frames[0][1], "connectivity differs"
+frames = read_frames(out, 33)
 # The importer may order vertices its own way (Assimp's welding): vertex i of the frames is the
 # file's vertex at frame 1's position, and must be the target file's same vertex at the last frame.
 tube, bent = read_obj(out + "/tube.obj")[0], read_obj(out + "/bent.obj")[0]

@@ -46,19 +46,13 @@ import sys
 out, src = sys.argv[1], sys.argv[2]
 sys.path.insert(0, src + "/tests/cli")
 sys.dont_write_bytecode = True  # nothing written into the source tree
-from surface_frames import measure, read_off, read_ply
+from surface_frames import check_ends, read_frames, read_off
 
 
-frames = [read_ply("%s/m.%04d.ply" % (out, f)) for f in range(1, 10)]
-for verts, faces in frames:
-    assert len(verts) == len(frames[0][0]) and faces == frames[0][1], "connectivity differs"
+frames = read_frames(out, 9)
 ends = ((0, read_off(src + "/scenes/meshes/blobby.off", (0, 0, 0)), (255, 0, 0, 255)),
         (8, read_off(src + "/scenes/meshes/star.off", (3, 0, 0)), (0, 0, 255, 255)))
-for f, (pts, tris), colour in ends:
-    got, want = measure(frames[f][0], frames[f][1]), measure(pts, tris)
-    for g, w, what in zip(got, want, ("volume", "area")):
-        assert abs(g / w - 1) < 1e-5, "frame %d's %s %g, the input's %g" % (f + 1, what, g, w)
-    assert all(v[6:] == colour for v in frames[f][0]), "colour of frame %d" % (f + 1)
+check_ends(frames, ends)
 print("star merge: %d vertices; the ends enclose the inputs' volumes and areas" % len(frames[0][0]))
 PY
 
