@@ -129,8 +129,8 @@ int runPreview(const PreviewArgs& args)
     bool labelsDrawn = true;
     FrameLoop loop(scene, frames, 1, args.quiet, false, interrupter);
     loop.run([&](const FrameStep& step) {
-        render::Image image = morph ? view.renderFrame(morph->frame(step.frame), step.frame)
-                                    : readFrame(args.from, step.frame);
+        render::Image image =
+            morph ? renderMorphFrame(view, *morph, step.frame) : readFrame(args.from, step.frame);
         if (drawPairs) {
             // Features are drawn at the image's own size (a frame read from disk keeps its size).
             const SceneRender atSize(scene, 0, image.width);

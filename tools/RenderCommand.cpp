@@ -322,9 +322,8 @@ int runRenderScene(const RenderSceneArgs& args)
                                    " exists, skipped",
                                ""};
         const auto start = std::chrono::steady_clock::now();
-        const VolumeSet v = morph.frame(step.frame);
-        step.progress(1);
-        const render::Image image = renderer.renderFrame(v, step.frame);
+        const render::Image image =
+            renderMorphFrame(renderer, morph, step.frame, [&] { step.progress(1); });
         const std::string error =
             writeFrameImage(image, renderer, file, args, scene, step, secondsSince(start));
         if (!error.empty()) return FrameResult{FrameResult::Outcome::Failed, error, ""};

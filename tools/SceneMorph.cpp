@@ -61,6 +61,16 @@ VolumeSet SceneMorph::frame(int frame, MorphStats* stats)
     return v;
 }
 
+SurfaceFrame SceneMorph::surfaceFrame(int frame)
+{
+    const std::string stage = "frame " + std::to_string(frame) + ": surface";
+    mInterrupter.start(stage.c_str());
+    SurfaceFrame f = mSurface->frame(frame);
+    mInterrupter.end();
+    if (mInterrupter.stopRequested()) throw Interrupted();
+    return f;
+}
+
 void keepOneSide(BlendSpec& blend, bool target)
 {
     ScheduleSpec held;

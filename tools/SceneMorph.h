@@ -31,6 +31,12 @@ public:
     /// interrupter asked to stop during it.
     VolumeSet frame(int frame, MorphStats* stats = nullptr);
 
+    /// Surface mode (blend.mode = "surface"): its frames are meshes (surfaceFrame), and frame()
+    /// gives them voxelized.
+    bool surfaceMode() const { return mSurface.has_value(); }
+    /// Surface mode: the in-between mesh of frame `frame`, velocities in world units per second.
+    SurfaceFrame surfaceFrame(int frame);
+
 private:
     void load(int frame);
 

@@ -26,7 +26,7 @@ render::Camera sceneCamera(const CameraSpec& c, const RenderSpec& r, int width)
 
 } // namespace
 
-std::shared_ptr<const render::Props> importProps(const std::vector<PropSpec>& props)
+std::vector<render::PropMesh> importPropMeshes(const std::vector<PropSpec>& props)
 {
     std::vector<render::PropMesh> meshes;
     for (const PropSpec& spec : props) {
@@ -40,8 +40,36 @@ std::shared_ptr<const render::Props> importProps(const std::vector<PropSpec>& pr
                                          : render::PropMesh::Role::Diffuse;
         meshes.push_back(std::move(prop));
     }
+    return meshes;
+}
+
+std::shared_ptr<const render::Props> importProps(const std::vector<PropSpec>& props)
+{
+    std::vector<render::PropMesh> meshes = importPropMeshes(props);
     if (meshes.empty()) return nullptr;
     return std::make_shared<const render::Props>(std::move(meshes));
+}
+
+render::PropMesh subjectMesh(const SurfaceFrame& frame, double albedo, bool moving)
+{
+    render::PropMesh mesh;
+    mesh.subject = true;
+    mesh.triangles = frame.triangles;
+    mesh.points.reserve(frame.points.size());
+    for (const Vec3d& p : frame.points) mesh.points.emplace_back(p);
+    mesh.color = Vec3d(albedo);
+    for (const Vec3f& c : frame.colors) mesh.colors.push_back(c * float(albedo));
+    std::vector<Vec3d> normals(frame.points.size(), Vec3d(0.0));
+    for (const Vec3I& t : frame.triangles) {
+        const Vec3d& a = frame.points[t[0]];
+        // The cross product's length is twice the area: area-weighted.
+        const Vec3d n = (frame.points[t[1]] - a).cross(frame.points[t[2]] - a);
+        for (int k = 0; k < 3; ++k) normals[t[k]] += n;
+    }
+    for (const Vec3d& n : normals) mesh.normals.emplace_back(n);
+    if (moving)
+        for (const Vec3d& v : frame.velocity) mesh.velocities.emplace_back(v);
+    return mesh;
 }
 
 std::shared_ptr<const render::EnvironmentMap> readSkyMap(const LightSpec& light)
@@ -72,7 +100,8 @@ SceneRender::SceneRender(const Scene& scene, int threads, int width)
     settings.layers = r.layers;
     settings.seed = r.seed;
     settings.threads = threads;
-    mProps = importProps(scene.props);
+    mPropMeshes = importPropMeshes(scene.props);
+    if (!mPropMeshes.empty()) mProps = std::make_shared<const render::Props>(mPropMeshes);
     settings.props = mProps.get();
     for (const LightSpec& light : r.lights) mMaps.push_back(readSkyMap(light));
 }
@@ -104,7 +133,24 @@ std::vector<render::Light> SceneRender::lights(double frame) const
 
 render::Image SceneRender::renderFrame(const VolumeSet& volumes, int frame) const
 {
+    return render(volumes, frame, settings);
+}
+
+render::Image SceneRender::renderFrame(const SurfaceFrame& surface, int frame) const
+{
+    std::vector<render::PropMesh> meshes = mPropMeshes;
+    meshes.push_back(subjectMesh(surface, medium.albedo, mSpec.motionBlur()));
+    const render::Props props(std::move(meshes));
     render::RenderSettings s = settings;
+    s.props = &props;
+    VolumeSet nothing; // no volume: the surface alone among the props
+    nothing.density = openvdb::FloatGrid::create(0.0f);
+    return render(nothing, frame, s);
+}
+
+render::Image SceneRender::render(const VolumeSet& volumes, int frame,
+                                  render::RenderSettings s) const
+{
     s.frame = frame;
     if (!mSpec.motionBlur())
         return render::renderVolume(*volumes.density, volumes.color.get(), camera(frame),
@@ -124,6 +170,19 @@ double SceneRender::shutterReachSeconds() const
 {
     if (!mSpec.motionBlur()) return 0.0;
     return std::max(std::abs(mSpec.shutter.first), std::abs(mSpec.shutter.second)) / mFps;
+}
+
+render::Image renderMorphFrame(const SceneRender& view, SceneMorph& morph, int frame,
+                               const std::function<void()>& morphed)
+{
+    if (morph.surfaceMode()) {
+        const SurfaceFrame surface = morph.surfaceFrame(frame);
+        if (morphed) morphed();
+        return view.renderFrame(surface, frame);
+    }
+    const VolumeSet volumes = morph.frame(frame);
+    if (morphed) morphed();
+    return view.renderFrame(volumes, frame);
 }
 
 } // namespace volmorph::cli

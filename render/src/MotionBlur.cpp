@@ -1,5 +1,6 @@
 // Eulerian motion blur (Renderer.h, renderMotionBlurred): one sub-frame image per shutter time, of
-// the volume moved along its velocity by that time (its mean exactly, the rest advected), averaged.
+// the volume moved along its velocity by that time (its mean exactly, the rest advected) and the
+// props moved along their vertices' velocities, averaged.
 #include <volmorph/render/Renderer.h>
 
 #include <volmorph/core/Interrupter.h>
@@ -9,6 +10,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <memory>
 #include <optional>
 
 namespace volmorph::render {
@@ -98,6 +100,13 @@ Image renderMotionBlurred(const openvdb::FloatGrid& density, const openvdb::Vec3
         const openvdb::FloatGrid* d = motion.at(&density, time.seconds, movedDensity);
         const openvdb::Vec3SGrid* c = motion.at(color, time.seconds, movedColor);
         if (settings.interrupter && settings.interrupter->wasInterrupted()) throw Interrupted();
+        std::unique_ptr<const Props> movedProps;
+        if (settings.props && settings.props->moves() && time.seconds != 0.0) {
+            movedProps = settings.props->moved(time.seconds);
+            each.props = movedProps.get();
+        } else {
+            each.props = settings.props;
+        }
         each.seed = shutterSeed(settings.seed, k);
         const Image image = renderVolume(*d, c, time.camera, time.lights, medium, each);
         if (k == 0) {

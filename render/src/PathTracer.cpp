@@ -93,12 +93,12 @@ public:
     Path(ThreadReaders& readers, Random& random) : mR(readers), mIn(readers.in), mRandom(random) {}
 
     /// Where a path is: a collision in the medium (index point ip, arrived along the unit index
-    /// direction `dir`), or a point on a prop (world point x nudged off it, unit normal n facing
-    /// the arrival, arrived along the unit world direction `dir`).
+    /// direction `dir`), or a point on a prop (world point x nudged off it, unit shading normal n
+    /// facing the arrival, arrived along the unit world direction `dir`).
     struct Vertex {
         bool surface = false;
         Vec3d ip{0.0}, x{0.0}, n{0.0}, dir{0.0};
-        size_t prop = 0;
+        Vec3d reflectance{0.0}; ///< a prop's, there
     };
 
     /// The radiance of the path from vertex `v` on (Cycles' bounces count every vertex): what
@@ -121,10 +121,10 @@ public:
         return L;
     }
 
-    /// The radiance leaving a diffuse prop's point x (normal n) toward -dir.
-    Radiance onSurface(const Vec3d& x, const Vec3d& n, const Vec3d& dir, size_t prop)
+    /// The radiance leaving a diffuse prop's point x (shading normal n, reflectance r) toward -dir.
+    Radiance onSurface(const Vec3d& x, const Vec3d& n, const Vec3d& dir, const Vec3d& r)
     {
-        return trace(Vertex{true, Vec3d(0.0), x, n, dir, prop});
+        return trace(Vertex{true, Vec3d(0.0), x, n, dir, r});
     }
 
     /// A shadow catcher's matte at x (normal n): from the direct light on it, and the environment
@@ -175,7 +175,7 @@ private:
             emitted += beta * mIn.medium.emission;
             beta = beta * albedoAt(v.ip);
         } else {
-            beta = beta * mIn.props->mesh(v.prop).color;
+            beta = beta * v.reflectance;
         }
         if (beta.x() <= 0.0 && beta.y() <= 0.0 && beta.z() <= 0.0) return false;
         if (!v.surface) {
@@ -270,11 +270,11 @@ private:
         dir /= scale;
         Vec3d at = ip;
         if (track(at, dir, onProp ? hit.distance * scale : kNoProp)) {
-            v = Vertex{false, at, Vec3d(0.0), Vec3d(0.0), dir, 0};
+            v = Vertex{false, at, Vec3d(0.0), Vec3d(0.0), dir, Vec3d(0.0)};
             return true;
         }
         if (!onProp) return false;
-        v = Vertex{true, Vec3d(0.0), surfacePoint(Ray{x, w}, hit), hit.normal, w, hit.prop};
+        v = Vertex{true, Vec3d(0.0), surfacePoint(Ray{x, w}, hit), hit.shading, w, hit.reflectance};
         return true;
     }
 
@@ -422,7 +422,8 @@ RaySample tracePath(ThreadReaders& readers, const Ray& ray, Random& random)
     Radiance surface;
     double matte = 0.0;
     if (prop.role == PropMesh::Role::Diffuse)
-        surface = path.onSurface(surfacePoint(ray, hit), hit.normal, ray.direction, hit.prop);
+        surface =
+            path.onSurface(surfacePoint(ray, hit), hit.shading, ray.direction, hit.reflectance);
     else if (prop.role == PropMesh::Role::ShadowCatcher)
         matte = path.catcherMatte(surfacePoint(ray, hit), hit.normal);
     finishOnProp(prop, hit.distance, surface, matte, out);

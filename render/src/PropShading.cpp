@@ -41,6 +41,10 @@ void finishOnProp(const PropMesh& prop, double distance, const Radiance& surface
     out.depth = std::min(out.depth, distance);
     switch (prop.role) {
     case PropMesh::Role::Diffuse:
+        if (prop.subject) {
+            out.volumeL += surface.sum() * out.T;
+            out.volumeT = 0.0;
+        }
         out.L.direct += surface.direct * out.T;
         out.L.indirect += surface.indirect * out.T;
         out.L.emission += surface.emission * out.T;

@@ -35,7 +35,8 @@ double shadowMatte(const Vec3d& received, const Vec3d& unoccluded);
 /// A camera ray that reached prop `hit`, `distance` world units along it, with `out` the volume in
 /// front of it (radiance, and its transmittance T): a diffuse prop adds T times `surface` (its
 /// radiance) and makes the pixel opaque; a holdout keeps the alpha of the volume in front only; a
-/// shadow catcher adds no colour and `matte` times T to the alpha (out.shadow). The depth becomes
+/// shadow catcher adds no colour and `matte` times T to the alpha (out.shadow). A subject prop
+/// (PropMesh::subject) goes into the volume's layer too (volumeL, volumeT). The depth becomes
 /// the prop's unless the volume's alpha passed 0.5 before it.
 void finishOnProp(const PropMesh& prop, double distance, const Radiance& surface, double matte,
                   RaySample& out);

@@ -62,10 +62,25 @@ void addMesh(RTCDevice device, RTCScene scene, const PropMesh& mesh, unsigned id
     rtcReleaseGeometry(geometry);
 }
 
+/// The per-vertex attribute `values` interpolated at barycentric (u, v) of triangle `tri`.
+Vec3d interpolate(const std::vector<Vec3f>& values, const Vec3I& tri, double u, double v)
+{
+    return Vec3d(values[tri[0]]) * (1.0 - u - v) + Vec3d(values[tri[1]]) * u +
+           Vec3d(values[tri[2]]) * v;
+}
+
+void checkSizes(const PropMesh& mesh)
+{
+    for (const std::vector<Vec3f>* values : {&mesh.colors, &mesh.normals, &mesh.velocities})
+        if (!values->empty() && values->size() != mesh.points.size())
+            throw std::invalid_argument("Props: a per-vertex attribute's size is not the points'");
+}
+
 } // namespace
 
 Props::Props(std::vector<PropMesh> meshes) : mMeshes(std::move(meshes))
 {
+    for (const PropMesh& mesh : mMeshes) checkSizes(mesh);
     mEmbree = std::make_unique<Embree>();
     mEmbree->device = rtcNewDevice(nullptr);
     if (!mEmbree->device)
@@ -80,6 +95,23 @@ Props::Props(std::vector<PropMesh> meshes) : mMeshes(std::move(meshes))
 }
 
 Props::~Props() = default;
+
+bool Props::moves() const
+{
+    for (const PropMesh& mesh : mMeshes)
+        for (const Vec3f& v : mesh.velocities)
+            if (v != Vec3f(0.0f)) return true;
+    return false;
+}
+
+std::unique_ptr<const Props> Props::moved(double seconds) const
+{
+    std::vector<PropMesh> meshes = mMeshes;
+    for (PropMesh& mesh : meshes)
+        for (size_t i = 0; i < mesh.velocities.size(); ++i)
+            mesh.points[i] = Vec3f(Vec3d(mesh.points[i]) + Vec3d(mesh.velocities[i]) * seconds);
+    return std::make_unique<const Props>(std::move(meshes));
+}
 
 bool Props::intersect(const Vec3d& origin, const Vec3d& direction, double tNear, double tFar,
                       PropHit& hit) const
@@ -99,6 +131,19 @@ bool Props::intersect(const Vec3d& origin, const Vec3d& direction, double tNear,
     const double length = n.length();
     n = length > 0.0 ? n / length : -direction;
     hit.normal = n.dot(direction) > 0.0 ? -n : n;
+    const PropMesh& mesh = mMeshes[hit.prop];
+    const Vec3I& tri = mesh.triangles[rayHit.hit.primID];
+    const double u = rayHit.hit.u, v = rayHit.hit.v;
+    hit.shading = hit.normal;
+    if (!mesh.normals.empty()) {
+        Vec3d s = interpolate(mesh.normals, tri, u, v);
+        const double sLength = s.length();
+        if (sLength > 0.0) {
+            s /= sLength;
+            hit.shading = s.dot(hit.normal) < 0.0 ? -s : s;
+        }
+    }
+    hit.reflectance = mesh.colors.empty() ? mesh.color : interpolate(mesh.colors, tri, u, v);
     return true;
 }
 

@@ -259,8 +259,8 @@ RaySample integrateRay(ThreadReaders& readers, const Ray& ray, Random* random)
     double matte = 0.0;
     if (prop.role != PropMesh::Role::Holdout) {
         const Vec3d received =
-            directIrradiance(readers, surfacePoint(ray, hit), hit.normal, unoccluded, random);
-        surface.direct = diffuseRadiance(prop.color, received);
+            directIrradiance(readers, surfacePoint(ray, hit), hit.shading, unoccluded, random);
+        surface.direct = diffuseRadiance(hit.reflectance, received);
         matte = shadowMatte(received, unoccluded);
     }
     finishOnProp(prop, hit.distance, surface, matte, out);

@@ -1,6 +1,6 @@
 """Renders a .vdb with Blender Cycles as volmorph's render-vdb would: the anchor of issue 33.
 
-usage: blender -b --factory-startup --python tests/bench/cycles_render.py -- IN.vdb OUT.exr
+usage: blender -b --factory-startup --python tests/bench/cycles_render.py -- IN.vdb|IN.ply OUT.exr
            --voxel V --eye X,Y,Z --lookat X,Y,Z --fov DEG --res WxH --extinction S --albedo A
            [--color-grid Cd] [--sun DX,DY,DZ,STRENGTH[,R,G,B]] [--sun-angle DEG] [--sky R,G,B]
            [--sky-map LATLONG.exr] [--floor MESH.obj --floor-color R,G,B] [--bounces N]
@@ -23,8 +23,13 @@ volmorph reads it; Blender's equirectangular mapping of the turned world is volm
 adds an OBJ mesh (y up, turned like the rest) with a Diffuse BSDF of --floor-color, and diffuse
 bounces as many as volume bounces (volmorph's bounces count every vertex, on a prop or in the
 medium).
+A surface morph's frame (issue 57): IN.ply as `volmorph morph` writes it (binary, x y z, uchar
+colours as linear values times 255), turned like the rest, smooth-shaded, a Diffuse BSDF whose
+colour is --albedo times the vertex colours (as volmorph renders a surface morph); --voxel is
+then unused.
 """
 import argparse
+import struct
 import math
 import sys
 import time
@@ -112,6 +117,76 @@ def volume_object(args):
         obj.data.velocity_scale = 1.0
 
 
+PLY_TYPES = {"float": "f", "double": "d", "uchar": "B", "char": "b", "int": "i", "uint": "I",
+             "short": "h", "ushort": "H"}
+
+
+def read_ply(path):
+    """Points, faces and linear vertex colours (None without) of a binary little-endian PLY."""
+    with open(path, "rb") as f:
+        data = f.read()
+    end = data.index(b"end_header\n") + len(b"end_header\n")
+    elements, current = [], None
+    for line in data[:end].decode().splitlines():
+        fields = line.split()
+        if fields[0] == "element":
+            current = (fields[1], int(fields[2]), [])
+            elements.append(current)
+        elif fields[0] == "property":
+            current[2].append(fields[1:])
+    at, points, colours, faces = end, [], [], []
+    for name, count, props in elements:
+        for _ in range(count):
+            row = {}
+            for prop in props:
+                if prop[0] == "list":
+                    (n,) = struct.unpack_from("<" + PLY_TYPES[prop[1]], data, at)
+                    at += struct.calcsize(PLY_TYPES[prop[1]])
+                    fmt = "<%d%s" % (n, PLY_TYPES[prop[2]])
+                    row[prop[3]] = struct.unpack_from(fmt, data, at)
+                    at += struct.calcsize(fmt)
+                else:
+                    (row[prop[1]],) = struct.unpack_from("<" + PLY_TYPES[prop[0]], data, at)
+                    at += struct.calcsize(PLY_TYPES[prop[0]])
+            if name == "vertex":
+                points.append(to_blender([row["x"], row["y"], row["z"]]))
+                if "red" in row:
+                    colours.append([row[c] / 255.0 for c in ("red", "green", "blue")])
+            elif name == "face":
+                faces.append(list(row["vertex_indices"]))
+    return points, faces, colours or None
+
+
+def surface_object(args):
+    """The PLY's mesh, smooth, Diffuse BSDF of --albedo times its vertex colours."""
+    points, faces, colours = read_ply(args.vdb)
+    mesh = bpy.data.meshes.new("surface")
+    mesh.from_pydata(points, [], faces)
+    mesh.polygons.foreach_set("use_smooth", [True] * len(mesh.polygons))
+    obj = bpy.data.objects.new("surface", mesh)
+    bpy.context.scene.collection.objects.link(obj)
+    mat = bpy.data.materials.new("surface")
+    mat.use_nodes = True
+    nodes, links = mat.node_tree.nodes, mat.node_tree.links
+    bsdf = nodes.new("ShaderNodeBsdfDiffuse")
+    bsdf.inputs["Roughness"].default_value = 0.0
+    a = args.albedo
+    bsdf.inputs["Color"].default_value = (a, a, a, 1.0)
+    if colours:
+        attribute = mesh.attributes.new("Col", "FLOAT_COLOR", "POINT")
+        attribute.data.foreach_set("color", [v for c in colours for v in (c[0], c[1], c[2], 1.0)])
+        attr = nodes.new("ShaderNodeAttribute")
+        attr.attribute_name = "Col"
+        mix = nodes.new("ShaderNodeMixRGB")
+        mix.blend_type = "MULTIPLY"
+        mix.inputs["Fac"].default_value = 1.0
+        mix.inputs["Color2"].default_value = (a, a, a, 1.0)
+        links.new(attr.outputs["Color"], mix.inputs["Color1"])
+        links.new(mix.outputs["Color"], bsdf.inputs["Color"])
+    links.new(bsdf.outputs["BSDF"], nodes["Material Output"].inputs["Surface"])
+    obj.data.materials.append(mat)
+
+
 def camera(args, width):
     cam = bpy.data.cameras.new("camera")
     cam.sensor_fit = "HORIZONTAL"
@@ -185,7 +260,7 @@ def settings(args):
     c.use_denoising = False
     c.max_bounces = args.bounces + 1
     c.volume_bounces = args.bounces
-    c.diffuse_bounces = args.bounces if args.floor else 0
+    c.diffuse_bounces = args.bounces if args.floor or args.vdb.endswith(".ply") else 0
     c.glossy_bounces = c.transmission_bounces = 0
     # A volume's boundary is a transparent surface to Cycles' shadow rays: with no transparent
     # bounces the sun would never reach the inside.
@@ -219,7 +294,10 @@ def main():
     args = parse()
     bpy.ops.wm.read_factory_settings(use_empty=True)
     width = settings(args)
-    volume_object(args)
+    if args.vdb.endswith(".ply"):
+        surface_object(args)
+    else:
+        volume_object(args)
     camera(args, width)
     lights(args)
     if args.floor:

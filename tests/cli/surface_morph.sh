@@ -9,7 +9,8 @@
 #   over the neighbouring frames (1/24 s apart), which checks the units as well as the derivative;
 # - morph -o .vdb: the in-between voxelized, with sdf, density, Cd and a vel grid no faster than the
 #   fastest vertex;
-# - render: one frame of it renders.
+# - render: frame 17 renders as a surface, the subject: its alpha all in the volume layer (no prop
+#   here); with a shutter it blurs (another image) and keeps its coverage (the mean alpha within 5%).
 # usage: surface_morph.sh VOLMORPH SOURCE_DIR
 set -eu
 volmorph=$1
@@ -126,5 +127,16 @@ assert 0.5 * fastest < top <= fastest * 1.0001, (top, fastest)
 PY
 
 "$volmorph" render "$out/scene.toml" --frames 17 -o "$out/r.####.exr" -q
-[ -s "$out/r.0017.exr" ] || { echo "no rendered frame"; exit 1; }
-echo "surface morph: check, meshes, voxels and a render"
+sed 's/^samples = 2$/samples = 16\nshutter = [-0.5, 0.5]/' "$out/scene.toml" >"$out/blur.toml"
+"$volmorph" render "$out/blur.toml" --frames 17 -o "$out/b.####.exr" -q
+# Channels: R G B A depth.Z direct.RGB emission.RGB indirect.RGB shadow.A volume.RGBA.
+alphas() { oiiotool --stats "$1" | awk '/Stats Avg/ { print $6, $(NF - 1) }'; }
+/usr/bin/python3 - "$(alphas "$out/r.0017.exr")" "$(alphas "$out/b.0017.exr")" <<'PY'
+import sys
+still, blur = ([float(v) for v in a.split()] for a in sys.argv[1:3])
+assert still[0] > 0.05 and still[0] == still[1], still  # the surface, and the subject's layer
+assert blur[0] == blur[1], blur
+assert abs(blur[0] - still[0]) < 0.05 * still[0], (blur, still)
+PY
+cmp -s "$out/r.0017.exr" "$out/b.0017.exr" && { echo "the shutter changed nothing"; exit 1; }
+echo "surface morph: check, meshes, voxels and renders (still and blurred)"

@@ -213,7 +213,9 @@ inline unsigned shutterSeed(unsigned seed, size_t k)
 /// density-weighted mean velocity exactly (the grids' transforms) and by the rest through
 /// OpenVDB's semi-Lagrangian VolumeAdvection; seen by its camera under its lights, with
 /// samples / times.size() samples per pixel (at least 1; set centreSingleSample false to jitter a
-/// lone one), seeded apart (shutterSeed). Exact for a translation, without resampling;
+/// lone one), seeded apart (shutterSeed). Props with vertex velocities (PropMesh::velocities) are
+/// built again at each time, each vertex moved linearly. Exact for a translation, without
+/// resampling;
 /// `velocity` must cover where the density arrives within the times (volmorph's vel does:
 /// MorphOptions::velocityReachSeconds).
 Image renderMotionBlurred(const openvdb::FloatGrid& density, const openvdb::Vec3SGrid* color,
