@@ -30,4 +30,10 @@ grep -q '^> target = { origin = \[' "$out/diff" || { cat "$out/diff"; exit 1; }
 # runs here gave identical screenshots; widening the type selector alone changed 0.02% of them).
 "$volmorph" diff "$shots/editor.png" "$src/tests/browser/editor.png" --fail 0.1 --failpercent 0.5 \
     --warn 0.1 --warnpercent 0.5 -o "$shots/editor.diff.png" || { echo "the page looks different: $shots/editor.diff.png"; exit 1; }
-echo "editor page: dragged pair 2's target origin and saved; one line changed; screenshot within bounds"
+# A surface-mode scene: landmarks only, snapped to the target, the in-between made again.
+sed "s|\"meshes/|\"$src/scenes/meshes/|; s|\"skies/|\"$src/scenes/skies/|" \
+    "$src/scenes/blobby-to-star-surface.toml" >"$out/surface.toml"
+start_editor "$out/surface.toml" -q
+node "$src/tests/browser/editor_surface.mjs" "$url" "$shots" || { stop_editor 10; exit 1; }
+stop_editor 10
+echo "editor page: dragged pair 2's target origin and saved; one line changed; screenshot within bounds; a surface scene's landmark snapped"

@@ -295,7 +295,8 @@ json EditDocument::state() const
             {"valid", valid()},
             {"pairs", std::move(pairs)},
             {"errors", std::move(errors)},
-            {"camera", cameraJson(mScene.render)}};
+            {"camera", cameraJson(mScene.render)},
+            {"landmarks", mScene.blend.mode == BlendMode::Surface}};
 }
 
 } // namespace volmorph::editor

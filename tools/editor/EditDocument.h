@@ -79,7 +79,8 @@ public:
     uint64_t pairsVersion() const { return mPairsVersion; }
 
     /// {"scene", "dirty", "canUndo", "canRedo", "valid", "pairs": [...], "errors": [...],
-    /// "camera": {...}}: what the page draws.
+    /// "camera": {...}, "landmarks"}: what the page draws; "landmarks" is true in surface mode
+    /// (the pairs are landmarks: points only, no suggestions).
     nlohmann::json state() const;
 
 private:

@@ -2,6 +2,7 @@
 
 #include <volmorph/PairSuggest.h>
 #include <volmorph/SceneVolumes.h>
+#include <volmorph/Schedule.h>
 #include <volmorph/core/Diagnostics.h>
 #include <volmorph/core/Interrupter.h>
 
@@ -89,15 +90,32 @@ std::string surfaceOf(const VolumeSet& volumes)
     return encodeMesh(points, triangles, quads);
 }
 
+std::string encodeTriangles(const std::vector<Vec3d>& points, const std::vector<Vec3I>& triangles)
+{
+    std::vector<openvdb::Vec3s> p(points.begin(), points.end());
+    // encodeMesh turns volumeToMesh's winding round: turned here first, the file's is kept.
+    std::vector<openvdb::Vec3I> t;
+    t.reserve(triangles.size());
+    for (const Vec3I& f : triangles) t.emplace_back(f[0], f[2], f[1]);
+    return encodeMesh(p, t, {});
+}
+
 EditorSession::EditorSession(const std::filesystem::path& scene, int resolution,
                              Interrupter* interrupter)
     : mInterrupter(interrupter), mDocument(scene)
 {
     Scene preview = mDocument.scene();
-    if (preview.blend.mode == BlendMode::Surface)
-        throw UserError(SourceLocation{scene.string()},
-                        "blend.mode = \"surface\": the editor does not edit surface morphs yet "
-                        "(morph -o out.####.ply writes their frames)");
+    if (preview.blend.mode == BlendMode::Surface) { // the meshes as they are
+        SceneMeshes meshes = importSceneMeshes(preview);
+        const auto encode = [](const Mesh& m) {
+            return encodeTriangles(std::vector<Vec3d>(m.points.begin(), m.points.end()),
+                                   m.triangles);
+        };
+        mSourceMesh = encode(meshes.source);
+        mTargetMesh = encode(meshes.target);
+        mSurfaceSides.emplace(std::move(meshes.source), std::move(meshes.target));
+        return;
+    }
     preview.volume.voxelSize.reset();
     preview.volume.resolution = resolution;
     SceneVolumes volumes = voxelizeScene(preview, interrupter);
@@ -128,6 +146,7 @@ Reply EditorSession::sideMesh(const std::map<std::string, std::string>& query)
 
 Reply EditorSession::morphMesh(double t)
 {
+    if (mSurfaceSides) return surfaceMesh(t);
     std::lock_guard<std::mutex> one(mMorphMutex);
     std::shared_ptr<const Morpher> last;
     std::vector<FeaturePairSpec> pairs;
@@ -157,10 +176,49 @@ Reply EditorSession::morphMesh(double t)
     std::lock_guard<std::mutex> lock(mMutex);
     mMorpher = morpher;
     mMorpherVersion = version;
-    mMorphMesh = surface;
+    keepMorphMesh(surface, version, t);
+    return {200, "application/octet-stream", std::move(surface)};
+}
+
+Reply EditorSession::surfaceMesh(double t)
+{
+    std::lock_guard<std::mutex> one(mMorphMutex);
+    SurfaceSpec spec;
+    BlendSpec blend;
+    uint64_t version = 0;
+    std::shared_ptr<const SurfaceMorpher> morpher;
+    {
+        std::lock_guard<std::mutex> lock(mMutex);
+        version = mDocument.pairsVersion();
+        if (mMorphVersion == version && mMorphT == t)
+            return {200, "application/octet-stream", mMorphMesh};
+        spec = mDocument.scene().surface;
+        blend = mDocument.scene().blend;
+        if (mSurfaceVersion == version) morpher = mSurfaceMorpher;
+    }
+    if (!morpher) {
+        try {
+            morpher = std::make_shared<const SurfaceMorpher>(
+                mSurfaceSides->first, mSurfaceSides->second, spec, mInterrupter);
+        } catch (const UserError& e) { // a landmark off its surface, or one that folds the map
+            throw Conflict(e.what());
+        }
+    }
+    const SurfaceFrame frame =
+        morpher->frame(scheduleValue(blend.sdf, t), scheduleValue(blend.color, t));
+    std::string mesh = encodeTriangles(frame.points, frame.triangles);
+    std::lock_guard<std::mutex> lock(mMutex);
+    mSurfaceMorpher = morpher;
+    mSurfaceVersion = version;
+    keepMorphMesh(mesh, version, t);
+    return {200, "application/octet-stream", std::move(mesh)};
+}
+
+void EditorSession::keepMorphMesh(const std::string& mesh, uint64_t version, double t)
+{
+    mMorphMesh = mesh;
     mMorphVersion = version;
     mMorphT = t;
-    return {200, "application/octet-stream", std::move(surface)};
 }
 
 Reply EditorSession::route(const std::string& method, const std::string& route,
@@ -177,6 +235,9 @@ Reply EditorSession::route(const std::string& method, const std::string& route,
     if (name == "save") {
         mDocument.save();
     } else if (name == "suggest") {
+        if (mSurfaceSides)
+            throw BadRequest("suggest: blend.mode = \"surface\" takes landmarks (point pairs), "
+                             "placed by hand; pairs suggest proposes warp features");
         mDocument.appendPairs(suggestPairs(mSource, mTarget).pairs, kSuggestedPairComment);
     } else if (name == "set" || name == "add" || name == "duplicate" || name == "delete" ||
                name == "undo" || name == "redo") {

@@ -1,8 +1,11 @@
 // What `volmorph edit` serves, without the HTTP: the scene being edited (EditDocument), its two
 // sides voxelized once at a preview resolution, and a Morpher kept across edits (its blend setup
 // shared through Morpher::withPairs), so that after a drag only the in-between at t and its
-// surface are made anew. handle() answers the page's JSON API; the server (EditorServer.h) adds
-// the token, the size bounds and the page's files.
+// surface are made anew. A surface-mode scene (blend.mode = "surface") shows its two meshes as
+// they are and its in-between mesh (SurfaceMorph.h); its pairs are landmarks, and an edit of them
+// puts the meshes into correspondence anew at the next in-between (a landmark the correspondence
+// refuses: 409 with its message). handle() answers the page's JSON API; the server (EditorServer.h)
+// adds the token, the size bounds and the page's files.
 //
 // The document is held under one lock for as long as a request reads or edits it, never while an
 // in-between is morphed: a morph takes a copy of the pairs and settings under the lock, runs
@@ -18,13 +21,15 @@
 //   GET  /api/mesh?of=source|target       a side's surface (encodeMesh)
 //   GET  /api/mesh?of=morph&t=T           the in-between's surface at t in [0, 1]
 //   POST /api/set|add|duplicate|delete|undo|redo   an edit (EditDocument::apply); the new state
-//   POST /api/suggest                     `pairs suggest`'s pairs appended; the new state
+//   POST /api/suggest                     `pairs suggest`'s pairs appended; the new state (400
+//                                         in surface mode: landmarks are placed by hand)
 //   POST /api/save                        the scene written in place; the new state
 #pragma once
 
 #include "EditDocument.h"
 
 #include <volmorph/Morph.h>
+#include <volmorph/SurfaceMorph.h>
 
 #include <openvdb/openvdb.h>
 
@@ -58,6 +63,9 @@ std::string encodeMesh(const std::vector<openvdb::Vec3s>& points,
 /// where it has no sdf (a fog volume), by OpenVDB's volumeToMesh; encoded.
 std::string surfaceOf(const VolumeSet& volumes);
 
+/// A mesh (world units, triangles wound as the file has them) encoded as above.
+std::string encodeTriangles(const std::vector<Vec3d>& points, const std::vector<Vec3I>& triangles);
+
 class EditorSession {
 public:
     /// Reads the scene (UserError when it is not valid) and voxelizes both sides at `resolution`
@@ -78,6 +86,10 @@ private:
     Reply sideMesh(const std::map<std::string, std::string>& query);
     /// The in-between's mesh at t, morphed outside mMutex (see the top of this file).
     Reply morphMesh(double t);
+    /// The same in surface mode: the in-between mesh of the pairs' correspondence.
+    Reply surfaceMesh(double t);
+    /// Stores the in-between's mesh of pairs version `version` at t (under mMutex).
+    void keepMorphMesh(const std::string& mesh, uint64_t version, double t);
 
     std::mutex mMutex;      ///< the document and the caches below
     std::mutex mMorphMutex; ///< one morph at a time
@@ -85,11 +97,15 @@ private:
     EditDocument mDocument;
     // Set once by the constructor, read without a lock afterwards.
     VolumeSet mSource, mTarget;
-    std::vector<TimedVolume> mInfluences; ///< variational mode's
+    std::vector<TimedVolume> mInfluences;               ///< variational mode's
+    std::optional<std::pair<Mesh, Mesh>> mSurfaceSides; ///< surface mode's meshes, placed
     std::string mSourceMesh, mTargetMesh;
     /// The last Morpher, for the pairs of version mMorpherVersion (its blend setup is reused).
     std::shared_ptr<const Morpher> mMorpher;
     uint64_t mMorpherVersion = 0;
+    /// Surface mode: the correspondence of the pairs of version mSurfaceVersion.
+    std::shared_ptr<const SurfaceMorpher> mSurfaceMorpher;
+    uint64_t mSurfaceVersion = ~uint64_t(0);
     /// The last in-between's mesh, by the pairs' version and t.
     std::string mMorphMesh;
     uint64_t mMorphVersion = ~uint64_t(0);

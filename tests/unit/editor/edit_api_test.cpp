@@ -5,6 +5,7 @@
 #include "editor/EditorSession.h"
 
 #include <volmorph/SceneVolumes.h>
+#include <volmorph/SurfaceMorph.h>
 
 #include <gtest/gtest.h>
 
@@ -274,4 +275,49 @@ TEST(EditApi, SessionAnswersAndTheInBetweenFollowsTheEdits)
     const json suggested = post(session, "suggest", "{}");
     EXPECT_GE(suggested["pairs"].size(), 2u);
     EXPECT_EQ(post(session, "undo", "{}")["pairs"].size(), 1u);
+}
+
+TEST(EditApi, SurfaceModeShowsTheMeshesAndItsLandmarksMoveTheInBetween)
+{
+    const auto scene = copyScene("blobby-to-star-surface.toml");
+    EditorSession session(scene, 32, nullptr);
+    const json state = json::parse(session.handle("GET", "/api/state", {}, "").body);
+    EXPECT_TRUE(state["landmarks"].get<bool>());
+    ASSERT_EQ(state["pairs"].size(), 3u);
+    // The sides are the mesh files as placed, not voxelized: their bounds exactly.
+    const SceneMeshes meshes = importSceneMeshes(loadScene(scene));
+    const MeshHeader source =
+        header(session.handle("GET", "/api/mesh", {{"of", "source"}}, "").body);
+    EXPECT_EQ(source.vertices, meshes.source.points.size());
+    EXPECT_EQ(source.triangles, meshes.source.triangles.size());
+    const auto [lo, hi] = meshes.source.bounds();
+    for (int i = 0; i < 3; ++i) EXPECT_FLOAT_EQ(source.lo[i], float(lo[i]));
+    for (int i = 0; i < 3; ++i) EXPECT_FLOAT_EQ(source.hi[i], float(hi[i]));
+
+    // Each in-between is the surface stage's, byte for byte, before and after a landmark's move.
+    const auto fresh = [&](double t) {
+        const Scene s = parseScene(session.document().text(), scene);
+        const SurfaceMorpher morpher(meshes.source, meshes.target, s.surface);
+        const SurfaceFrame f = morpher.frame(t, t); // linear schedules: tau = t
+        return encodeTriangles(f.points, f.triangles);
+    };
+    const std::string before =
+        session.handle("GET", "/api/mesh", {{"of", "morph"}, {"t", "0.5"}}, "").body;
+    EXPECT_EQ(before, fresh(0.5));
+    post(session, "set", R"({"key": "pair[3].target.origin", "value": [0, 0.5, 0.5]})");
+    const std::string after =
+        session.handle("GET", "/api/mesh", {{"of", "morph"}, {"t", "0.5"}}, "").body;
+    EXPECT_NE(after, before);
+    EXPECT_EQ(after, fresh(0.5));
+
+    // A landmark far off its surface: the correspondence refuses it, 409 naming the pair's line.
+    post(session, "set", R"({"key": "pair[3].target.origin", "value": [5, 5, 5]})");
+    const Reply off = session.handle("GET", "/api/mesh", {{"of", "morph"}, {"t", "0.25"}}, "");
+    EXPECT_EQ(off.status, 409);
+    EXPECT_NE(off.body.find("blobby-to-star-surface.toml:"), std::string::npos) << off.body;
+    // No suggestions, and a segment is an error placed at its pair.
+    EXPECT_EQ(session.handle("POST", "/api/suggest", {}, "{}").status, 400);
+    const json segment = post(session, "set", R"({"key": "pair[1].type", "value": "segment"})");
+    EXPECT_FALSE(segment["valid"].get<bool>());
+    EXPECT_EQ(segment["errors"][0]["pair"], 1);
 }

@@ -63,6 +63,16 @@ function redraw() {
   $('undo').disabled = !state.canUndo;
   $('redo').disabled = !state.canRedo;
   $('duplicate').disabled = $('delete').disabled = !state.pairs[selected - 1];
+  landmarkMode(state.landmarks);
+}
+
+/** Surface mode: the pairs are landmarks, points placed by hand (no other type, no suggestions). */
+function landmarkMode(on) {
+  $('suggest').disabled = on;
+  $('suggest').title = on ? 'surface mode: landmarks are placed by hand'
+    : 'append the pairs volmorph pairs suggest proposes';
+  if (on) $('new-type').value = 'point';
+  $('new-type').disabled = on;
 }
 
 /** The labels follow the view: placed after its next redraw. */

@@ -24,7 +24,9 @@ export function showFields(state, selected, onSet) {
   const pair = state.pairs[selected - 1];
   if (!pair) { fields.textContent = 'none: click a pair, or an element in the view'; return; }
   const type = document.createElement('select');
-  for (const t of ['point', 'segment', 'rectangle', 'box']) type.add(new Option(t, t, false, t === pair.type));
+  const types = state.landmarks ? ['point'] : ['point', 'segment', 'rectangle', 'box'];
+  if (!types.includes(pair.type)) types.push(pair.type); // an invalid one stays shown, with its error
+  for (const t of types) type.add(new Option(t, t, false, t === pair.type));
   type.addEventListener('change', () => onSet(`pair[${selected}].type`, type.value));
   fields.append(row('type', [type]));
   for (const side of ['source', 'target']) {
