@@ -298,6 +298,28 @@ void printView(const RenderSpec& r)
     }
 }
 
+/// [timing]: the spread, the sweep and each region (its file checked here, at its key).
+void printTiming(const Scene& scene)
+{
+    const TimingSettings& t = scene.timing;
+    if (t.spread == 0.0 && scene.timingRegions.empty()) return;
+    checkTimingRegions(scene);
+    std::printf("timing  spread %s: the last place starts %s of the morph after the first; each "
+                "place morphs over %s of it\n",
+                fmt(t.spread).c_str(), fmt(t.spread).c_str(), fmt(1.0 - t.spread).c_str());
+    if (t.sweep)
+        std::printf("        sweep from %s along %s: delay 0 behind that plane, %s from %s world "
+                    "units on\n",
+                    fmt(t.sweep->origin).c_str(), fmt(t.sweep->direction).c_str(),
+                    fmt(t.spread).c_str(), fmt(t.sweep->length).c_str());
+    for (size_t i = 0; i < scene.timingRegions.size(); ++i) {
+        const TimingRegionSpec& r = scene.timingRegions[i];
+        std::printf("        region %zu %s: delay %s inside, fading over %s world units outside\n",
+                    i + 1, r.shape.file().string().c_str(), fmt(r.start).c_str(),
+                    fmt(r.softness).c_str());
+    }
+}
+
 /// The frame range, the output pattern and every frame's t.
 void printFrames(const Scene& scene)
 {
@@ -346,6 +368,7 @@ int runCheck(const std::string& scenePath)
     printVolume(scene, meshes, source, target);
     printPairs(scene);
     printSettings(scene);
+    printTiming(scene);
     if (scene.blend.mode == BlendMode::Surface) printSurface(scene, meshes);
     printView(scene.render);
     printProps(scene);

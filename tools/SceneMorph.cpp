@@ -41,6 +41,9 @@ void SceneMorph::load(int frame)
     MorphOptions options = mOptions;
     options.setupInterrupter = &mInterrupter;
     options.influences = std::move(volumes.influences);
+    if (scene.timing.spread > 0.0)
+        options.localTime =
+            std::make_shared<const LocalTime>(scene.timing, std::move(volumes.timingRegions));
     mInterrupter.start("morph setup");
     mMorpher.emplace(std::move(volumes.source), std::move(volumes.target), scene.pairs, scene.warp,
                      scene.blend, options);

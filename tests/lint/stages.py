@@ -23,6 +23,7 @@ HEADERS = {
     "Scene.h": "scene", "Frames.h": "scene", "SceneDocument.h": "scene",
     "SceneVolumes.h": "sides", "VoxelCache.h": "sides", "SceneSurface.h": "sides",
     "SurfaceSettings.h": "surface", "SurfaceMorph.h": "surface",
+    "TimingSettings.h": "timing", "LocalTime.h": "timing",
 }
 
 # What each stage may read, itself included. The scene builds every stage's options, so it reads
@@ -34,14 +35,15 @@ ALLOWED = {
     "voxelize": {"core", "volumeset", "mesh", "voxelize"},
     "volume": {"core", "volumeset", "voxelize", "volume"},
     "feature": {"core", "volumeset", "feature"},
-    "warp": {"core", "volumeset", "feature", "warp"},
-    "blend": {"core", "volumeset", "voxelize", "feature", "warp", "blend"},
-    "morph": {"core", "volumeset", "voxelize", "feature", "warp", "blend", "morph"},
-    "surface": {"core", "mesh", "surface"},
+    "timing": {"core", "timing"},
+    "warp": {"core", "volumeset", "feature", "timing", "warp"},
+    "blend": {"core", "volumeset", "voxelize", "feature", "timing", "warp", "blend"},
+    "morph": {"core", "volumeset", "voxelize", "feature", "timing", "warp", "blend", "morph"},
+    "surface": {"core", "mesh", "timing", "surface"},
     "export": {"core", "volumeset", "mesh", "surface", "export"},
-    "scene": {"core", "feature", "warp", "blend", "volume", "surface", "scene"},
-    "sides": {"core", "volumeset", "mesh", "voxelize", "volume", "export", "feature", "blend",
-              "surface", "scene", "sides"},
+    "scene": {"core", "feature", "timing", "warp", "blend", "volume", "surface", "scene"},
+    "sides": {"core", "volumeset", "mesh", "voxelize", "volume", "export", "feature", "timing",
+              "blend", "surface", "scene", "sides"},
 }
 
 INCLUDE = re.compile(r'^\s*#\s*include\s*[<"]([^>"]+)[>"]', re.M)

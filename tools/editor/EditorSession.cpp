@@ -122,6 +122,9 @@ EditorSession::EditorSession(const std::filesystem::path& scene, int resolution,
     mSource = std::move(volumes.source);
     mTarget = std::move(volumes.target);
     mInfluences = std::move(volumes.influences);
+    if (preview.timing.spread > 0.0)
+        mLocalTime =
+            std::make_shared<const LocalTime>(preview.timing, std::move(volumes.timingRegions));
     mSourceMesh = surfaceOf(mSource);
     mTargetMesh = surfaceOf(mTarget);
 }
@@ -167,6 +170,7 @@ Reply EditorSession::morphMesh(double t)
     if (!last) {
         MorphOptions options;
         options.influences = mInfluences;
+        options.localTime = mLocalTime;
         options.setupInterrupter = mInterrupter;
         morpher = std::make_shared<const Morpher>(mSource, mTarget, pairs, warp, blend, options);
     } else if (lastVersion != version) {

@@ -98,6 +98,7 @@ private:
     // Set once by the constructor, read without a lock afterwards.
     VolumeSet mSource, mTarget;
     std::vector<TimedVolume> mInfluences;               ///< variational mode's
+    std::shared_ptr<const LocalTime> mLocalTime;        ///< the scene's timing (null: none)
     std::optional<std::pair<Mesh, Mesh>> mSurfaceSides; ///< surface mode's meshes, placed
     std::string mSourceMesh, mTargetMesh;
     /// The last Morpher, for the pairs of version mMorpherVersion (its blend setup is reused).

@@ -11,6 +11,7 @@
 
 #include <volmorph/core/Interrupter.h>
 #include <volmorph/BlendSettings.h>
+#include <volmorph/LocalTime.h>
 #include <volmorph/FeaturePair.h>
 #include <volmorph/WarpSettings.h>
 #include <volmorph/VolumeSet.h>
@@ -46,6 +47,9 @@ struct MorphOptions {
     Interrupter* setupInterrupter = nullptr;
     /// Variational mode's influence shapes (SceneVolumes::influences), on the sides' transform.
     std::vector<TimedVolume> influences;
+    /// Where the morph happens when ([timing]); null or inactive: everywhere at once. Density and
+    /// sdf modes without pairs honour it (the scene refuses the rest).
+    std::shared_ptr<const LocalTime> localTime;
 };
 
 /// What one kept output leaf costs while an sdf-mode frame is made: density, colour, the distance

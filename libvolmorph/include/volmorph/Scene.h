@@ -7,6 +7,7 @@
 
 #include <volmorph/BlendSettings.h>
 #include <volmorph/SurfaceSettings.h>
+#include <volmorph/TimingSettings.h>
 #include <volmorph/FeaturePair.h>
 #include <volmorph/VolumeSource.h>
 #include <volmorph/WarpSettings.h>
@@ -59,6 +60,16 @@ struct ObjectSpec {
 struct InfluenceSpec {
     ObjectSpec object; ///< a mesh or a single volume file (no sequence), placed as a side is
     double t = 0.5;    ///< in (0, 1)
+};
+
+/// A [[timing.region]]: a closed mesh or a fog mask (density 0.5 its surface) inside which the
+/// morph starts at `start` (in t), fading into the rest's delay over `softness` world units
+/// outside.
+struct TimingRegionSpec {
+    ObjectSpec shape; ///< a mesh or a single volume file, placed as a side is
+    double start = 0.0;
+    double softness = 0.0;
+    SourceLocation where; ///< the region's table
 };
 
 /// A [[prop]]: a mesh in the shot beside the morph, seen and lit by the renderer only.
@@ -176,6 +187,8 @@ struct Scene {
     BlendSpec blend;
     std::vector<InfluenceSpec> influences; ///< [variational] influence (variational mode only)
     SurfaceSpec surface;                   ///< [surface] (surface mode only)
+    TimingSettings timing;                 ///< [timing]: where the morph happens when
+    std::vector<TimingRegionSpec> timingRegions; ///< [[timing.region]]
     RenderSpec render;
     std::vector<PropSpec> props;
     FramesSpec frames;

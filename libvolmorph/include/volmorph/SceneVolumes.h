@@ -6,6 +6,7 @@
 
 #include <volmorph/core/Interrupter.h>
 #include <volmorph/Mesh.h>
+#include <volmorph/LocalTime.h>
 #include <volmorph/Scene.h>
 #include <volmorph/VolumeSet.h>
 
@@ -45,6 +46,8 @@ struct SceneVolumes {
     VolumeSet source, target;
     /// Variational mode's influence shapes on the same transform, each with its time.
     std::vector<TimedVolume> influences;
+    /// [[timing.region]]s: each one's signed distance, valid to its softness and more outside.
+    std::vector<TimingRegion> timingRegions;
 };
 
 /// Imports and voxelizes (or reads) both sides of `scene` (the same code as `volmorph voxelize`);
@@ -56,6 +59,17 @@ SceneVolumes voxelizeScene(const Scene& scene, Interrupter* interrupter = nullpt
 /// Variational mode's influence shapes (none in another mode), voxelized or read at `voxelSize`,
 /// each with a level set.
 std::vector<TimedVolume> voxelizeInfluences(const Scene& scene, double voxelSize,
+                                            Interrupter* interrupter = nullptr,
+                                            uint64_t memoryLimitBytes = 0);
+
+/// The scene's [[timing.region]]s at `voxelSize`: a mesh (which must be closed: UserError at its
+/// `mesh` key otherwise) voxelized, a fog mask read and its 0.5 level made a level set, each with
+/// a band that reaches its softness (and two voxels more) outside.
+/// Checks each region's file without voxelizing it: a mesh imported (and closed), a volume's
+/// header read. UserError at its key otherwise.
+void checkTimingRegions(const Scene& scene);
+
+std::vector<TimingRegion> loadTimingRegions(const Scene& scene, double voxelSize,
                                             Interrupter* interrupter = nullptr,
                                             uint64_t memoryLimitBytes = 0);
 

@@ -11,6 +11,7 @@
 
 #include <volmorph/core/Interrupter.h>
 #include <volmorph/BlendSettings.h>
+#include <volmorph/LocalTime.h>
 #include <volmorph/VolumeSet.h>
 
 #include <openvdb/Types.h>
@@ -54,6 +55,8 @@ struct BlendRequest {
     double velocityScale = 0.0;
     /// The velocity also covers the voxels its motion reaches within this many seconds.
     double velocityReachSeconds = 0.0;
+    /// Where the morph happens when (null: everywhere at t).
+    const LocalTime* localTime = nullptr;
 };
 
 /// A method's frame: the grids (density and Cd; sdf in sdf mode), without names or transforms

@@ -23,6 +23,8 @@ public:
           mTau(tauColor), mBackground(bg)
     {
     }
+    /// The colour schedule's tau for what follows (a timing gives each voxel its own).
+    void setTau(float tauColor) { mTau = tauColor; }
     /// ps, pt: the warped points (index space); a, b: the densities there.
     Vec3f operator()(const openvdb::Vec3R& ps, const openvdb::Vec3R& pt, float a, float b)
     {

@@ -1,5 +1,6 @@
 #include "blend/DensityBlend.h"
 
+#include "blend/BlendTime.h"
 #include "blend/ColorBlend.h"
 #include "blend/ExtraGrids.h"
 #include "blend/Sample.h"
@@ -23,7 +24,8 @@ template <typename Sampler>
 struct Resampler {
     const VolumeSet& source;
     const VolumeSet& target;
-    float tauDensity, tauColor;
+    const BlendTime& densityTime; ///< tau at each voxel (uniform without a timing)
+    const BlendTime& colorTime;
     Vec3f background;
 
     struct Uniform {
@@ -34,6 +36,8 @@ struct Resampler {
     /// both sides (the colour's only where that side weighs); nothing when some point may not.
     std::optional<Uniform> uniform(const WarpLeaf& w) const
     {
+        if (!densityTime.uniform()) return std::nullopt; // each voxel has its own tau
+        const float tauDensity = densityTime.atAll().tau, tauColor = colorTime.atAll().tau;
         const openvdb::CoordBBox boxS = warpedBox(w.s), boxT = warpedBox(w.t);
         auto ds = source.density->getConstAccessor();
         auto dt = target.density->getConstAccessor();
@@ -60,12 +64,20 @@ struct Resampler {
     {
         auto ds = source.density->getConstAccessor();
         auto dt = target.density->getConstAccessor();
-        ColorBlend<Sampler> blend(source, target, tauColor, background);
+        ColorBlend<Sampler> blend(source, target, colorTime.atAll().tau, background);
+        const bool timed = !densityTime.uniform();
+        float tauDensity = densityTime.atAll().tau;
         bool any = false;
         for (openvdb::Index n = 0; n < 512; ++n) {
             const openvdb::Vec3R ps(w.source(n)), pt(w.target(n));
             a[n] = sample<Sampler>(ds, ps);
             b[n] = sample<Sampler>(dt, pt);
+            if (timed) {
+                const Delay delay = densityTime.delayAt(
+                    (w.origin + OutputLeaves::ValueLeaf::offsetToLocalCoord(n)).asVec3d());
+                tauDensity = densityTime.fromDelay(delay).tau;
+                blend.setTau(colorTime.fromDelay(delay).tau);
+            }
             const float d = (1.0f - tauDensity) * a[n] + tauDensity * b[n];
             if (!(d > kEmpty)) continue;
             value.setValueOn(n, d);
@@ -83,10 +95,13 @@ public:
 
     BlendedFrame frame(const BlendRequest& r, OutputLeaves& leaves) const override
     {
-        const float tauD = float(scheduleValue(mSpec.density, r.t));
-        const float tauC = float(scheduleValue(mSpec.color, r.t));
-        const Resampler<Sampler> resample{mSource, mTarget, tauD, tauC, leaves.background()};
-        const ExtraGrids extras(mSource, mTarget, mSpec, r.t);
+        const openvdb::math::Transform& xform = mSource.density->transform();
+        const BlendTime densityTime(mSpec.density, r.t, r.localTime, xform);
+        const BlendTime colorTime(mSpec.color, r.t, r.localTime, xform);
+        const float tauD = densityTime.atAll().tau;
+        const Resampler<Sampler> resample{mSource, mTarget, densityTime, colorTime,
+                                          leaves.background()};
+        const ExtraGrids extras(mSource, mTarget, mSpec, r.t, r.localTime);
         const VelocityBlend velocity(*r.warp, r.velocityScale, tauD);
         BlendedFrame out;
         r.adaptive->forEachLeaf(

@@ -38,8 +38,8 @@ ExtraGrids::pair(const VolumeSet& source, const VolumeSet& target, const BlendSp
         e.sourceBackground = (e.source ? e.source : e.target)->background();
         e.targetBackground = (e.target ? e.target : e.source)->background();
         const auto it = spec.grids.find(name);
-        e.tau =
-            float(scheduleValue(it == spec.grids.end() ? spec.density : it->second.schedule, t));
+        e.schedule = it == spec.grids.end() ? &spec.density : &it->second.schedule;
+        e.tau = float(scheduleValue(*e.schedule, t));
         e.like = e.source ? openvdb::GridBase::ConstPtr(e.source) : e.target;
         out.push_back(std::move(e));
     }
@@ -47,9 +47,10 @@ ExtraGrids::pair(const VolumeSet& source, const VolumeSet& target, const BlendSp
 }
 
 ExtraGrids::ExtraGrids(const VolumeSet& source, const VolumeSet& target, const BlendSpec& spec,
-                       double t)
+                       double t, const LocalTime* local)
     : mFloats(pair<openvdb::FloatGrid>(source, target, spec, t)),
-      mVectors(pair<openvdb::Vec3SGrid>(source, target, spec, t))
+      mVectors(pair<openvdb::Vec3SGrid>(source, target, spec, t)), mT(t),
+      mLocal(local && local->active() ? local : nullptr), mXform(source.density->transform().copy())
 {
 }
 

@@ -12,6 +12,8 @@
 #include "warp/AdaptiveWarp.h"
 
 #include <volmorph/BlendSettings.h>
+#include <volmorph/LocalTime.h>
+#include <volmorph/Schedule.h>
 #include <volmorph/VolumeSet.h>
 
 #include <openvdb/openvdb.h>
@@ -34,8 +36,10 @@ struct WarpedPoints {
 
 class ExtraGrids {
 public:
-    /// The extras of both sides at morph time t, paired by name.
-    ExtraGrids(const VolumeSet& source, const VolumeSet& target, const BlendSpec& spec, double t);
+    /// The extras of both sides at morph time t, paired by name; under `local` (may be null)
+    /// each voxel takes its grid's schedule at its own local time.
+    ExtraGrids(const VolumeSet& source, const VolumeSet& target, const BlendSpec& spec, double t,
+               const LocalTime* local = nullptr);
 
     /// Throws UserError when a grid has one type on one side and another on the other, or when
     /// blend.grids names a grid neither side carries.
@@ -73,13 +77,14 @@ private:
         std::string name;
         typename GridT::ConstPtr source, target; ///< null where a side lacks it
         typename GridT::ValueType sourceBackground, targetBackground;
-        float tau = 0.0f;
-        openvdb::GridBase::ConstPtr like; ///< whose metadata the output copies
+        float tau = 0.0f;                       ///< at t, everywhere without a timing
+        const ScheduleSpec* schedule = nullptr; ///< its schedule (blend.grids', or the density's)
+        openvdb::GridBase::ConstPtr like;       ///< whose metadata the output copies
     };
 
     template <typename Sampler, typename GridT, typename Points>
-    static void fillOne(const Extra<GridT>& e, const openvdb::util::NodeMask<3>& on,
-                        const Points& points, typename GridT::TreeType::LeafNodeType& leaf)
+    void fillOne(const Extra<GridT>& e, const openvdb::util::NodeMask<3>& on, const Points& points,
+                 typename GridT::TreeType::LeafNodeType& leaf) const
     {
         using Value = typename GridT::ValueType;
         auto a = e.source ? e.source->getConstAccessor() : e.target->getConstAccessor();
@@ -88,8 +93,16 @@ private:
             const auto [ps, pt] = points(openvdb::Index(it.pos()));
             const Value va = e.source ? Value(sample<Sampler>(a, ps)) : e.sourceBackground;
             const Value vb = e.target ? Value(sample<Sampler>(b, pt)) : e.targetBackground;
-            leaf.setValueOn(it.pos(), Value((1.0f - e.tau) * va + e.tau * vb));
+            const float tau =
+                mLocal ? localTau(*e.schedule, leaf.offsetToGlobalCoord(it.pos())) : e.tau;
+            leaf.setValueOn(it.pos(), Value((1.0f - tau) * va + tau * vb));
         }
+    }
+
+    /// A schedule at the local time of output voxel ijk.
+    float localTau(const ScheduleSpec& schedule, const openvdb::Coord& ijk) const
+    {
+        return float(scheduleValue(schedule, mLocal->at(mXform->indexToWorld(ijk), mT).tau));
     }
 
     template <typename GridT>
@@ -98,6 +111,9 @@ private:
 
     std::vector<Extra<openvdb::FloatGrid>> mFloats;
     std::vector<Extra<openvdb::Vec3SGrid>> mVectors;
+    double mT;
+    const LocalTime* mLocal;              ///< null: every voxel at t
+    openvdb::math::Transform::Ptr mXform; ///< the output's
 };
 
 } // namespace volmorph::detail

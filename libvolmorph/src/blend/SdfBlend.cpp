@@ -45,16 +45,17 @@ public:
 
     BlendedFrame frame(const BlendRequest& r, OutputLeaves& leaves) const override
     {
-        const float tauC = float(scheduleValue(mSpec.color, r.t));
-        const float tauS = float(scheduleValue(mSpec.sdf, r.t));
-        SdfFrame<Sampler> blend(mSource, mTarget, *mFarSource, *mFarTarget, *r.warp, tauS, tauC,
-                                leaves.background(), r.toleranceVoxels);
+        const openvdb::math::Transform& xform = mSource.density->transform();
+        const BlendTime sdfTime(mSpec.sdf, r.t, r.localTime, xform);
+        const BlendTime colorTime(mSpec.color, r.t, r.localTime, xform);
+        SdfFrame<Sampler> blend(mSource, mTarget, *mFarSource, *mFarTarget, *r.warp, sdfTime,
+                                colorTime, leaves.background(), r.toleranceVoxels);
         // With no pairs (and pruning), distances are read from those kept across frames.
         IdentityDistances* const kept =
             r.prune && r.warp->pairCount() == 0 ? mIdentity.get() : nullptr;
         blend.classify(r.box, r.prune, kept);
         BlendedFrame out;
-        const ExtraGrids extras(mSource, mTarget, mSpec, r.t);
+        const ExtraGrids extras(mSource, mTarget, mSpec, r.t, r.localTime);
         const std::vector<Coord> evaluate = sortLeaves(blend.classes(), kept != nullptr, leaves);
         const bool velocity = r.velocityScale > 0.0;
         if (kept) {
@@ -66,9 +67,9 @@ public:
         DistanceTrees distances;
         assemble(blend, extras, leaves, velocity ? &distances : nullptr, out);
         if (velocity) {
-            const SdfVelocity v(
-                *r.warp, r.velocityScale, tauS, float(scheduleSlope(mSpec.sdf, r.t)),
-                kSdfRampVoxels * float(mSource.voxelSize()), float(mSource.voxelSize()));
+            const SdfVelocity v(*r.warp, r.velocityScale, sdfTime,
+                                kSdfRampVoxels * float(mSource.voxelSize()),
+                                float(mSource.voxelSize()));
             out.grids.velocity = v.make(distances.source, distances.target, r.velocityReachSeconds,
                                         mSource.voxelSize());
             out.velocityInterpolated = v.interpolatedCubes();

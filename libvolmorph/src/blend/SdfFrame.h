@@ -3,6 +3,7 @@
 // SdfBlend.cpp then removes dust (Islands.h) and rebuilds the band (Redistance.h).
 #pragma once
 
+#include "blend/BlendTime.h"
 #include "blend/BlockClasses.h"
 #include "blend/ColorBlend.h"
 #include "blend/ExtendedDistance.h"
@@ -34,11 +35,14 @@ public:
     using ValueLeaf = openvdb::FloatTree::LeafNodeType;
     using ColorLeaf = openvdb::Vec3STree::LeafNodeType;
 
+    /// sdfTime, colorTime: the distance's and the colour's schedules at each voxel (uniform
+    /// without a timing).
     SdfFrame(const VolumeSet& source, const VolumeSet& target, const ExtendedDistance& farSource,
-             const ExtendedDistance& farTarget, const InverseWarp& warp, float tauSdf,
-             float tauColor, Vec3f background, double toleranceVoxels)
+             const ExtendedDistance& farTarget, const InverseWarp& warp, const BlendTime& sdfTime,
+             const BlendTime& colorTime, Vec3f background, double toleranceVoxels)
         : mSource(source), mTarget(target), mFarSource(farSource), mFarTarget(farTarget),
-          mWarp(warp), mTau(tauSdf), mTauColor(tauColor), mBackground(background),
+          mWarp(warp), mSdfTime(sdfTime), mColorTime(colorTime), mTau(sdfTime.atAll().tau),
+          mTauColor(colorTime.atAll().tau), mBackground(background),
           mVoxel(float(source.voxelSize())),
           mWidth(std::min(source.sdf->background(), target.sdf->background()) / mVoxel),
           // The extended fields' slack, and the approximated warp's error: leaves are judged with
@@ -63,12 +67,14 @@ public:
         const std::vector<uint8_t> wanted =
             coarse.empty() ? std::vector<uint8_t>{} : coarse.wanted(n);
         std::vector<Vec3d> ps, pt; // the warped centres (with pairs)
-        const std::vector<float> blend =
-            identity ? keptCentreBlends(box, *identity) : centreBlends(ps, pt, wanted);
+        std::vector<float> apart;  // |d_T - d_S| at the centres, world units
+        const std::vector<float> blend = identity ? keptCentreBlends(box, *identity, apart)
+                                                  : centreBlends(ps, pt, wanted, apart);
         mSamples += wanted.empty() ? count : size_t(std::count(wanted.begin(), wanted.end(), 1));
         // The warp's stretch per leaf; the identity's is 1 exactly.
         std::vector<float> stretch =
             warped ? leafStretch(ps, pt, n, mTau, 8.0, wanted) : std::vector<float>(count, 1.0f);
+        addTimingStretch(stretch, apart);
         c.maxStretch = 1.0;
         for (size_t i = 0; i < count; ++i)
             if (wanted.empty() || wanted[i])
@@ -151,10 +157,10 @@ public:
     /// Blends voxel n from its two distances: active within the compute band, +/- the band
     /// (inactive) beyond it; its colour, colorAt(), within the band that is kept.
     template <typename ColorAt>
-    void blendVoxel(openvdb::Index n, float da, float db, const Bands& bands, ValueLeaf& value,
-                    ColorLeaf& color, Seen& seen, const ColorAt& colorAt) const
+    void blendVoxel(openvdb::Index n, float da, float db, float tau, const Bands& bands,
+                    ValueLeaf& value, ColorLeaf& color, Seen& seen, const ColorAt& colorAt) const
     {
-        const float d = (1.0f - mTau) * da + mTau * db;
+        const float d = (1.0f - tau) * da + tau * db;
         seen.inside = seen.inside || d < 0.0f;
         seen.outside = seen.outside || !(d < 0.0f);
         if (!(std::abs(d) < bands.compute)) {
@@ -193,15 +199,27 @@ public:
         for (openvdb::Index n = 0; n < 512; ++n) {
             const float da = distances.source[n], db = distances.target[n];
             record.record(n, da, db);
-            blendVoxel(n, da, db, bands, value, color, seen, [&] {
-                return colors.atVoxel(origin + value.offsetToLocalCoord(n), fogRamp(da, ramp),
-                                      fogRamp(db, ramp));
-            });
+            const openvdb::Coord ijk = origin + value.offsetToLocalCoord(n);
+            const Taus tau = tausAt(ijk.asVec3d());
+            colors.setTau(tau.color);
+            blendVoxel(n, da, db, tau.sdf, bands, value, color, seen,
+                       [&] { return colors.atVoxel(ijk, fogRamp(da, ramp), fogRamp(db, ramp)); });
         }
         return seen.whole();
     }
 
     void addSamples(uint64_t n) const { mSamples += n; }
+
+    /// The distance's and the colour's tau at output index point ijk.
+    struct Taus {
+        float sdf, color;
+    };
+    Taus tausAt(const Vec3d& ijk) const
+    {
+        if (mSdfTime.uniform()) return {mTau, mTauColor};
+        const Delay delay = mSdfTime.delayAt(ijk);
+        return {mSdfTime.fromDelay(delay).tau, mColorTime.fromDelay(delay).tau};
+    }
 
     /// The kept band (world units) of the leaf at `origin`, or the widest one outside the box.
     float keepBandAt(const openvdb::Coord& origin) const
@@ -235,7 +253,8 @@ private:
         {
             if (mF.mPrune) {
                 const openvdb::Index c = ((qx + 2) * 8 + qy + 2) * 8 + qz + 2;
-                const float d = blendAt(mW.source(c), mW.target(c));
+                const float d = blendAt(mW.source(c), mW.target(c),
+                                        mF.tausAt(at(qx + 2.0, qy + 2.0, qz + 2.0)).sdf);
                 if (!(std::abs(d) < mQuarterLimit)) return constant(qx, qy, qz, 4, d);
             }
             for (int bq = 0; bq < 8; ++bq)
@@ -256,7 +275,8 @@ private:
                     ms += mW.source(n);
                     mt += mW.target(n);
                 }
-                const float d = blendAt(ms * 0.125f, mt * 0.125f);
+                const float d = blendAt(ms * 0.125f, mt * 0.125f,
+                                        mF.tausAt(at(bx + 0.5, by + 0.5, bz + 0.5)).sdf);
                 if (!(std::abs(d) < mBlockLimit)) return constant(bx, by, bz, 2, d);
             }
             for (int i = bx; i < bx + 2; ++i)
@@ -267,17 +287,25 @@ private:
                         const float da = mA(ps), db = mB(pt);
                         ++samples;
                         mDistances.record(n, da, db);
-                        mF.blendVoxel(n, da, db, mBands, mValue, mColor, seen, [&] {
+                        const Taus tau = mF.tausAt(at(i, j, k));
+                        mColors.setTau(tau.color);
+                        mF.blendVoxel(n, da, db, tau.sdf, mBands, mValue, mColor, seen, [&] {
                             return mColors(ps, pt, fogRamp(da, mRamp), fogRamp(db, mRamp));
                         });
                     }
         }
 
-        /// The blend at one pair of warped points (index space), counted as a sample.
-        float blendAt(const Vec3f& ps, const Vec3f& pt)
+        /// The blend at one pair of warped points (index space) by `tau`, counted as a sample.
+        float blendAt(const Vec3f& ps, const Vec3f& pt, float tau)
         {
             ++samples;
-            return (1.0f - mF.mTau) * mA(openvdb::Vec3R(ps)) + mF.mTau * mB(openvdb::Vec3R(pt));
+            return (1.0f - tau) * mA(openvdb::Vec3R(ps)) + tau * mB(openvdb::Vec3R(pt));
+        }
+
+        /// The output index point at the leaf's local (x, y, z).
+        Vec3d at(double x, double y, double z) const
+        {
+            return mW.origin.asVec3d() + Vec3d(x, y, z);
         }
 
         /// The cube of `size` voxels at (x0, y0, z0) of the leaf is inside or outside as a whole.
@@ -360,13 +388,15 @@ private:
     /// The blend at the centres of the classified box's leaves (`wanted`, unless empty, says which)
     /// through the exact warp, and the warped centres (index space) into ps and pt.
     std::vector<float> centreBlends(std::vector<Vec3d>& ps, std::vector<Vec3d>& pt,
-                                    const std::vector<uint8_t>& wanted) const
+                                    const std::vector<uint8_t>& wanted,
+                                    std::vector<float>& apart) const
     {
         const BlockClasses& c = mClasses;
         const openvdb::Coord n = c.leaves.dim();
         auto index = [&n](int x, int y, int z) { return (size_t(x) * n.y() + y) * n.z() + z; };
         const size_t count = size_t(n.x()) * n.y() * n.z();
         std::vector<float> blend(count);
+        apart.assign(count, 0.0f);
         ps.resize(count);
         pt.resize(count);
         tbb::parallel_for(tbb::blocked_range<int>(0, n.x()), [&](const tbb::blocked_range<int>& r) {
@@ -380,21 +410,48 @@ private:
                         const Vec3d centre(leaf.x() * 8 + 3.5, leaf.y() * 8 + 3.5,
                                            leaf.z() * 8 + 3.5);
                         mWarp.map(centre, ps[i], pt[i]);
-                        blend[i] = (1.0f - mTau) * a(ps[i]) + mTau * b(pt[i]);
+                        const float da = a(ps[i]), db = b(pt[i]), tau = tausAt(centre).sdf;
+                        blend[i] = (1.0f - tau) * da + tau * db;
+                        apart[i] = std::abs(db - da);
                     }
         });
         return blend;
     }
 
     /// The same from the distances kept across frames (the identity warp).
-    std::vector<float> keptCentreBlends(const openvdb::CoordBBox& box,
-                                        IdentityDistances& identity) const
+    std::vector<float> keptCentreBlends(const openvdb::CoordBBox& box, IdentityDistances& identity,
+                                        std::vector<float>& apart) const
     {
         const auto centres = identity.centres<Sampler>(box, mFarSource, mFarTarget);
         std::vector<float> blend(centres->source.size());
-        for (size_t i = 0; i < blend.size(); ++i)
-            blend[i] = (1.0f - mTau) * centres->source[i] + mTau * centres->target[i];
+        apart.resize(blend.size());
+        const openvdb::CoordBBox& leaves = mClasses.leaves;
+        const openvdb::Coord n = leaves.dim();
+        for (size_t i = 0; i < blend.size(); ++i) {
+            float tau = mTau;
+            if (!mSdfTime.uniform()) {
+                const int z = int(i % size_t(n.z())), y = int(i / size_t(n.z()) % size_t(n.y())),
+                          x = int(i / (size_t(n.z()) * size_t(n.y())));
+                const openvdb::Coord leaf = leaves.min().offsetBy(x, y, z);
+                tau = tausAt(leaf.asVec3d() * 8.0 + Vec3d(3.5)).sdf;
+            }
+            const float da = centres->source[i], db = centres->target[i];
+            blend[i] = (1.0f - tau) * da + tau * db;
+            apart[i] = std::abs(db - da);
+        }
         return blend;
+    }
+
+    /// With a timing, tau varies over a leaf, and the blend with it: |grad phi| <= G + |grad tau|
+    /// |d_T - d_S| per voxel, where |d_T - d_S| is at most its value at the centre plus 2 G per
+    /// voxel out to the leaf's corners (3.5 sqrt(3) voxels), and |grad tau| at most the timing's
+    /// bound. The leaf's stretch becomes that bound: its bands and limits widen with it.
+    void addTimingStretch(std::vector<float>& stretch, const std::vector<float>& apart) const
+    {
+        const float g = mSdfTime.maxGradient();
+        if (g == 0.0f) return;
+        for (size_t i = 0; i < stretch.size(); ++i)
+            stretch[i] += g * (apart[i] / mVoxel + 2.0f * stretch[i] * 3.5f * kSqrt3);
     }
 
     const VolumeSet& mSource;
@@ -402,7 +459,9 @@ private:
     const ExtendedDistance& mFarSource;
     const ExtendedDistance& mFarTarget;
     const InverseWarp& mWarp;
-    float mTau, mTauColor;
+    const BlendTime& mSdfTime;
+    const BlendTime& mColorTime;
+    float mTau, mTauColor; ///< without a timing, every voxel's
     Vec3f mBackground;
     float mVoxel;              ///< world units
     float mWidth;              ///< the output band's half width, voxels

@@ -126,7 +126,8 @@ openvdb::MaskTree SdfVelocity::shell(const openvdb::FloatTree& source,
         openvdb::util::NodeMask<3> near;
         if (a && b) // recorded together: never one without the other
             for (auto it = a->cbeginValueOn(); it; ++it) {
-                const float phi = (1.0f - mTau) * *it + mTau * b->getValue(it.pos());
+                const float tau = mTime.at(it.getCoord()).tau;
+                const float phi = (1.0f - tau) * *it + tau * b->getValue(it.pos());
                 if (std::abs(phi) < mShell) near.setOn(it.pos());
             }
         leaf.setValueMask(near);
@@ -146,17 +147,20 @@ void SdfVelocity::leaf(const openvdb::FloatTree& source, const openvdb::FloatTre
     for (auto it = shell.beginOn(); it; ++it) {
         const openvdb::Index n = it.pos();
         const float da = a.at(n), db = b.at(n);
-        const float wa = (1.0f - mTau) * fogRamp(da, mRamp), wb = mTau * fogRamp(db, mRamp);
+        const VoxelTau time = mTime.at(origin + VectorLeaf::offsetToLocalCoord(n));
+        const float tau = time.tau;
+        const float wa = (1.0f - tau) * fogRamp(da, mRamp), wb = tau * fogRamp(db, mRamp);
         const Vec3f warp = wa + wb > 0.0f ? (wa * vs[n] + wb * vt[n]) / (wa + wb)
-                                          : (1.0f - mTau) * vs[n] + mTau * vt[n];
+                                          : (1.0f - tau) * vs[n] + tau * vt[n];
         Vec3f fix(0.0f), ga, gb;
         if (gradient(a, n, da, ga) && gradient(b, n, db, gb)) {
-            const Vec3f normal = (1.0f - mTau) * ga + mTau * gb;
+            // grad phi, with the chain rule through tau's own gradient under a timing.
+            const Vec3f normal = (1.0f - tau) * ga + tau * gb + (db - da) * time.gradient;
             const float length2 = normal.lengthSqr();
             const float floor = kMinGradient * std::max(ga.length(), gb.length());
             if (length2 > floor * floor) {
                 const float rate =
-                    mSlope * (db - da) - (1.0f - mTau) * ga.dot(vs[n]) - mTau * gb.dot(vt[n]);
+                    time.dt * (db - da) - (1.0f - tau) * ga.dot(vs[n]) - tau * gb.dot(vt[n]);
                 fix = ((-rate - warp.dot(normal)) / length2) * normal;
             }
         }

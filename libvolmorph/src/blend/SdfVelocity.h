@@ -4,14 +4,16 @@
 // (each side's -J^-1 dW/dt, warp/VelocityLeaf.h, mixed by each side's fog as colour is) keeps its
 // tangential part; its normal part is replaced so that phi_t + v . grad phi = 0:
 //   v = v_w + ((-phi_t - v_w . grad phi) / |grad phi|^2) grad phi,
-//   phi_t = tau' (d_T(W_T) - d_S(W_S)) - (1 - tau) g_S . v_S - tau g_T . v_T,
-//   grad phi = (1 - tau) g_S + tau g_T,
+//   phi_t = tau_t (d_T(W_T) - d_S(W_S)) - (1 - tau) g_S . v_S - tau g_T . v_T,
+//   grad phi = (1 - tau) g_S + tau g_T + (d_T(W_T) - d_S(W_S)) grad tau,
 // g the gradient, at the output voxel, of the side's warped distance d(W) (g . v = grad d . J v =
 // -grad d . dW/dt). The warped distances are the frame's own, recorded where its leaves were
 // blended (SdfFrame::Distances); their gradients are central differences over the output's voxels
 // (one-sided, second order, at the edge of what was recorded). Where |grad phi| is below a quarter
 // of a distance's (the sides' gradients cancel, as where a surface splits in two), the normal is
-// undefined and the voxel keeps v_w.
+// undefined and the voxel keeps v_w. Under a timing tau is each voxel's (BlendTime.h): tau_t is
+// the schedule's slope times d tau / d t there, and grad tau the delay's chain rule; without one
+// tau_t is the schedule's slope at t and grad tau is 0.
 //
 // Beyond the voxels blended, out to the shutter's reach (VelocityReach.h), the velocity is the
 // warp's, (1 - tau) v_S + tau v_T, plus the normal correction v - v_w extended outward layer by
@@ -20,6 +22,7 @@
 // Units: index units per unit t inside, world units per second in the grid.
 #pragma once
 
+#include "blend/BlendTime.h"
 #include "blend/VelocityBlend.h"
 
 #include <openvdb/openvdb.h>
@@ -28,13 +31,13 @@ namespace volmorph::detail {
 
 class SdfVelocity {
 public:
-    /// worldPerSecond: world units per second of one index unit per unit t; tau and tauSlope
-    /// (d tau / dt): the distance schedule's at the frame; rampWorld: the fog's ramp, voxelSize:
+    /// worldPerSecond: world units per second of one index unit per unit t; time: the distance
+    /// schedule's tau at each voxel (it must outlive this); rampWorld: the fog's ramp, voxelSize:
     /// the output's voxel (world units).
-    SdfVelocity(const InverseWarp& warp, double worldPerSecond, float tau, float tauSlope,
+    SdfVelocity(const InverseWarp& warp, double worldPerSecond, const BlendTime& time,
                 float rampWorld, float voxelSize)
-        : mBlend(warp, worldPerSecond, tau), mScale(float(worldPerSecond)), mTau(tau),
-          mSlope(tauSlope), mRamp(rampWorld), mShell(rampWorld + 2.0f * voxelSize)
+        : mBlend(warp, worldPerSecond, time.atAll().tau), mScale(float(worldPerSecond)),
+          mTime(time), mRamp(rampWorld), mShell(rampWorld + 2.0f * voxelSize)
     {
     }
 
@@ -58,7 +61,9 @@ private:
               VectorLeaf& velocity, VectorLeaf* correction) const;
 
     VelocityBlend mBlend;
-    float mScale, mTau, mSlope, mRamp;
+    float mScale;
+    const BlendTime& mTime;
+    float mRamp;
     float mShell; ///< world units: where |phi| is below it, the formula; beyond, the extension
 };
 

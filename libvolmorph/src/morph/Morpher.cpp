@@ -93,6 +93,10 @@ Morpher::Morpher(VolumeSet source, VolumeSet target, std::vector<FeaturePairSpec
         throw std::invalid_argument("Morpher: source and target must share one transform");
     if (!mOptions.memoryLimitBytes) mOptions.memoryLimitBytes = defaultMemoryLimitBytes();
     detail::ExtraGrids::check(mSource, mTarget, mBlend);
+    if (mOptions.localTime && mOptions.localTime->active() &&
+        (!mPairs.empty() || mBlend.mode == BlendMode::Variational))
+        throw std::invalid_argument(
+            "Morpher: a timing is applied in density and sdf modes without pairs only");
     mSourceBlocks = std::make_shared<const detail::Occupancy>(mSource.density->tree());
     mTargetBlocks = std::make_shared<const detail::Occupancy>(mTarget.density->tree());
     const detail::BlendSetup setup{mSource,
@@ -169,6 +173,7 @@ VolumeSet Morpher::run(double t, const CoordBBox& box, bool prune, double tolera
     if (mOptions.secondsPerUnitT > 0.0)
         request.velocityScale = mSource.voxelSize() / mOptions.secondsPerUnitT;
     request.velocityReachSeconds = mOptions.velocityReachSeconds;
+    request.localTime = mOptions.localTime.get();
     const float tauColor = float(scheduleValue(mBlend.color, t));
     detail::OutputLeaves leaves(
         t, mOptions.memoryLimitBytes, residentBytes(),

@@ -28,7 +28,7 @@ using detail::typeName;
 // reported with a "did you mean" for near misses.
 const std::vector<std::string> kRootKeys = {"source", "target", "volume",  "pair",
                                             "warp",   "blend",  "surface", "variational",
-                                            "render", "prop",   "frames"};
+                                            "timing", "render", "prop",    "frames"};
 const std::vector<std::string> kFramesKeys = {"range", "output", "fps"};
 
 class SceneParser {
@@ -69,6 +69,15 @@ public:
                 r.error(r.at(*n), "[surface]: only used with blend.mode = \"surface\"");
         }
         if (mScene.blend.mode == BlendMode::Surface) checkSurfaceMode(root);
+        if (const toml::node* n = root.get("timing")) {
+            detail::parseTiming(r, *n, mScene.folder, mScene.timing, mScene.timingRegions);
+            const BlendMode mode = mScene.blend.mode;
+            if (mode == BlendMode::Variational || mode == BlendMode::Surface ||
+                !mScene.pairs.empty())
+                r.error(mScene.timing.where,
+                        "[timing]: not yet applied with feature pairs, in variational mode or to "
+                        "surface morphs; density and sdf modes without [[pair]]s take it");
+        }
         if (const toml::node* n = root.get("render"))
             detail::parseRender(r, *n, mScene.folder, mScene.render);
         if (const toml::node* n = root.get("prop"))

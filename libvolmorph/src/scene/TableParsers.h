@@ -36,6 +36,9 @@ void parseVariational(Reader& r, const toml::node& node, const std::filesystem::
                       VariationalSpec& variational, std::vector<InfluenceSpec>& influences);
 /// [surface] (surface mode): correspondence, interpolation, kernel.
 void parseSurface(Reader& r, const toml::node& node, SurfaceSpec& surface);
+/// [timing] (spread, sweep) and its [[timing.region]]s, their files resolved against `folder`.
+void parseTiming(Reader& r, const toml::node& node, const std::filesystem::path& folder,
+                 TimingSettings& timing, std::vector<TimingRegionSpec>& regions);
 /// [render], its camera and lights (with their keys); a sky map's path resolved against `folder`.
 void parseRender(Reader& r, const toml::node& node, const std::filesystem::path& folder,
                  RenderSpec& render);

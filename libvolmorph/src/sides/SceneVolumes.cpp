@@ -4,7 +4,11 @@
 #include <volmorph/VolumeInput.h>
 #include <volmorph/Voxelize.h>
 
+#include <openvdb/tools/LevelSetRebuild.h>
+
 #include <algorithm>
+#include <cmath>
+#include <string>
 
 namespace volmorph {
 
@@ -110,6 +114,7 @@ SceneVolumes voxelizeScene(const Scene& sequenced, Interrupter* interrupter,
         *sides[i] = objectVolumes(*specs[i], meshes[i], inputs[i] ? &*inputs[i] : nullptr,
                                   voxelSize, needsSdf(scene), interrupter, memoryLimitBytes);
     out.influences = voxelizeInfluences(scene, voxelSize, interrupter, memoryLimitBytes);
+    out.timingRegions = loadTimingRegions(scene, voxelSize, interrupter, memoryLimitBytes);
     return out;
 }
 
@@ -129,6 +134,69 @@ std::vector<TimedVolume> voxelizeInfluences(const Scene& scene, double voxelSize
         out.push_back({objectVolumes(influence.object, &mesh, input ? &*input : nullptr, voxelSize,
                                      true, interrupter, memoryLimitBytes),
                        influence.t});
+    }
+    return out;
+}
+
+} // namespace volmorph
+
+namespace volmorph {
+namespace {
+
+/// Region i's mesh, placed; UserError at its `mesh` key when it is not closed.
+Mesh importRegionMesh(const Scene& scene, size_t i)
+{
+    const ObjectSpec& shape = scene.timingRegions[i].shape;
+    Mesh mesh = importMesh(shape.mesh, shape.transform, shape.fileWhere);
+    if (!mesh.report.watertight())
+        throw UserError(shape.fileWhere,
+                        "timing.region[" + std::to_string(i + 1) + "]: " + shape.mesh.string() +
+                            " is not closed (" + std::to_string(mesh.report.boundaryEdges) +
+                            " boundary edges, " + std::to_string(mesh.report.nonManifoldEdges) +
+                            " non-manifold): a region needs a closed surface");
+    return mesh;
+}
+
+} // namespace
+
+void checkTimingRegions(const Scene& scene)
+{
+    for (size_t i = 0; i < scene.timingRegions.size(); ++i) {
+        const ObjectSpec& shape = scene.timingRegions[i].shape;
+        if (shape.isVolume())
+            inspectVolume(shape.volumeSource());
+        else
+            importRegionMesh(scene, i);
+    }
+}
+
+std::vector<TimingRegion> loadTimingRegions(const Scene& scene, double voxelSize,
+                                            Interrupter* interrupter, uint64_t memoryLimitBytes)
+{
+    std::vector<TimingRegion> out;
+    for (size_t i = 0; i < scene.timingRegions.size(); ++i) {
+        const TimingRegionSpec& region = scene.timingRegions[i];
+        const ObjectSpec& shape = region.shape;
+        // The band reaches the softness, and two voxels more, outside.
+        const float halfWidth =
+            std::max(3.0f, float(std::ceil(region.softness / voxelSize)) + 2.0f);
+        openvdb::FloatGrid::Ptr sdf;
+        if (shape.isVolume()) {
+            VolumeInputOptions o;
+            o.voxelSize = voxelSize;
+            o.needSdf = true;
+            o.memoryLimitBytes = memoryLimitBytes;
+            const VolumeSet v = VolumeInput(shape.volumeSource()).resample(o, interrupter);
+            sdf = openvdb::tools::levelSetRebuild(*v.sdf, 0.0f, halfWidth, 3.0f);
+        } else {
+            const Mesh mesh = importRegionMesh(scene, i);
+            VoxelizeOptions o;
+            o.voxelSize = voxelSize;
+            o.halfWidthVoxels = halfWidth;
+            o.memoryLimitBytes = memoryLimitBytes;
+            sdf = voxelize(mesh, o, interrupter).sdf;
+        }
+        out.push_back({sdf, region.start, region.softness});
     }
     return out;
 }

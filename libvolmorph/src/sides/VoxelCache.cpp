@@ -211,9 +211,12 @@ SceneVolumes voxelizeSceneCached(const Scene& scene, const std::filesystem::path
         r.problem = readEntry(r.entry, key, cached);
         if (r.problem.empty()) {
             r.outcome = CacheReport::Outcome::Hit;
-            // The influence shapes are not cached: voxelized each time at the sides' voxel size.
+            // The influence shapes and timing regions are not cached: voxelized each time at the
+            // sides' voxel size.
             cached.influences =
                 voxelizeInfluences(scene, cached.source.voxelSize(), interrupter, memoryLimitBytes);
+            cached.timingRegions =
+                loadTimingRegions(scene, cached.source.voxelSize(), interrupter, memoryLimitBytes);
             return cached;
         }
     }

@@ -8,8 +8,6 @@
 #include <volmorph/Schedule.h>
 #include <volmorph/Voxelize.h>
 
-#include <openvdb/tools/LevelSetSphere.h>
-
 using namespace volmorph;
 using namespace volmorph::test;
 
@@ -21,23 +19,6 @@ MorphOptions withVelocity()
     MorphOptions o;
     o.secondsPerUnitT = 1.0;
     return o;
-}
-
-/// A sphere of `radius` about the origin as a voxelized object: exact distances (OpenVDB's
-/// level-set sphere, a narrow band of 3 voxels), its fog, a grey colour.
-VolumeSet exactSphere(double radius, double voxel)
-{
-    VolumeSet v;
-    v.sdf = openvdb::tools::createLevelSetSphere<openvdb::FloatGrid>(
-        float(radius), openvdb::Vec3f(0.0f), float(voxel), 3.0f);
-    v.sdf->setName(kSdfGridName);
-    v.density = fogFromLevelSet(*v.sdf, 1.5f * float(voxel));
-    v.density->setName(kDensityGridName);
-    v.color = openvdb::Vec3SGrid::create(Vec3f(0.5f));
-    v.color->setTransform(v.sdf->transform().copy());
-    v.color->setName(kColorGridName);
-    v.color->tree().topologyUnion(v.sdf->tree());
-    return v;
 }
 
 BlendSpec sdfBlend()

@@ -73,6 +73,24 @@ inline VolumeSet voxelized(const std::string& mesh, double voxelSize,
     return voxelize(importMesh(kMeshes / mesh, xf), o);
 }
 
+/// A sphere of `radius` about `centre` as a voxelized object: exact distances (OpenVDB's
+/// level-set sphere, a narrow band of `band` voxels), its fog, a grey colour.
+inline VolumeSet exactSphere(double radius, double voxel, float band = 3.0f,
+                             const Vec3d& centre = Vec3d(0.0))
+{
+    VolumeSet v;
+    v.sdf = openvdb::tools::createLevelSetSphere<openvdb::FloatGrid>(
+        float(radius), openvdb::Vec3f(centre), float(voxel), band);
+    v.sdf->setName(kSdfGridName);
+    v.density = fogFromLevelSet(*v.sdf, 1.5f * float(voxel));
+    v.density->setName(kDensityGridName);
+    v.color = openvdb::Vec3SGrid::create(Vec3f(0.5f));
+    v.color->setTransform(v.sdf->transform().copy());
+    v.color->setName(kColorGridName);
+    v.color->tree().topologyUnion(v.sdf->tree());
+    return v;
+}
+
 /// Two objects and the one pair that turns one into the other.
 struct OnePairMorph {
     VolumeSet source, target;

@@ -1,0 +1,166 @@
+// A morph that travels ([timing], LocalTime.h) in sdf mode without pairs (issue 59): a sphere into
+// a cube swept upward with spread 0.5 is the cube at the bottom and the sphere at the top half way,
+// one closed surface in every frame, the inputs at its ends; and the `vel` grid, with a sweep and
+// with a region, is the normal speed the frames themselves show (central differences of the
+// redistanced frames at each surface voxel), which checks the chain rule through tau(x, t).
+#include "support/WarpFixtures.h"
+#include "support/ZeroSetTopology.h"
+
+#include <volmorph/LocalTime.h>
+
+using namespace volmorph;
+using namespace volmorph::test;
+
+namespace {
+
+constexpr double kVoxel = 0.02;
+
+/// Upward over the middle three fifths of the shapes (y from -0.5 to 0.5): the bottom fifth
+/// starts first, the top fifth last.
+std::shared_ptr<const LocalTime> upward(double spread, std::vector<TimingRegion> regions = {})
+{
+    TimingSettings s;
+    s.spread = spread;
+    s.sweep = TimingSweep{Vec3d(0.0, -0.3, 0.0), Vec3d(0.0, 1.0, 0.0), 0.6, {}};
+    return std::make_shared<const LocalTime>(s, std::move(regions));
+}
+
+MorphOptions timed(std::shared_ptr<const LocalTime> time, bool velocity = false)
+{
+    MorphOptions o;
+    o.localTime = std::move(time);
+    if (velocity) o.secondsPerUnitT = 1.0;
+    return o;
+}
+
+BlendSpec sdfMode()
+{
+    BlendSpec b;
+    b.mode = BlendMode::Sdf;
+    return b;
+}
+
+/// Intersection over union of the insides (sdf < 0) of two level sets over the voxels of `box`.
+double insideIoU(const openvdb::FloatGrid& a, const openvdb::FloatGrid& b,
+                 const openvdb::CoordBBox& box)
+{
+    auto ra = a.getConstAccessor();
+    auto rb = b.getConstAccessor();
+    size_t both = 0, either = 0;
+    for (auto it = box.begin(); it; ++it) {
+        const bool ia = ra.getValue(*it) < 0.0f, ib = rb.getValue(*it) < 0.0f;
+        both += ia && ib;
+        either += ia || ib;
+    }
+    return either ? double(both) / double(either) : 1.0;
+}
+
+/// The voxels of the slab lo <= y <= hi world units across the shapes' box.
+openvdb::CoordBBox slab(double lo, double hi)
+{
+    const int x = int(std::ceil(0.6 / kVoxel));
+    return openvdb::CoordBBox(openvdb::Coord(-x, int(std::ceil(lo / kVoxel)), -x),
+                              openvdb::Coord(x, int(std::floor(hi / kVoxel)), x));
+}
+
+/// Over the surface voxels of frame t (|sdf| below half a voxel) whose local time is strictly
+/// between 0 and 1 from t - h to t + h (the difference does not straddle a start or an end): the
+/// mean |vel . n - v_n| over the mean |v_n|, v_n = -(sdf(t + h) - sdf(t - h)) / 2h from the
+/// frames themselves (redistanced: |grad sdf| = 1), n from sdf(t)'s central differences.
+double normalSpeedError(const Morpher& morpher, const LocalTime& time, double t, double h,
+                        int& count)
+{
+    const VolumeSet now = morpher.frame(t), before = morpher.frame(t - h),
+                    after = morpher.frame(t + h);
+    auto phi = now.sdf->getConstAccessor();
+    auto p0 = before.sdf->getConstAccessor();
+    auto p1 = after.sdf->getConstAccessor();
+    auto vel = now.velocity->getConstAccessor();
+    double error = 0.0, speed = 0.0;
+    count = 0;
+    for (auto it = now.sdf->cbeginValueOn(); it; ++it) {
+        const openvdb::Coord c = it.getCoord();
+        if (!(std::abs(*it) < 0.5 * kVoxel) || !vel.isValueOn(c)) continue;
+        const double vn = -(double(p1.getValue(c)) - double(p0.getValue(c))) / (2.0 * h);
+        Vec3d n;
+        for (int k = 0; k < 3; ++k) {
+            openvdb::Coord step(0);
+            step[k] = 1;
+            n[k] = double(phi.getValue(c + step)) - double(phi.getValue(c - step));
+        }
+        const Vec3d x = now.sdf->indexToWorld(c);
+        const double before = time.at(x, t - h).tau, after = time.at(x, t + h).tau;
+        if (!(before > 0.0 && after < 1.0)) continue; // the morph starts or ends there
+        error += std::abs(Vec3d(vel.getValue(c)).dot(n.unit()) - vn);
+        speed += std::abs(vn);
+        ++count;
+    }
+    return count ? error / speed : 1e9;
+}
+
+} // namespace
+
+TEST(TimingMorph, ASweptSphereIntoACubeIsTheCubeBelowAndTheSphereAboveHalfWay)
+{
+    const VolumeSet sphere = voxelized("sphere.obj", kVoxel), cube = voxelized("cube.obj", kVoxel);
+    const Morpher morpher(sphere, cube, {}, WarpSpec{}, sdfMode(), timed(upward(0.5)));
+    const VolumeSet half = morpher.frame(0.5);
+    // The bottom fifth is the target's, the top fifth the source's.
+    EXPECT_GE(insideIoU(*half.sdf, *cube.sdf, slab(-0.55, -0.3)), 0.95);
+    EXPECT_GE(insideIoU(*half.sdf, *sphere.sdf, slab(0.3, 0.55)), 0.95);
+    // Not the morph without a timing, which is half way everywhere.
+    const Morpher plain(sphere, cube, {}, WarpSpec{}, sdfMode());
+    EXPECT_LT(insideIoU(*plain.frame(0.5).sdf, *cube.sdf, slab(-0.55, -0.3)), 0.95);
+    // The ends are the inputs, and every frame is one closed surface (a sphere's topology).
+    EXPECT_GE(insideIoU(*morpher.frame(0.0).sdf, *sphere.sdf, slab(-0.6, 0.6)), 0.99);
+    EXPECT_GE(insideIoU(*morpher.frame(1.0).sdf, *cube.sdf, slab(-0.6, 0.6)), 0.99);
+    for (double t = 0.0; t <= 1.0001; t += 0.125) {
+        const Topology topology = topologyOf(*morpher.frame(t).sdf);
+        EXPECT_EQ(topology.components, 1) << "t " << t;
+        EXPECT_EQ(topology.euler, 2) << "t " << t;
+    }
+}
+
+TEST(TimingMorph, DensityModeBlendsEachPlaceAtItsOwnTime)
+{
+    // Half way, the bottom fifth's fog is the cube's and the top fifth's the sphere's; in between
+    // each voxel is the blend at its own tau.
+    BlendSpec density;
+    density.mode = BlendMode::Density;
+    const VolumeSet sphere = voxelized("sphere.obj", kVoxel), cube = voxelized("cube.obj", kVoxel);
+    const auto time = upward(0.5);
+    const Morpher morpher(sphere, cube, {}, WarpSpec{}, density, timed(time));
+    const VolumeSet half = morpher.frame(0.5);
+    auto out = half.density->getConstAccessor();
+    auto a = sphere.density->getConstAccessor();
+    auto b = cube.density->getConstAccessor();
+    double worst = 0.0;
+    for (auto it = slab(-0.6, 0.6).begin(); it; ++it) {
+        const double tau = time->at(half.density->indexToWorld(*it), 0.5).tau;
+        const double expected = (1.0 - tau) * a.getValue(*it) + tau * b.getValue(*it);
+        worst = std::max(worst, std::abs(double(out.getValue(*it)) - expected));
+    }
+    EXPECT_LT(worst, 1e-6);
+    // The fifths: wholly the target's below, the source's above.
+    EXPECT_EQ(time->at(Vec3d(0, -0.35, 0), 0.5).tau, 1.0);
+    EXPECT_EQ(time->at(Vec3d(0, 0.35, 0), 0.5).tau, 0.0);
+}
+
+TEST(TimingMorph, VelocityUnderASweepOrARegionIsTheFramesOwnNormalSpeed)
+{
+    // Concentric exact spheres (radii 0.5 and 0.4, bands wide enough to hold every in-between's
+    // surface): the surface moves only by the blend, at each place on its own time.
+    const VolumeSet big = exactSphere(0.5, kVoxel, 8.0f), small = exactSphere(0.4, kVoxel, 8.0f);
+    const auto region = openvdb::tools::createLevelSetSphere<openvdb::FloatGrid>(
+        0.25f, openvdb::Vec3f(0.4f, 0.2f, 0.0f), float(kVoxel), 12.0f);
+    const std::pair<const char*, std::shared_ptr<const LocalTime>> timings[] = {
+        {"sweep", upward(0.5)}, {"region", upward(0.5, {TimingRegion{region, 0.0, 0.15}})}};
+    for (const auto& [name, time] : timings) {
+        const Morpher morpher(big, small, {}, WarpSpec{}, sdfMode(), timed(time, true));
+        for (double t : {name[0] == 's' ? 0.6 : 0.35}) {
+            int count = 0;
+            EXPECT_LT(normalSpeedError(morpher, *time, t, 0.01, count), 0.01) << name << " t " << t;
+            EXPECT_GT(count, 500) << name << " t " << t;
+        }
+    }
+}
