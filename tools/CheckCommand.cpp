@@ -308,8 +308,8 @@ void printTiming(const Scene& scene)
                 "place morphs over %s of it\n",
                 fmt(t.spread).c_str(), fmt(t.spread).c_str(), fmt(1.0 - t.spread).c_str());
     if (t.sweep)
-        std::printf("        sweep from %s along %s: delay 0 behind that plane, %s from %s world "
-                    "units on\n",
+        std::printf("        sweep from %s along %s: the delay rises from 0 at that plane to %s "
+                    "at %s world units along\n",
                     fmt(t.sweep->origin).c_str(), fmt(t.sweep->direction).c_str(),
                     fmt(t.spread).c_str(), fmt(t.sweep->length).c_str());
     for (size_t i = 0; i < scene.timingRegions.size(); ++i) {

@@ -7,6 +7,9 @@
 
 #include <volmorph/Feature.h>
 #include <volmorph/Frames.h>
+#include <volmorph/LocalTime.h>
+#include <volmorph/Mesh.h>
+#include <volmorph/VolumeInput.h>
 #include <volmorph/Morph.h>
 #include <volmorph/render/Output.h>
 #include <volmorph/render/Overlay.h>
@@ -25,6 +28,10 @@ constexpr render::Color kInterpolated{1.0f, 0.75f, 0.05f};
 constexpr render::Color kSourceSide{0.05f, 0.6f, 1.0f};
 constexpr render::Color kTargetSide{1.0f, 0.1f, 0.6f};
 constexpr render::Color kBackground{0.02f, 0.02f, 0.025f};
+// [timing]: where places start now (green), where they finish now (white), regions (violet).
+constexpr render::Color kStarting{0.1f, 0.9f, 0.2f};
+constexpr render::Color kFinishing{0.9f, 0.9f, 0.9f};
+constexpr render::Color kRegion{0.6f, 0.3f, 1.0f};
 
 struct PreviewArgs {
     std::string scene, output, frames, from;
@@ -64,6 +71,60 @@ bool drawFeatures(render::Image& image, const render::Camera& camera, const Scen
                                       std::to_string(i + 1), kInterpolated, 16);
     }
     return labels;
+}
+
+/// A square of side `size` world units in the plane through `centre` with unit normal `normal`.
+void drawSquare(render::Image& image, const render::Camera& camera, const Vec3d& centre,
+                const Vec3d& normal, double size, const render::Color& color)
+{
+    const Vec3d helper = std::abs(normal.y()) < 0.9 ? Vec3d(0, 1, 0) : Vec3d(1, 0, 0);
+    const Vec3d u = normal.cross(helper).unit() * (0.5 * size), v = normal.cross(u);
+    const Vec3d corners[4] = {centre - u - v, centre + u - v, centre + u + v, centre - u + v};
+    for (int k = 0; k < 4; ++k)
+        render::drawSegment(image, camera, corners[k], corners[(k + 1) % 4], color, 1);
+}
+
+/// [timing] at morph time t: the sweep's two fronts (where places start now, where they finish
+/// now: between them the morph is under way), and each region's bounds with its start.
+void drawTiming(render::Image& image, const render::Camera& camera, const Scene& scene, double t)
+{
+    const TimingSettings& timing = scene.timing;
+    if (timing.spread == 0.0) return;
+    if (const auto& sweep = timing.sweep) {
+        const LocalTime along(timing, {});
+        const Vec3d dir = sweep->direction.unit();
+        // The place along the sweep whose delay is `d` (the delay rises along it: bisection).
+        const auto at = [&](double d) {
+            double lo = 0.0, hi = 1.0;
+            for (int k = 0; k < 40; ++k) {
+                const double mid = 0.5 * (lo + hi);
+                (along.delay(sweep->origin + dir * (mid * sweep->length)).d < d ? lo : hi) = mid;
+            }
+            return sweep->origin + dir * (lo * sweep->length);
+        };
+        if (t <= timing.spread) drawSquare(image, camera, at(t), dir, sweep->length, kStarting);
+        if (const double done = t - (1.0 - timing.spread); done >= 0.0)
+            drawSquare(image, camera, at(done), dir, sweep->length, kFinishing);
+    }
+    for (const TimingRegionSpec& region : scene.timingRegions) {
+        const ObjectSpec& shape = region.shape;
+        std::pair<Vec3d, Vec3d> box;
+        if (shape.isVolume()) {
+            const VolumeFileInfo info = inspectVolume(shape.volumeSource());
+            box = {info.worldMin, info.worldMax};
+        } else {
+            box = importMesh(shape.mesh, shape.transform, shape.fileWhere).bounds();
+        }
+        for (int e = 0; e < 12; ++e) { // the box's edges: 4 along each axis
+            const int axis = e / 4, a = (axis + 1) % 3, b = (axis + 2) % 3;
+            Vec3d p = box.first, q;
+            if (e & 1) p[a] = box.second[a];
+            if (e & 2) p[b] = box.second[b];
+            q = p;
+            q[axis] = box.second[axis];
+            render::drawSegment(image, camera, p, q, kRegion, 1);
+        }
+    }
 }
 
 void writeImage(const render::Image& image, const std::string& path, const render::Camera& camera,
@@ -137,6 +198,7 @@ int runPreview(const PreviewArgs& args)
             labelsDrawn =
                 drawFeatures(image, atSize.camera(step.frame), scene, step.t, args.sides) &&
                 labelsDrawn;
+            drawTiming(image, atSize.camera(step.frame), scene, step.t);
         }
         char label[64];
         std::snprintf(label, sizeof label, "frame %d  t=%.3f", step.frame, step.t);
