@@ -64,7 +64,8 @@ std::vector<TimedVolume> voxelizeInfluences(const Scene& scene, double voxelSize
 
 /// The scene's [[timing.region]]s at `voxelSize`: a mesh (which must be closed: UserError at its
 /// `mesh` key otherwise) voxelized, a fog mask read and its 0.5 level made a level set, each with
-/// a band that reaches its softness (and two voxels more) outside.
+/// a band that reaches its softness (and two voxels more) outside. A softness below a voxel is
+/// taken as one voxel.
 /// Checks each region's file without voxelizing it: a mesh imported (and closed), a volume's
 /// header read. UserError at its key otherwise.
 void checkTimingRegions(const Scene& scene);

@@ -196,7 +196,9 @@ std::vector<TimingRegion> loadTimingRegions(const Scene& scene, double voxelSize
             o.memoryLimitBytes = memoryLimitBytes;
             sdf = voxelize(mesh, o, interrupter).sdf;
         }
-        out.push_back({sdf, region.start, region.softness});
+        // A hard edge (softness 0) is a voxel soft: the delay, and the in-between with it, stay
+        // continuous, and the blend's bounds finite.
+        out.push_back({sdf, region.start, std::max(region.softness, voxelSize)});
     }
     return out;
 }
