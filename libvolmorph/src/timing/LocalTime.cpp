@@ -74,10 +74,14 @@ LocalTime::LocalTime(const TimingSettings& settings, std::vector<TimingRegion> r
         throw std::invalid_argument("LocalTime: the spread must lie in [0, 1)");
     if (mSweep && !(mSweep->length > 0.0))
         throw std::invalid_argument("LocalTime: the sweep's length must be positive");
-    for (const TimingRegion& r : mRegions)
+    for (const TimingRegion& r : mRegions) {
         if (!r.sdf || !(r.start >= 0.0 && r.start <= mSpread) || !(r.softness >= 0.0))
             throw std::invalid_argument(
                 "LocalTime: a region needs an sdf, a start in [0, spread] and softness >= 0");
+        // Beyond its band a level set reads its background: the fade must end within it.
+        if (double(r.sdf->background()) < r.softness)
+            throw std::invalid_argument("LocalTime: a region's level set must reach its softness");
+    }
     if (mSweep) mSweep->direction = mSweep->direction.unit();
 }
 

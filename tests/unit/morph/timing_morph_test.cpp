@@ -124,28 +124,28 @@ TEST(TimingMorph, ASweptSphereIntoACubeIsTheCubeBelowAndTheSphereAboveHalfWay)
 TEST(TimingMorph, ARegionThatStartsAtOnceIsDoneWhileTheRestHasNotBegun)
 {
     // A sweep whose delay is the spread everywhere (its plane far below), and a region, the
-    // lower half-space's ball about (0, -0.5, 0) of radius 0.45, that starts at 0 with a softness
-    // of 0.05: inside it the morph is over by t = 1 - spread, outside it has not begun at
-    // t = spread.
+    // ball about (0, -0.5, 0) of radius 0.45, that starts at 0 with a softness of 0.15: inside it
+    // the morph is over by t = 1 - spread, outside it has not begun at t = spread.
     constexpr double kSpread = 0.4;
     TimingSettings settings;
     settings.spread = kSpread;
     settings.sweep = TimingSweep{Vec3d(0.0, -10.0, 0.0), Vec3d(0.0, 1.0, 0.0), 1.0, {}};
     const auto ball = openvdb::tools::createLevelSetSphere<openvdb::FloatGrid>(
-        0.45f, openvdb::Vec3f(0.0f, -0.5f, 0.0f), float(kVoxel), 6.0f);
+        0.45f, openvdb::Vec3f(0.0f, -0.5f, 0.0f), float(kVoxel), 10.0f); // reaches the softness
     const auto time =
-        std::make_shared<const LocalTime>(settings, std::vector{TimingRegion{ball, 0.0, 0.05}});
+        std::make_shared<const LocalTime>(settings, std::vector{TimingRegion{ball, 0.0, 0.15}});
     const VolumeSet sphere = voxelized("sphere.obj", kVoxel), cube = voxelized("cube.obj", kVoxel);
     const Morpher morpher(sphere, cube, {}, WarpSpec{}, sdfMode(), timed(time));
     // Inside the region: the box |x|, |z| <= 0.2, -0.6 <= y <= -0.2, all inside the ball.
     const int r = int(0.2 / kVoxel);
     const openvdb::CoordBBox inside(openvdb::Coord(-r, int(-0.6 / kVoxel), -r),
                                     openvdb::Coord(r, int(-0.2 / kVoxel), r));
-    EXPECT_GE(insideIoU(*morpher.frame(1.0 - kSpread).sdf, *cube.sdf, inside), 0.99);
-    EXPECT_LT(insideIoU(*morpher.frame(kSpread).sdf, *cube.sdf, inside), 0.99); // under way
-    // Outside it (above y = 0.1: beyond the ball's softness), the source's until t = spread.
-    EXPECT_GE(insideIoU(*morpher.frame(kSpread).sdf, *sphere.sdf, slab(0.1, 0.6)), 0.99);
-    EXPECT_LT(insideIoU(*morpher.frame(1.0 - kSpread).sdf, *sphere.sdf, slab(0.1, 0.6)), 0.99);
+    const VolumeSet early = morpher.frame(kSpread), late = morpher.frame(1.0 - kSpread);
+    EXPECT_GE(insideIoU(*late.sdf, *cube.sdf, inside), 0.99);
+    EXPECT_LT(insideIoU(*early.sdf, *cube.sdf, inside), 0.99); // under way
+    // Outside it (above y = 0.12: beyond the ball's softness), the source's until t = spread.
+    EXPECT_GE(insideIoU(*early.sdf, *sphere.sdf, slab(0.12, 0.6)), 0.99);
+    EXPECT_LT(insideIoU(*late.sdf, *sphere.sdf, slab(0.12, 0.6)), 0.99);
 }
 
 TEST(TimingMorph, DensityModeBlendsEachPlaceAtItsOwnTime)

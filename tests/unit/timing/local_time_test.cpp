@@ -112,4 +112,6 @@ TEST(LocalTime, ARegionOverridesTheSweepInsideAndFadesOverItsSoftness)
     }
     EXPECT_THROW(LocalTime(upward(1.0), {}), std::invalid_argument);
     EXPECT_THROW(LocalTime(upward(0.5), {TimingRegion{sphere, 0.6, 0.1}}), std::invalid_argument);
+    EXPECT_THROW(LocalTime(upward(0.5), {TimingRegion{sphere, 0.0, 0.5}}), // beyond its band
+                 std::invalid_argument);
 }
