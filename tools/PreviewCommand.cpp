@@ -84,9 +84,27 @@ void drawSquare(render::Image& image, const render::Camera& camera, const Vec3d&
         render::drawSegment(image, camera, corners[k], corners[(k + 1) % 4], color, 1);
 }
 
+/// Each [[timing.region]]'s world bounds (its mesh imported, or its volume's header read): once
+/// for the preview, not per frame.
+std::vector<std::pair<Vec3d, Vec3d>> regionBounds(const Scene& scene)
+{
+    std::vector<std::pair<Vec3d, Vec3d>> out;
+    for (const TimingRegionSpec& region : scene.timingRegions) {
+        const ObjectSpec& shape = region.shape;
+        if (shape.isVolume()) {
+            const VolumeFileInfo info = inspectVolume(shape.volumeSource());
+            out.emplace_back(info.worldMin, info.worldMax);
+        } else {
+            out.push_back(importMesh(shape.mesh, shape.transform, shape.fileWhere).bounds());
+        }
+    }
+    return out;
+}
+
 /// [timing] at morph time t: the sweep's two fronts (where places start now, where they finish
-/// now: between them the morph is under way), and each region's bounds with its start.
-void drawTiming(render::Image& image, const render::Camera& camera, const Scene& scene, double t)
+/// now: between them the morph is under way), and each region's bounds (regionBounds).
+void drawTiming(render::Image& image, const render::Camera& camera, const Scene& scene, double t,
+                const std::vector<std::pair<Vec3d, Vec3d>>& regions)
 {
     const TimingSettings& timing = scene.timing;
     if (timing.spread == 0.0) return;
@@ -106,25 +124,16 @@ void drawTiming(render::Image& image, const render::Camera& camera, const Scene&
         if (const double done = t - (1.0 - timing.spread); done >= 0.0)
             drawSquare(image, camera, at(done), dir, sweep->length, kFinishing);
     }
-    for (const TimingRegionSpec& region : scene.timingRegions) {
-        const ObjectSpec& shape = region.shape;
-        std::pair<Vec3d, Vec3d> box;
-        if (shape.isVolume()) {
-            const VolumeFileInfo info = inspectVolume(shape.volumeSource());
-            box = {info.worldMin, info.worldMax};
-        } else {
-            box = importMesh(shape.mesh, shape.transform, shape.fileWhere).bounds();
-        }
+    for (const auto& [lo, hi] : regions)
         for (int e = 0; e < 12; ++e) { // the box's edges: 4 along each axis
             const int axis = e / 4, a = (axis + 1) % 3, b = (axis + 2) % 3;
-            Vec3d p = box.first, q;
-            if (e & 1) p[a] = box.second[a];
-            if (e & 2) p[b] = box.second[b];
-            q = p;
-            q[axis] = box.second[axis];
+            Vec3d p = lo;
+            if (e & 1) p[a] = hi[a];
+            if (e & 2) p[b] = hi[b];
+            Vec3d q = p;
+            q[axis] = hi[axis];
             render::drawSegment(image, camera, p, q, kRegion, 1);
         }
-    }
 }
 
 void writeImage(const render::Image& image, const std::string& path, const render::Camera& camera,
@@ -188,6 +197,7 @@ int runPreview(const PreviewArgs& args)
     std::vector<render::Image> images;
     std::vector<std::string> labels;
     bool labelsDrawn = true;
+    const auto regions = drawPairs ? regionBounds(scene) : std::vector<std::pair<Vec3d, Vec3d>>{};
     FrameLoop loop(scene, frames, 1, args.quiet, false, interrupter);
     loop.run([&](const FrameStep& step) {
         render::Image image =
@@ -198,7 +208,7 @@ int runPreview(const PreviewArgs& args)
             labelsDrawn =
                 drawFeatures(image, atSize.camera(step.frame), scene, step.t, args.sides) &&
                 labelsDrawn;
-            drawTiming(image, atSize.camera(step.frame), scene, step.t);
+            drawTiming(image, atSize.camera(step.frame), scene, step.t, regions);
         }
         char label[64];
         std::snprintf(label, sizeof label, "frame %d  t=%.3f", step.frame, step.t);

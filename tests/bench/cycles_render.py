@@ -81,6 +81,22 @@ def parse():
     return p.parse_args(argv)
 
 
+def albedo_times(nodes, links, albedo, attribute, socket):
+    """Sets `socket` to the albedo, times the colour attribute `attribute` when one is named."""
+    a = albedo
+    if not attribute:
+        socket.default_value = (a, a, a, 1.0)
+        return
+    attr = nodes.new("ShaderNodeAttribute")
+    attr.attribute_name = attribute
+    mix = nodes.new("ShaderNodeMixRGB")
+    mix.blend_type = "MULTIPLY"
+    mix.inputs["Fac"].default_value = 1.0
+    mix.inputs["Color2"].default_value = (a, a, a, 1.0)
+    links.new(attr.outputs["Color"], mix.inputs["Color1"])
+    links.new(mix.outputs["Color"], socket)
+
+
 def volume_object(args):
     bpy.ops.object.volume_import(filepath=args.vdb, align="WORLD", location=(0, 0, 0))
     obj = bpy.context.selected_objects[0]
@@ -97,18 +113,7 @@ def volume_object(args):
     pv.inputs["Density Attribute"].default_value = args.grid
     pv.inputs["Absorption Color"].default_value = (0.0, 0.0, 0.0, 1.0)
     pv.inputs["Anisotropy"].default_value = args.anisotropy
-    a = args.albedo
-    if args.color_grid:
-        attr = nodes.new("ShaderNodeAttribute")
-        attr.attribute_name = args.color_grid
-        mix = nodes.new("ShaderNodeMixRGB")
-        mix.blend_type = "MULTIPLY"
-        mix.inputs["Fac"].default_value = 1.0
-        mix.inputs["Color2"].default_value = (a, a, a, 1.0)
-        links.new(attr.outputs["Color"], mix.inputs["Color1"])
-        links.new(mix.outputs["Color"], pv.inputs["Color"])
-    else:
-        pv.inputs["Color"].default_value = (a, a, a, 1.0)
+    albedo_times(nodes, links, args.albedo, args.color_grid, pv.inputs["Color"])
     links.new(pv.outputs["Volume"], out.inputs["Volume"])
     obj.data.materials.append(mat)
     if args.velocity_grid:
@@ -170,19 +175,10 @@ def surface_object(args):
     nodes, links = mat.node_tree.nodes, mat.node_tree.links
     bsdf = nodes.new("ShaderNodeBsdfDiffuse")
     bsdf.inputs["Roughness"].default_value = 0.0
-    a = args.albedo
-    bsdf.inputs["Color"].default_value = (a, a, a, 1.0)
     if colours:
         attribute = mesh.attributes.new("Col", "FLOAT_COLOR", "POINT")
         attribute.data.foreach_set("color", [v for c in colours for v in (c[0], c[1], c[2], 1.0)])
-        attr = nodes.new("ShaderNodeAttribute")
-        attr.attribute_name = "Col"
-        mix = nodes.new("ShaderNodeMixRGB")
-        mix.blend_type = "MULTIPLY"
-        mix.inputs["Fac"].default_value = 1.0
-        mix.inputs["Color2"].default_value = (a, a, a, 1.0)
-        links.new(attr.outputs["Color"], mix.inputs["Color1"])
-        links.new(mix.outputs["Color"], bsdf.inputs["Color"])
+    albedo_times(nodes, links, args.albedo, "Col" if colours else "", bsdf.inputs["Color"])
     links.new(bsdf.outputs["BSDF"], nodes["Material Output"].inputs["Surface"])
     obj.data.materials.append(mat)
 

@@ -4,27 +4,16 @@
 // the landmark, and the in-between is made again (a new correspondence) with no request refused.
 // Leaves a screenshot, editor-surface.png, in OUT_DIR.
 // usage: node editor_surface.mjs URL OUT_DIR
-import { createRequire } from 'node:module';
 import path from 'node:path';
-import { fileURLToPath } from 'node:url';
 
-const here = path.dirname(fileURLToPath(import.meta.url));
-const require = createRequire(path.join(here, '../../tools/editor/web/package.json'));
-const { chromium } = require('playwright-core');
+import { openPage } from './chromium.mjs';
 
 const [url, out] = process.argv.slice(2);
 const fail = (message) => { console.error(`editor_surface: ${message}`); process.exit(1); };
 if (!url || !out) fail('usage: node editor_surface.mjs URL OUT_DIR');
 
-const browser = await chromium.launch({
-  executablePath: process.env.CHROMIUM || '/usr/bin/chromium',
-  args: ['--use-angle=swiftshader', '--enable-unsafe-swiftshader', '--no-sandbox', '--font-render-hinting=none'],
-});
+const { browser, page, problems } = await openPage();
 try {
-  const page = await browser.newPage({ viewport: { width: 1280, height: 720 }, deviceScaleFactor: 1 });
-  const problems = [];
-  page.on('pageerror', (e) => problems.push(`page error: ${e.message}`));
-  page.on('response', (r) => { if (r.status() >= 400) problems.push(`${r.status()}: ${r.url()}`); });
   await page.goto(url);
   await page.waitForFunction(() => window.volmorphEditor && window.volmorphEditor.ready, null, { timeout: 120000 });
   const state = await page.evaluate(() => window.volmorphEditor.state());

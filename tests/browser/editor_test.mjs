@@ -3,13 +3,9 @@
 // screenshot of the loaded page, select pair 2, drag its target origin with the gizmo, save.
 // Prints one JSON line: {"dragToMeshMs", "morphUpdates", ...}. Exit 0 when every step passed.
 // usage: node editor_test.mjs URL OUT_DIR [DRAGS]
-import { createRequire } from 'node:module';
 import path from 'node:path';
-import { fileURLToPath } from 'node:url';
 
-const here = path.dirname(fileURLToPath(import.meta.url));
-const require = createRequire(path.join(here, '../../tools/editor/web/package.json'));
-const { chromium } = require('playwright-core');
+import { openPage } from './chromium.mjs';
 
 const [url, out, dragCount = '1'] = process.argv.slice(2);
 const fail = (message) => { console.error(`editor_test: ${message}`); process.exit(1); };
@@ -77,16 +73,8 @@ async function otherEdits(page) {
   await page.waitForFunction((u) => window.volmorphEditor.morphUpdates > u, updates, { timeout: 30000 });
 }
 
-const browser = await chromium.launch({
-  executablePath: process.env.CHROMIUM || '/usr/bin/chromium',
-  args: ['--use-angle=swiftshader', '--enable-unsafe-swiftshader', '--no-sandbox', '--font-render-hinting=none'],
-});
+const { browser, page, problems } = await openPage();
 try {
-  const page = await browser.newPage({ viewport: { width: 1280, height: 720 }, deviceScaleFactor: 1 });
-  const problems = [];
-  page.on('pageerror', (e) => problems.push(`page error: ${e.message}`));
-  page.on('console', (m) => { if (m.type() === 'error') problems.push(`console: ${m.text()}`); });
-  page.on('response', (r) => { if (r.status() >= 400) problems.push(`${r.status()}: ${r.url()}`); });
   await page.goto(url);
   // The printed URL's token went into the session's cookie: the page's own URL carries none.
   if (new URL(page.url()).search !== '') fail(`the page's URL still carries the token: ${page.url()}`);
