@@ -6,7 +6,8 @@
 // s a ramp from 0 at u = 0 to 1 at u = 1, linear but over its first and last tenth, where it is
 // quadratic (C1); then each region in order overrides it inside itself: d = (1 - w) d + w start,
 // w = 1 inside the region's surface and falling to 0 at `softness` world units outside it
-// (smoothstep of the signed distance: C1; softness 0 is a hard edge, with no derivative there).
+// (smoothstep of the signed distance, read through the quadratic B-spline of the level set's
+// voxels: C1, its gradient exact; softness 0 is a hard edge, with no derivative there).
 #pragma once
 
 #include <volmorph/TimingSettings.h>
@@ -60,6 +61,9 @@ public:
     LocalTau fromDelay(const Delay& delay, double t) const;
     /// The largest |grad d| anywhere (per world unit): a bound for Lipschitz arguments.
     double maxDelayGradient() const;
+    /// True when tau(., t) is clamped (0: not begun, or 1: done) everywhere within `radius` world
+    /// units of x, by the delay at x and maxDelayGradient(); its value into `tau`.
+    bool clampedWithin(const Vec3d& x, double radius, double t, double& tau) const;
 
 private:
     double mSpread = 0.0;

@@ -25,6 +25,7 @@ namespace volmorph {
 namespace detail {
 class Occupancy;
 class BlendMethod;
+struct TauTable;
 } // namespace detail
 
 struct MorphOptions {
@@ -48,7 +49,8 @@ struct MorphOptions {
     /// Variational mode's influence shapes (SceneVolumes::influences), on the sides' transform.
     std::vector<TimedVolume> influences;
     /// Where the morph happens when ([timing]); null or inactive: everywhere at once. Density and
-    /// sdf modes without pairs honour it (the scene refuses the rest).
+    /// sdf modes honour it, the warp too (each place at its local time: src/warp/TimedWarp.h);
+    /// the variational method does not (the scene refuses it).
     std::shared_ptr<const LocalTime> localTime;
 };
 
@@ -98,7 +100,8 @@ public:
                            MorphStats* stats = nullptr) const;
 
     /// The index-space box the output at t can occupy: the active bounds of source and target,
-    /// mapped by every pair's affine map (each pair alone is affine), all together, plus a margin.
+    /// mapped by every pair's affine map (each pair alone is affine), all together, plus a margin;
+    /// under a timing, the union of those at every local time the warp's table holds.
     openvdb::CoordBBox candidateBounds(double t) const;
 
     const VolumeSet& source() const { return mSource; }
@@ -107,6 +110,12 @@ public:
 private:
     VolumeSet run(double t, const openvdb::CoordBBox& box, bool prune, double tolerance,
                   MorphStats* stats, Interrupter* interrupter) const;
+    /// candidateBounds() with every place at t.
+    openvdb::CoordBBox boundsAt(double t) const;
+    /// True under an active timing.
+    bool timed() const;
+    /// The warp's table over local time, under a timing with pairs (else none).
+    void tabulate();
 
     VolumeSet mSource, mTarget;
     /// The blend method (with what it keeps across frames: sdf mode's extended distances).
@@ -114,6 +123,8 @@ private:
     /// Which 8^3 blocks of source and target are occupied; they do not change with t.
     std::shared_ptr<const detail::Occupancy> mSourceBlocks, mTargetBlocks;
     std::vector<FeaturePairSpec> mPairs;
+    /// Under a timing with pairs: the warp's levels over local time (warp/TimedWarp.h).
+    std::shared_ptr<const detail::TauTable> mTauTable;
     WarpSpec mWarp;
     BlendSpec mBlend;
     MorphOptions mOptions;

@@ -7,7 +7,7 @@
 #pragma once
 
 #include "blend/OutputLeaves.h"
-#include "warp/AdaptiveWarp.h"
+#include "warp/FrameWarp.h"
 
 #include <volmorph/core/Interrupter.h>
 #include <volmorph/BlendSettings.h>
@@ -44,8 +44,8 @@ struct BlendRequest {
     openvdb::CoordBBox box;       ///< the candidate domain (output index space)
     bool prune = true;            ///< false: every voxel of the box (the tests' reference)
     double toleranceVoxels = 0.0; ///< the approximated warp's error bound
-    const InverseWarp* warp = nullptr;
-    const AdaptiveWarp* adaptive = nullptr;
+    /// The frame's warp: at t, or at each place's local time under a timing (warp/FrameWarp.h).
+    const FrameWarp* warp = nullptr;
     /// The sides' occupied blocks, to skip leaves whose image misses both (null: none skipped).
     const Occupancy* sourceBlocks = nullptr;
     const Occupancy* targetBlocks = nullptr;

@@ -42,6 +42,14 @@ public:
     /// A bound on |grad tau| per index unit anywhere (0 when uniform).
     float maxGradient() const { return mMaxGradient; }
 
+    /// True when tau is clamped (not begun, or done) everywhere within `radius` voxels of index
+    /// point ijk (never without a timing).
+    bool clampedNear(const Vec3d& ijk, double radius) const
+    {
+        double tau;
+        return mLocal && mLocal->clampedWithin(mXform.indexToWorld(ijk), radius * mVoxel, mT, tau);
+    }
+
     /// The delay at index point ijk (for several schedules at one voxel: delayAt, then fromDelay).
     Delay delayAt(const Vec3d& ijk) const
     {

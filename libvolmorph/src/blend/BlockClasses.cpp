@@ -75,7 +75,8 @@ std::vector<float> leafStretch(const std::vector<Vec3d>& ps, const std::vector<V
                         norm(diff(ps, x, y, z, 0), diff(ps, x, y, z, 1), diff(ps, x, y, z, 2));
                     const double t =
                         norm(diff(pt, x, y, z, 0), diff(pt, x, y, z, 1), diff(pt, x, y, z, 2));
-                    own[index(x, y, z)] = float((1.0 - tau) * s + tau * t);
+                    own[index(x, y, z)] =
+                        float(tau < 0.0f ? std::max(s, t) : (1.0 - tau) * s + tau * t);
                 }
     });
     std::vector<float> stretch = neighbourhoodMax(own, n);

@@ -38,11 +38,11 @@ std::vector<float> neighbourhoodMax(const std::vector<float>& values, const open
 
 /// The warp's stretch per block of a box of `dim` blocks `spacing` voxels apart, from the warped
 /// centres `ps`, `pt` of its blocks (indexed as BlockClasses::index does; index space) blended by
-/// `tau`: the spectral norm of the Jacobian by differences between neighbouring centres, the
-/// largest over the 3^3 neighbourhood, with a margin of 1.25 for what varies between centres,
-/// and at least 1. `known`, unless empty: the blocks whose centres were warped (differences are
-/// one-sided beside the others, and a block with neither neighbour known along an axis has none
-/// along it).
+/// `tau` (the larger of both sides' where tau is negative: under a timing, each place its own): the
+/// spectral norm of the Jacobian by differences between neighbouring centres, the largest over the
+/// 3^3 neighbourhood, with a margin of 1.25 for what varies between centres, and at least 1.
+/// `known`, unless empty: the blocks whose centres were warped (differences are one-sided beside
+/// the others, and a block with neither neighbour known along an axis has none along it).
 std::vector<float> leafStretch(const std::vector<Vec3d>& ps, const std::vector<Vec3d>& pt,
                                const openvdb::Coord& dim, float tau, double spacing = 8.0,
                                const std::vector<uint8_t>& known = {});

@@ -98,13 +98,12 @@ public:
         const openvdb::math::Transform& xform = mSource.density->transform();
         const BlendTime densityTime(mSpec.density, r.t, r.localTime, xform);
         const BlendTime colorTime(mSpec.color, r.t, r.localTime, xform);
-        const float tauD = densityTime.atAll().tau;
         const Resampler<Sampler> resample{mSource, mTarget, densityTime, colorTime,
                                           leaves.background()};
         const ExtraGrids extras(mSource, mTarget, mSpec, r.t, r.localTime);
-        const VelocityBlend velocity(*r.warp, r.velocityScale, tauD);
+        const VelocityBlend velocity(*r.warp, r.velocityScale, densityTime);
         BlendedFrame out;
-        r.adaptive->forEachLeaf(
+        r.warp->forEachLeaf(
             r.box, r.sourceBlocks, r.targetBlocks,
             [&](const WarpLeaf& w) {
                 // A uniform interior is one tile (without `vel`: any velocity transports a

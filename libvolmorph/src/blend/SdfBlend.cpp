@@ -183,7 +183,7 @@ private:
         const AdaptiveWarp::CellFilter wanted = [&classes](const CoordBBox& cells) {
             return classes.anyToEvaluate(cells);
         };
-        r.adaptive->forEachLeaf(
+        r.warp->forEachLeaf(
             r.box, nullptr, nullptr,
             [&](const WarpLeaf& w) {
                 auto [value, color] = leaves.make(w.origin, band);

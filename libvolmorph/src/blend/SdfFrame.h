@@ -9,7 +9,7 @@
 #include "blend/ExtendedDistance.h"
 #include "blend/IdentityDistances.h"
 #include "blend/Redistance.h"
-#include "warp/AdaptiveWarp.h"
+#include "warp/FrameWarp.h"
 
 #include <volmorph/Voxelize.h>
 #include <volmorph/Warp.h>
@@ -38,7 +38,7 @@ public:
     /// sdfTime, colorTime: the distance's and the colour's schedules at each voxel (uniform
     /// without a timing).
     SdfFrame(const VolumeSet& source, const VolumeSet& target, const ExtendedDistance& farSource,
-             const ExtendedDistance& farTarget, const InverseWarp& warp, const BlendTime& sdfTime,
+             const ExtendedDistance& farTarget, const FrameWarp& warp, const BlendTime& sdfTime,
              const BlendTime& colorTime, Vec3f background, double toleranceVoxels)
         : mSource(source), mTarget(target), mFarSource(farSource), mFarTarget(farTarget),
           mWarp(warp), mSdfTime(sdfTime), mColorTime(colorTime), mTau(sdfTime.atAll().tau),
@@ -63,7 +63,9 @@ public:
         const size_t count = size_t(n.x()) * n.y() * n.z();
         const bool warped = mWarp.pairCount() > 0;
         // With pairs, blocks of leaves first: only the leaves near the band are warped one by one.
-        const CoarseBlocks coarse = prune && warped && !identity ? coarseBlocks() : CoarseBlocks{};
+        // (Not under a timing: a block's tau varies more than its centre says.)
+        const CoarseBlocks coarse =
+            prune && warped && !identity && mSdfTime.uniform() ? coarseBlocks() : CoarseBlocks{};
         const std::vector<uint8_t> wanted =
             coarse.empty() ? std::vector<uint8_t>{} : coarse.wanted(n);
         std::vector<Vec3d> ps, pt; // the warped centres (with pairs)
@@ -73,7 +75,8 @@ public:
         mSamples += wanted.empty() ? count : size_t(std::count(wanted.begin(), wanted.end(), 1));
         // The warp's stretch per leaf; the identity's is 1 exactly.
         std::vector<float> stretch =
-            warped ? leafStretch(ps, pt, n, mTau, 8.0, wanted) : std::vector<float>(count, 1.0f);
+            warped ? leafStretch(ps, pt, n, mSdfTime.uniform() ? mTau : -1.0f, 8.0, wanted)
+                   : std::vector<float>(count, 1.0f);
         addTimingStretch(stretch, apart);
         c.maxStretch = 1.0;
         for (size_t i = 0; i < count; ++i)
@@ -445,20 +448,32 @@ private:
     /// With a timing, tau varies over a leaf, and the blend with it: |grad phi| <= G + |grad tau|
     /// |d_T - d_S| per voxel, where |d_T - d_S| is at most its value at the centre plus 2 G per
     /// voxel out to the leaf's corners (3.5 sqrt(3) voxels), and |grad tau| at most the timing's
-    /// bound. The leaf's stretch becomes that bound: its bands and limits widen with it.
+    /// bound (0 where tau is clamped over the whole leaf: not begun, or done). The leaf's stretch
+    /// becomes that bound: its bands and limits widen with it.
     void addTimingStretch(std::vector<float>& stretch, const std::vector<float>& apart) const
     {
         const float g = mSdfTime.maxGradient();
         if (g == 0.0f) return;
-        for (size_t i = 0; i < stretch.size(); ++i)
-            stretch[i] += g * (apart[i] / mVoxel + 2.0f * stretch[i] * 3.5f * kSqrt3);
+        const openvdb::Coord n = mClasses.leaves.dim();
+        tbb::parallel_for(
+            tbb::blocked_range<size_t>(0, stretch.size()),
+            [&](const tbb::blocked_range<size_t>& r) {
+                for (size_t i = r.begin(); i != r.end(); ++i) {
+                    const openvdb::Coord leaf = mClasses.leaves.min().offsetBy(
+                        int(i / (size_t(n.y()) * n.z())), int(i / size_t(n.z()) % size_t(n.y())),
+                        int(i % size_t(n.z())));
+                    const Vec3d centre = leaf.asVec3d() * 8.0 + Vec3d(3.5);
+                    if (mSdfTime.clampedNear(centre, 3.5 * kSqrt3)) continue;
+                    stretch[i] += g * (apart[i] / mVoxel + 2.0f * stretch[i] * 3.5f * kSqrt3);
+                }
+            });
     }
 
     const VolumeSet& mSource;
     const VolumeSet& mTarget;
     const ExtendedDistance& mFarSource;
     const ExtendedDistance& mFarTarget;
-    const InverseWarp& mWarp;
+    const FrameWarp& mWarp;
     const BlendTime& mSdfTime;
     const BlendTime& mColorTime;
     float mTau, mTauColor; ///< without a timing, every voxel's

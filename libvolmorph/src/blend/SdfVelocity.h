@@ -34,10 +34,10 @@ public:
     /// worldPerSecond: world units per second of one index unit per unit t; time: the distance
     /// schedule's tau at each voxel (it must outlive this); rampWorld: the fog's ramp, voxelSize:
     /// the output's voxel (world units).
-    SdfVelocity(const InverseWarp& warp, double worldPerSecond, const BlendTime& time,
+    SdfVelocity(const FrameWarp& warp, double worldPerSecond, const BlendTime& time,
                 float rampWorld, float voxelSize)
-        : mBlend(warp, worldPerSecond, time.atAll().tau), mScale(float(worldPerSecond)),
-          mTime(time), mRamp(rampWorld), mShell(rampWorld + 2.0f * voxelSize)
+        : mBlend(warp, worldPerSecond, time), mScale(float(worldPerSecond)), mTime(time),
+          mRamp(rampWorld), mShell(rampWorld + 2.0f * voxelSize)
     {
     }
 

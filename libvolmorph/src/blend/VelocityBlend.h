@@ -1,11 +1,14 @@
 // The in-between's velocity, the `vel` grid: each side's warp velocity at the output voxel
 // (warp/VelocityLeaf.h), mixed as the density blend weights the sides,
 //   v = ((1 - tau) rho_S v_S + tau rho_T v_T) / ((1 - tau) rho_S + tau rho_T),
-// rho the side's density at its warped point (where both are empty: (1 - tau) v_S + tau v_T).
+// rho the side's density at its warped point (where both are empty: (1 - tau) v_S + tau v_T),
+// tau each voxel's under a timing.
 // World units per second: the warp's index units per unit t, times the voxel size, over the
 // seconds one unit of t lasts.
 #pragma once
 
+#include "blend/BlendTime.h"
+#include "warp/FrameWarp.h"
 #include "warp/VelocityLeaf.h"
 
 #include <openvdb/openvdb.h>
@@ -23,9 +26,10 @@ class VelocityBlend {
 public:
     using Leaf = openvdb::Vec3STree::LeafNodeType;
 
-    /// worldPerSecond: world units per second of one index unit per unit t (0: no velocity).
-    VelocityBlend(const InverseWarp& warp, double worldPerSecond, float tauDensity)
-        : mLeaf(warp), mScale(float(worldPerSecond)), mTau(tauDensity)
+    /// worldPerSecond: world units per second of one index unit per unit t (0: no velocity);
+    /// time: the density schedule's tau at each voxel (it must outlive this, as `warp` must).
+    VelocityBlend(const FrameWarp& warp, double worldPerSecond, const BlendTime& time)
+        : mLeaf(warp.velocities()), mScale(float(worldPerSecond)), mTime(time)
     {
     }
 
@@ -41,9 +45,10 @@ public:
         auto out = std::make_unique<Leaf>(origin, Vec3f(0.0f), false);
         for (auto it = on.beginOn(); it; ++it) {
             const openvdb::Index n = it.pos();
-            const float wa = (1.0f - mTau) * std::max(a[n], 0.0f), wb = mTau * std::max(b[n], 0.0f);
+            const float tau = tauAt(origin, n);
+            const float wa = (1.0f - tau) * std::max(a[n], 0.0f), wb = tau * std::max(b[n], 0.0f);
             const Vec3f v = wa + wb > 0.0f ? (wa * vs[n] + wb * vt[n]) / (wa + wb)
-                                           : (1.0f - mTau) * vs[n] + mTau * vt[n];
+                                           : (1.0f - tau) * vs[n] + tau * vt[n];
             out->setValueOn(n, v * mScale);
         }
         return out;
@@ -58,8 +63,10 @@ public:
     {
         Vec3f vs[512], vt[512];
         mLeaf.fill(origin, on, vs, vt);
-        for (auto it = on.beginOn(); it; ++it)
-            out[it.pos()] = (1.0f - mTau) * vs[it.pos()] + mTau * vt[it.pos()];
+        for (auto it = on.beginOn(); it; ++it) {
+            const float tau = tauAt(origin, it.pos());
+            out[it.pos()] = (1.0f - tau) * vs[it.pos()] + tau * vt[it.pos()];
+        }
     }
     /// World units per second of one index unit per unit t.
     float scale() const { return mScale; }
@@ -95,8 +102,15 @@ public:
     const VelocityLeaf& warpVelocity() const { return mLeaf; }
 
 private:
+    float tauAt(const openvdb::Coord& origin, openvdb::Index n) const
+    {
+        return mTime.uniform() ? mTime.atAll().tau
+                               : mTime.at(origin + Leaf::offsetToLocalCoord(n)).tau;
+    }
+
     VelocityLeaf mLeaf;
-    float mScale, mTau;
+    float mScale;
+    const BlendTime& mTime;
     mutable std::atomic<uint64_t> mInterpolated{0}, mExact{0};
 };
 

@@ -7,6 +7,7 @@
 #include "blend/BlendMethod.h"
 #include "blend/ExtraGrids.h"
 #include "warp/AdaptiveWarp.h"
+#include "warp/TimedWarp.h"
 
 #include <volmorph/core/MemoryLimit.h>
 
@@ -93,10 +94,8 @@ Morpher::Morpher(VolumeSet source, VolumeSet target, std::vector<FeaturePairSpec
         throw std::invalid_argument("Morpher: source and target must share one transform");
     if (!mOptions.memoryLimitBytes) mOptions.memoryLimitBytes = defaultMemoryLimitBytes();
     detail::ExtraGrids::check(mSource, mTarget, mBlend);
-    if (mOptions.localTime && mOptions.localTime->active() &&
-        (!mPairs.empty() || mBlend.mode == BlendMode::Variational))
-        throw std::invalid_argument(
-            "Morpher: a timing is applied in density and sdf modes without pairs only");
+    if (timed() && mBlend.mode == BlendMode::Variational)
+        throw std::invalid_argument("Morpher: a timing is applied in density and sdf modes only");
     mSourceBlocks = std::make_shared<const detail::Occupancy>(mSource.density->tree());
     mTargetBlocks = std::make_shared<const detail::Occupancy>(mTarget.density->tree());
     const detail::BlendSetup setup{mSource,
@@ -111,6 +110,24 @@ Morpher::Morpher(VolumeSet source, VolumeSet target, std::vector<FeaturePairSpec
                                    mOptions.setupInterrupter,
                                    &mOptions.influences};
     mMethod = detail::makeBlendMethod(setup);
+    tabulate();
+}
+
+bool Morpher::timed() const
+{
+    return mOptions.localTime && mOptions.localTime->active();
+}
+
+void Morpher::tabulate()
+{
+    mTauTable.reset();
+    if (!timed() || mPairs.empty()) return;
+    // Sampled over where the output can be, at either end and half way.
+    CoordBBox region = boundsAt(0.0);
+    region.expand(boundsAt(0.5));
+    region.expand(boundsAt(1.0));
+    mTauTable = std::make_shared<const detail::TauTable>(detail::TauTable::make(
+        mPairs, mWarp, 1.0 / mSource.voxelSize(), region, mWarp.toleranceVoxels));
 }
 
 Morpher Morpher::withPairs(std::vector<FeaturePairSpec> pairs) const
@@ -120,10 +137,20 @@ Morpher Morpher::withPairs(std::vector<FeaturePairSpec> pairs) const
         return Morpher(mSource, mTarget, std::move(pairs), mWarp, mBlend, mOptions);
     Morpher other(*this);
     other.mPairs = std::move(pairs);
+    other.tabulate();
     return other;
 }
 
 CoordBBox Morpher::candidateBounds(double t) const
+{
+    if (!mTauTable) return boundsAt(t);
+    // Under a timing a place can be at any local time: every level's.
+    CoordBBox box;
+    for (const double tau : mTauTable->levels) box.expand(boundsAt(tau));
+    return box;
+}
+
+CoordBBox Morpher::boundsAt(double t) const
 {
     // The occupied blocks' bounds and a block more on each side.
     CoordBBox s = mSourceBlocks->bounds(), d = mTargetBlocks->bounds();
@@ -158,15 +185,21 @@ VolumeSet Morpher::frameOverBox(double t, const CoordBBox& box, double tolerance
 VolumeSet Morpher::run(double t, const CoordBBox& box, bool prune, double tolerance,
                        MorphStats* stats, Interrupter* interrupter) const
 {
-    const InverseWarp warp(mPairs, mWarp, t, 1.0 / mSource.voxelSize());
-    const detail::AdaptiveWarp adaptive(warp, tolerance);
+    const double unit = 1.0 / mSource.voxelSize();
+    const InverseWarp warp(mPairs, mWarp, t, unit);
+    std::unique_ptr<const detail::FrameWarp> frameWarp;
+    if (mTauTable)
+        frameWarp = std::make_unique<const detail::TimedWarp>(
+            mPairs, mWarp, unit, *mTauTable, *mOptions.localTime, mSource.density->transform(), t,
+            tolerance);
+    else
+        frameWarp = std::make_unique<const detail::PlainWarp>(warp, tolerance);
     detail::BlendRequest request;
     request.t = t;
     request.box = box;
     request.prune = prune;
     request.toleranceVoxels = tolerance;
-    request.warp = &warp;
-    request.adaptive = &adaptive;
+    request.warp = frameWarp.get();
     request.sourceBlocks = prune ? mSourceBlocks.get() : nullptr;
     request.targetBlocks = prune ? mTargetBlocks.get() : nullptr;
     request.interrupter = interrupter;

@@ -72,11 +72,10 @@ public:
         if (const toml::node* n = root.get("timing")) {
             detail::parseTiming(r, *n, mScene.folder, mScene.timing, mScene.timingRegions);
             const BlendMode mode = mScene.blend.mode;
-            if (mode == BlendMode::Variational || mode == BlendMode::Surface ||
-                !mScene.pairs.empty())
+            if (mode == BlendMode::Variational || mode == BlendMode::Surface)
                 r.error(mScene.timing.where,
-                        "[timing]: not yet applied with feature pairs, in variational mode or to "
-                        "surface morphs; density and sdf modes without [[pair]]s take it");
+                        "[timing]: not yet applied in variational mode or to surface morphs; "
+                        "density and sdf modes take it");
         }
         if (const toml::node* n = root.get("render"))
             detail::parseRender(r, *n, mScene.folder, mScene.render);

@@ -150,6 +150,11 @@ public:
                      AdaptiveWarpStats* stats = nullptr, Interrupter* interrupter = nullptr,
                      const CellFilter* wanted = nullptr) const;
 
+    /// Calls fn, in parallel, for each of `leaves` (their origins, output index space), none
+    /// culled: the traversal's lattice and fill for a list made elsewhere (TimedWarp.h).
+    void fillLeaves(const std::vector<openvdb::Coord>& leaves, const LeafFunction& fn,
+                    AdaptiveWarpStats* stats = nullptr, Interrupter* interrupter = nullptr) const;
+
     /// Leaves are first gathered in cells this many voxels on a side (filtered, and culled by the
     /// hull of every pair's affine image).
     static constexpr int kTopCell = 64;

@@ -168,7 +168,59 @@ VOLMORPH_ALWAYS_INLINE inline v8i quotientRule(const Sums& sums, Vec3d* v[2], v8
     return bad;
 }
 
+/// Every pair's terms at the 8 points y (relative to the reference) into `sums`; returns the lanes
+/// too near an element for single precision.
+VOLMORPH_ALWAYS_INLINE inline v8i addPairs(const std::vector<VelocityKernel::Pair>& pairs,
+                                           const InverseWarp& warp, const v8f y[3], float near,
+                                           Sums& sums)
+{
+    for (v8f& v : sums.v) v = v8f{};
+    v8i tooNear = v8i{};
+    for (size_t i = 0; i < pairs.size(); ++i) {
+        const PairTerms terms(pairs[i], y, warp, i, near);
+        tooNear |= terms.tooNear;
+        terms.addTo(sums, pairs[i], y);
+    }
+    return tooNear;
+}
+
+/// Both sides' points (p~ = P / W, relative to the output point) and Jacobians at each lane from
+/// the sums; returns the lanes without a finite positive weight.
+VOLMORPH_ALWAYS_INLINE inline v8i jetsFromSums(const Sums& sums, const Vec3d p[8],
+                                               VelocityKernel::Jet out[8])
+{
+    const v8f* S = sums.v;
+    const v8f W = S[Sums::W], one = splat8(1.0f);
+    const v8i bad = !(W > 0.0f && W < std::numeric_limits<float>::infinity());
+    const v8f invW = one / (bad ? one : W);
+    for (int s = 0; s < 2; ++s) {
+        const v8f* side = S + Sums::Side + Sums::PerSide * s;
+        for (int a = 0; a < 3; ++a) {
+            const v8f mean = side[Sums::P + a] * invW;
+            for (int l = 0; l < 8; ++l) out[l].point[s][a] = p[l][a] + double(mean[l]);
+            for (int b = 0; b < 3; ++b) {
+                const v8f j = (side[Sums::M + 3 * a + b] - mean * S[Sums::Grad + b]) * invW;
+                for (int l = 0; l < 8; ++l) out[l].jacobian[s](a, b) = double(j[l]);
+            }
+        }
+    }
+    return bad;
+}
+
 } // namespace
+
+VOLMORPH_ALWAYS_INLINE inline int VelocityKernel::eightJetsBody(const Vec3d p[8], Jet out[8]) const
+{
+    const float near = float(std::max(mExactWithin, InverseWarp::kOnElement));
+    v8f y[3];
+    for (int a = 0; a < 3; ++a)
+        for (int l = 0; l < 8; ++l) y[a][l] = float(p[l][a] - mReference[a]);
+    Sums sums;
+    const v8i bad = addPairs(mPairs, mWarp, y, near, sums) | jetsFromSums(sums, p, out);
+    int lanes = 0;
+    for (int l = 0; l < 8; ++l) lanes |= (bad[l] ? 1 : 0) << l;
+    return lanes;
+}
 
 VOLMORPH_ALWAYS_INLINE inline int VelocityKernel::eightBody(const Vec3d p[8], Vec3d s[8],
                                                             Vec3d t[8], int& folds) const
@@ -178,13 +230,7 @@ VOLMORPH_ALWAYS_INLINE inline int VelocityKernel::eightBody(const Vec3d p[8], Ve
     for (int a = 0; a < 3; ++a)
         for (int l = 0; l < 8; ++l) y[a][l] = float(p[l][a] - mReference[a]);
     Sums sums;
-    for (v8f& v : sums.v) v = v8f{};
-    v8i tooNear = v8i{};
-    for (size_t i = 0; i < mPairs.size(); ++i) {
-        const PairTerms terms(mPairs[i], y, mWarp, i, near);
-        tooNear |= terms.tooNear;
-        terms.addTo(sums, mPairs[i], y);
-    }
+    const v8i tooNear = addPairs(mPairs, mWarp, y, near, sums);
     Vec3d* v[2] = {s, t};
     v8i fold[2];
     const v8i bad = tooNear | quotientRule(sums, v, fold);
@@ -199,6 +245,14 @@ VOLMORPH_ALWAYS_INLINE inline int VelocityKernel::eightBody(const Vec3d p[8], Ve
 }
 
 #ifdef VOLMORPH_HAVE_AVX2_KERNEL
+VOLMORPH_AVX2 int VelocityKernel::eightJetsAvx2(const Vec3d p[8], Jet out[8]) const
+{
+    return eightJetsBody(p, out);
+}
+VOLMORPH_AVX512 int VelocityKernel::eightJetsAvx512(const Vec3d p[8], Jet out[8]) const
+{
+    return eightJetsBody(p, out);
+}
 VOLMORPH_AVX2 int VelocityKernel::eightAvx2(const Vec3d p[8], Vec3d s[8], Vec3d t[8],
                                             int& folds) const
 {
@@ -210,6 +264,39 @@ VOLMORPH_AVX512 int VelocityKernel::eightAvx512(const Vec3d p[8], Vec3d s[8], Ve
     return eightBody(p, s, t, folds);
 }
 #endif
+
+int VelocityKernel::eightJetsBaseline(const Vec3d p[8], Jet out[8]) const
+{
+    return eightJetsBody(p, out);
+}
+
+int VelocityKernel::eightJets(const Vec3d p[8], Jet out[8]) const
+{
+    return (this->*pickBuild(mBuild, VOLMORPH_BUILDS(&VelocityKernel::eightJets)))(p, out);
+}
+
+void VelocityKernel::jets(const Vec3d* p, size_t n, Jet* out) const
+{
+    auto scalar = [&](const Vec3d& point, Jet& jet) {
+        InverseWarp::Derivatives d[2];
+        mWarp.map(point, jet.point[0], jet.point[1]);
+        mWarp.derivatives(point, d[0], d[1]);
+        for (int s = 0; s < 2; ++s) jet.jacobian[s] = d[s].jacobian;
+    };
+    for (size_t first = 0; first < n; first += 8) {
+        const size_t count = std::min<size_t>(8, n - first);
+        Vec3d points[8];
+        Jet lanes[8];
+        for (size_t l = 0; l < 8; ++l) points[l] = p[first + std::min(l, count - 1)];
+        const int doubled = mPairs.empty() ? 0xff : eightJets(points, lanes);
+        for (size_t l = 0; l < count; ++l) {
+            if (doubled & (1 << l))
+                scalar(points[l], out[first + l]);
+            else
+                out[first + l] = lanes[l];
+        }
+    }
+}
 
 int VelocityKernel::eightBaseline(const Vec3d p[8], Vec3d s[8], Vec3d t[8], int& folds) const
 {

@@ -22,23 +22,43 @@
 
 #include "warp/AdaptiveWarp.h"
 
+#include <openvdb/math/Mat3.h>
+
 #include <volmorph/Warp.h>
 
 #include <vector>
 
 namespace volmorph::detail {
 
-class VelocityKernel {
+/// Both sides' warp velocities at points (output index space): what VelocityLeaf interpolates.
+class PointVelocities {
+public:
+    virtual ~PointVelocities() = default;
+    /// Both sides' velocities -J^-1 dW/dt at the n points p (the warp's units per unit t);
+    /// `regular` false where J is singular (a fold: the velocity is 0).
+    virtual void velocities(const Vec3d* p, size_t n, Vec3d* source, Vec3d* target,
+                            bool* regular) const = 0;
+};
+
+class VelocityKernel final : public PointVelocities {
 public:
     /// exactWithin: the d + offset (warp units) under which a point is evaluated in double
     /// precision. limit: the most capable build to use (for tests; the CPU may allow less).
     VelocityKernel(const InverseWarp& warp, double exactWithin,
                    KernelBuild limit = KernelBuild::Avx512);
 
-    /// Both sides' velocities -J^-1 dW/dt at the n points p (the warp's units per unit t), as
-    /// InverseWarp::derivatives and InverseWarp::velocity give them; `regular` false where J is
-    /// singular (a fold: the velocity is 0).
-    void velocities(const Vec3d* p, size_t n, Vec3d* source, Vec3d* target, bool* regular) const;
+    /// As InverseWarp::derivatives and InverseWarp::velocity give them.
+    void velocities(const Vec3d* p, size_t n, Vec3d* source, Vec3d* target,
+                    bool* regular) const override;
+
+    /// Both sides' warped points and Jacobians at a point (the warp's units), as InverseWarp::map
+    /// and ::derivatives give them: what TimedWarp blends between its levels.
+    struct Jet {
+        Vec3d point[2];
+        openvdb::math::Mat3d jacobian[2];
+    };
+    /// The jets at the n points.
+    void jets(const Vec3d* p, size_t n, Jet* out) const;
 
     /// One pair's quantities at t (WarpDerivatives.cpp's names), points relative to the kernel's
     /// reference point x0.
@@ -68,6 +88,12 @@ private:
     int eightAvx2(const Vec3d p[8], Vec3d s[8], Vec3d t[8], int& folds) const;
     int eightAvx512(const Vec3d p[8], Vec3d s[8], Vec3d t[8], int& folds) const;
     int eightBody(const Vec3d p[8], Vec3d s[8], Vec3d t[8], int& folds) const;
+    /// Jets at 8 points; returns a bit per point that needs the double path.
+    int eightJets(const Vec3d p[8], Jet out[8]) const;
+    int eightJetsBaseline(const Vec3d p[8], Jet out[8]) const;
+    int eightJetsAvx2(const Vec3d p[8], Jet out[8]) const;
+    int eightJetsAvx512(const Vec3d p[8], Jet out[8]) const;
+    int eightJetsBody(const Vec3d p[8], Jet out[8]) const;
 
     const InverseWarp& mWarp;
     Vec3d mReference;

@@ -117,7 +117,7 @@ struct Batch {
         return n++;
     }
     /// Evaluates the points; false if any lies on a fold.
-    bool run(const VelocityKernel& kernel)
+    bool run(const PointVelocities& kernel)
     {
         kernel.velocities(p, size_t(n), v[0], v[1], ok);
         return std::all_of(ok, ok + n, [](bool b) { return b; });
@@ -137,7 +137,7 @@ void VelocityLeaf::fillExact(const openvdb::Coord& origin, const openvdb::util::
             const openvdb::Index n = it.pos();
             voxels[batch.add(at(origin, int(n >> 6), int((n >> 3) & 7), int(n & 7)))] = n;
         }
-        batch.run(mKernel);
+        batch.run(mPoints);
         for (int i = 0; i < batch.n; ++i) {
             source[voxels[i]] = Vec3f(batch.v[0][i]);
             target[voxels[i]] = Vec3f(batch.v[1][i]);
@@ -162,7 +162,7 @@ void VelocityLeaf::refine(const openvdb::Coord& origin, int c, double speed,
     for (int q = 0; q < 8; ++q)
         batch.add(
             at(origin, ox + 2 * (q >> 2) + 1, oy + 2 * ((q >> 1) & 1) + 1, oz + 2 * (q & 1) + 1));
-    batch.run(mKernel);
+    batch.run(mPoints);
     Vec3d fine[2][3][3][3];
     for (int i = 0; i < 3; ++i)
         for (int j = 0; j < 3; ++j)
@@ -259,7 +259,7 @@ int VelocityLeaf::fill(const openvdb::Coord& origin, const openvdb::util::NodeMa
         const int base = batch.n;
         for (const openvdb::Coord& l : points)
             batch.add(at(origin, 4 * l.x(), 4 * l.y(), 4 * l.z()));
-        if (!batch.run(mKernel)) return false;
+        if (!batch.run(mPoints)) return false;
         for (size_t i = 0; i < points.size(); ++i) {
             const openvdb::Coord& l = points[i];
             for (int s = 0; s < 2; ++s) {

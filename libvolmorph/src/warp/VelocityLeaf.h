@@ -25,6 +25,7 @@
 #include <openvdb/openvdb.h>
 
 #include <cstdint>
+#include <memory>
 
 namespace volmorph::detail {
 
@@ -40,7 +41,13 @@ public:
     /// `warp` maps output index space at the frame's t (built with unit 1 / voxel size).
     /// tolerance: the check's allowed error, relative to the leaf's largest lattice speed.
     explicit VelocityLeaf(const InverseWarp& warp, double tolerance = 2e-3)
-        : mKernel(warp, kExactWithin), mTolerance(tolerance)
+        : mOwned(std::make_shared<const VelocityKernel>(warp, kExactWithin)), mPoints(*mOwned),
+          mTolerance(tolerance)
+    {
+    }
+    /// The same from any warp's velocities at points (a frame's warp under a timing: TimedWarp).
+    explicit VelocityLeaf(const PointVelocities& points, double tolerance = 2e-3)
+        : mPoints(points), mTolerance(tolerance)
     {
     }
 
@@ -62,7 +69,8 @@ private:
     void refine(const openvdb::Coord& origin, int c, double speed, const VelocityLattice& coarse,
                 const openvdb::util::NodeMask<3>& on, Vec3f source[512], Vec3f target[512]) const;
 
-    VelocityKernel mKernel;
+    std::shared_ptr<const VelocityKernel> mOwned; ///< when built from an InverseWarp
+    const PointVelocities& mPoints;
     double mTolerance;
 };
 

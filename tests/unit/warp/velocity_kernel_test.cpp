@@ -146,3 +146,32 @@ TEST(VelocityKernel, VectorAndBaselineBuildsGiveTheSameBits)
         }
     }
 }
+
+TEST(VelocityKernel, ItsJetsAreTheScalarMapAndJacobianInSinglePrecision)
+{
+    // What TimedWarp blends between its levels: each side's point and dW/dp'.
+    std::mt19937 random(13);
+    WarpSpec spec;
+    spec.epsilon = 2.0;
+    const auto pairs = randomPairs(random, 6, 50.0);
+    const InverseWarp warp(pairs, spec, 0.4);
+    const detail::VelocityKernel kernel(warp, 1.0);
+    std::uniform_real_distribution<double> u(0.0, 50.0);
+    std::vector<Vec3d> points(37); // not a multiple of 8
+    for (Vec3d& p : points) p = Vec3d(u(random), u(random), u(random));
+    std::vector<detail::VelocityKernel::Jet> jets(points.size());
+    kernel.jets(points.data(), points.size(), jets.data());
+    for (size_t i = 0; i < points.size(); ++i) {
+        Vec3d s[2];
+        InverseWarp::Derivatives d[2];
+        warp.map(points[i], s[0], s[1]);
+        warp.derivatives(points[i], d[0], d[1]);
+        for (int side = 0; side < 2; ++side) {
+            EXPECT_LT((jets[i].point[side] - s[side]).length(), 1e-4 * 50.0) << i;
+            InverseWarp::Derivatives k;
+            k.jacobian = jets[i].jacobian[side];
+            k.rate = d[side].rate;
+            EXPECT_LT(relativeError(k, d[side]), 1e-4) << i << " side " << side;
+        }
+    }
+}

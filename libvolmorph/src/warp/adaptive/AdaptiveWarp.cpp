@@ -14,6 +14,7 @@
 #include <atomic>
 #include <cmath>
 #include <limits>
+#include <map>
 
 namespace volmorph::detail {
 
@@ -232,6 +233,19 @@ public:
                                   perTop[ti] = cellsOf(CoordBBox::createCube(tops[ti], kTopCell));
                           });
         for (const auto& v : perTop) mCells.insert(mCells.end(), v.begin(), v.end());
+        return !mCells.empty();
+    }
+
+    /// 1'. Instead of findCells(): the cells of a given list of leaves. False when it is empty.
+    bool listCells(const std::vector<Coord>& leaves)
+    {
+        std::map<Coord, uint8_t> cells;
+        for (const Coord& c : leaves) {
+            const Coord cell(c.x() & -16, c.y() & -16, c.z() & -16);
+            const int m = ((c.x() >> 3) & 1) << 2 | ((c.y() >> 3) & 1) << 1 | ((c.z() >> 3) & 1);
+            cells[cell] |= uint8_t(1u << m);
+        }
+        for (const auto& [origin, mask] : cells) mCells.push_back(Cell{origin, mask});
         return !mCells.empty();
     }
 
@@ -465,6 +479,16 @@ private:
     /// One scratch context per thread (its counters summed into the stats at the end).
     tbb::enumerable_thread_specific<WarpContext> mContexts;
 };
+
+void AdaptiveWarp::fillLeaves(const std::vector<Coord>& leaves, const LeafFunction& fn,
+                              AdaptiveWarpStats* stats, Interrupter* interrupter) const
+{
+    Traversal traversal(*this, CoordBBox(), nullptr, nullptr, fn, interrupter, nullptr);
+    if (!traversal.listCells(leaves)) return;
+    traversal.evaluateLattice();
+    traversal.visitLeaves();
+    if (stats) traversal.addStats(*stats);
+}
 
 void AdaptiveWarp::forEachLeaf(const CoordBBox& box, const Occupancy* source,
                                const Occupancy* target, const LeafFunction& fn,
