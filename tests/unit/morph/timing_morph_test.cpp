@@ -242,9 +242,11 @@ TEST(TimingMorph, WithPairsTheWarpTravelsTooAndItsVelocityIsTheFramesOwn)
     // that says so: each place is warped at its own local time. Half way under the upward sweep,
     // the bottom fifth is the target's and the top fifth the source's, not the morph at 0.5
     // everywhere; `vel` is the frames' own normal speed with a sweep and with a region. The
-    // frames take the exact warp: an approximated one's error (up to its tolerance) changes from
-    // frame to frame, and a central difference over 2h would measure that, not the motion (with
-    // 0.25 voxels the mean error is 0.9% with the sweep, 1.4% with the region).
+    // frames take the exact warp: the table's velocity (TimedWarp.h) is its map's derivative
+    // between two levels, which changes at each level, and a central difference over 2h = 0.02
+    // (tau moves by 0.04) spans levels 1/64 apart (with the table: 0.9% with the sweep, 1.4% with
+    // the region; the table's own velocity against its map within one interval is
+    // timed_warp_test.cpp's).
     WarpSpec exact;
     exact.toleranceVoxels = 0.0;
     const VolumeSet big = exactSphere(0.5, kVoxel, 8.0f),
