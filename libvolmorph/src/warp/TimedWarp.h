@@ -3,20 +3,20 @@
 //
 // The warp at a given tau does not depend on the frame, so it is tabulated once per morph at
 // levels tau_0 = 0 < ... < tau_K = 1 (TauTable), and a place between two levels takes the linear
-// blend of their maps, W~(p, tau) = (1 - f) W_k(p) + f W_k+1(p), f = (tau - tau_k) / h_k: continuous
-// in p and in t. The levels start at sixteenths and are halved, down to sixty-fourths at most, until
-// at every interval's midpoint the warp is within a quarter of the tolerance of its ends' blend at
-// sample points: a lattice over the morph's candidate box, and on and about each interpolated
-// element at the interval's ends and middle. Each level's approximated warp (AdaptiveWarp) keeps
-// its a-priori bound within the other three quarters. The table's error is measured, not bounded,
-// and where an element's edge sweeps over a place the weights have a kink in tau, which halving
-// shrinks only linearly: there the table errs most (TauTable::error: 1.6 voxels for the default
-// scene's pairs, within the weights' offset of an element's path; far less elsewhere), and the
-// frame's stats add it to the warp's bound. A leaf is filled at every
-// level its voxels' taus reach (one where they all sit at a level, as before a place begins or
-// after it ends; about two to five across the ramp), each level through its own traversal of a
-// list of leaves, a chunk of leaves at a time, and its voxels blended. With tolerance 0 every
-// voxel is mapped exactly at its own tau (the tests' reference).
+// blend of their maps, W~(p, tau) = (1 - f) W_k(p) + f W_k+1(p), f = (tau - tau_k) / h_k:
+// continuous in p and in t. The levels start at sixteenths and are halved, down to sixty-fourths at
+// most, until at every interval's midpoint the warp is within a quarter of the tolerance of its
+// ends' blend at sample points: a lattice over the morph's candidate box, and on and about each
+// interpolated element at the interval's ends and middle. Each level's approximated warp
+// (AdaptiveWarp) keeps its a-priori bound within the other three quarters. The table's error is
+// measured, not bounded, and where an element's edge sweeps over a place the weights have a kink in
+// tau, which halving shrinks only linearly: there the table errs most (TauTable::error: 1.6 voxels
+// for the default scene's pairs, within the weights' offset of an element's path; far less
+// elsewhere), and the frame's stats add it to the warp's bound. A leaf is filled at every level its
+// voxels' taus reach (one where they all sit at a level, as before a place begins or after it ends;
+// about two to five across the ramp), each level through its own traversal of a list of leaves, a
+// chunk of leaves at a time, and its voxels blended. With tolerance 0 every voxel is mapped exactly
+// at its own tau (the tests' reference).
 //
 // The velocity is that of the map as made: with the slope S = (W_k+1 - W_k) / h_k,
 //   dW~/dp = (1 - f) J_k + f J_k+1 + S (grad tau)^T,   dW~/dt = S tau_t,

@@ -21,21 +21,6 @@ namespace volmorph::detail {
 using openvdb::Coord;
 using openvdb::CoordBBox;
 
-KernelBuild bestKernelBuild()
-{
-#if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__)
-    static const KernelBuild best =
-        __builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512vl") &&
-                __builtin_cpu_supports("avx512dq") && __builtin_cpu_supports("avx512bw")
-            ? KernelBuild::Avx512
-        : __builtin_cpu_supports("avx2") ? KernelBuild::Avx2
-                                         : KernelBuild::Baseline;
-    return best;
-#else
-    return KernelBuild::Baseline;
-#endif
-}
-
 AdaptiveWarp::~AdaptiveWarp() = default;
 
 AdaptiveWarp::AdaptiveWarp(const InverseWarp& warp, double toleranceVoxels, KernelBuild limit)

@@ -323,4 +323,21 @@ void leafRange(const WarpLeaf& leaf, Vec3f lo[2], Vec3f hi[2], KernelBuild build
     pickBuild(build, VOLMORPH_BUILDS(leafRange))(leaf, lo, hi);
 }
 
+/// The most capable of the kernels' builds this CPU runs (AdaptiveWarp.h; every kernel picks by
+/// it).
+KernelBuild bestKernelBuild()
+{
+#if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__)
+    static const KernelBuild best =
+        __builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512vl") &&
+                __builtin_cpu_supports("avx512dq") && __builtin_cpu_supports("avx512bw")
+            ? KernelBuild::Avx512
+        : __builtin_cpu_supports("avx2") ? KernelBuild::Avx2
+                                         : KernelBuild::Baseline;
+    return best;
+#else
+    return KernelBuild::Baseline;
+#endif
+}
+
 } // namespace volmorph::detail
