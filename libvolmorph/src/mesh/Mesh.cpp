@@ -15,6 +15,7 @@
 #include <poll.h>
 #include <signal.h>
 #include <sys/wait.h>
+#include <time.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -253,20 +254,54 @@ bool writeVector(int fd, const std::vector<T>& v)
     return writeAll(fd, &n, sizeof n) && writeAll(fd, v.data(), v.size() * sizeof(T));
 }
 
-/// Reads exactly `size` bytes before `deadline`; false on EOF, error or timeout.
-bool readAll(int fd, void* data, size_t size, std::chrono::steady_clock::time_point deadline,
-             bool& timedOut)
+/// How long the reader in the child may take: `cpuSeconds` of its own work (a parser in an endless
+/// loop spends it) and at most `wallSeconds` of waiting (a reader stuck without working). Work is
+/// measured, not the wall clock, so that a child starved of a core on a loaded machine is not taken
+/// for a hung one (a 5 s wall-clock limit failed a cube's import under CI's load).
+class ReaderBudget {
+public:
+    ReaderBudget(pid_t child, double cpuSeconds, double wallSeconds)
+        : mCpu(cpuSeconds), mWall(wallSeconds), mStart(std::chrono::steady_clock::now())
+    {
+        mHasCpuClock = ::clock_getcpuclockid(child, &mClock) == 0;
+    }
+
+    /// True once either limit is spent; `exhausted()` then says which.
+    bool spent()
+    {
+        const double waited =
+            std::chrono::duration<double>(std::chrono::steady_clock::now() - mStart).count();
+        timespec used{};
+        const bool cpuKnown = mHasCpuClock && ::clock_gettime(mClock, &used) == 0;
+        const double worked = cpuKnown ? double(used.tv_sec) + 1e-9 * double(used.tv_nsec) : waited;
+        if (worked >= mCpu)
+            mExhausted = Limit::Cpu;
+        else if (waited >= mWall)
+            mExhausted = Limit::Wall;
+        return mExhausted != Limit::None;
+    }
+
+    enum class Limit { None, Cpu, Wall };
+    Limit exhausted() const { return mExhausted; }
+    double cpuSeconds() const { return mCpu; }
+    double wallSeconds() const { return mWall; }
+
+private:
+    double mCpu, mWall;
+    std::chrono::steady_clock::time_point mStart;
+    clockid_t mClock{};
+    bool mHasCpuClock = false;
+    Limit mExhausted = Limit::None;
+};
+
+/// Reads exactly `size` bytes while `budget` lasts; false on EOF, error or a spent budget.
+bool readAll(int fd, void* data, size_t size, ReaderBudget& budget)
 {
     char* p = static_cast<char*>(data);
     while (size > 0) {
-        const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(
-            deadline - std::chrono::steady_clock::now());
-        if (left.count() <= 0) {
-            timedOut = true;
-            return false;
-        }
+        if (budget.spent()) return false;
         pollfd pfd{fd, POLLIN, 0};
-        const int r = ::poll(&pfd, 1, int(std::min<long long>(left.count(), 1000)));
+        const int r = ::poll(&pfd, 1, 100);
         if (r < 0 && errno == EINTR) continue;
         if (r < 0) return false;
         if (r == 0) continue;
@@ -276,19 +311,18 @@ bool readAll(int fd, void* data, size_t size, std::chrono::steady_clock::time_po
 }
 
 template <typename T>
-bool readVector(int fd, std::vector<T>& v, std::chrono::steady_clock::time_point deadline,
-                bool& timedOut)
+bool readVector(int fd, std::vector<T>& v, ReaderBudget& budget)
 {
     uint64_t n = 0;
-    if (!readAll(fd, &n, sizeof n, deadline, timedOut) || n > (uint64_t(1) << 34) / sizeof(T))
-        return false;
+    if (!readAll(fd, &n, sizeof n, budget) || n > (uint64_t(1) << 34) / sizeof(T)) return false;
     v.resize(size_t(n));
-    return readAll(fd, v.data(), v.size() * sizeof(T), deadline, timedOut);
+    return readAll(fd, v.data(), v.size() * sizeof(T), budget);
 }
 
 /// readWithAssimp() in a child process, so that a parser that aborts, crashes or never returns on
 /// a malformed file (Assimp 5.2 does all three; fuzzing found them) becomes an error message, not
-/// a dead or hung volmorph. The time limit grows with the file: 5 s plus 2 s per MB.
+/// a dead or hung volmorph. The limits grow with the file: 5 s of the reader's CPU time plus 2 s
+/// per MB, and 60 s plus 10 s per MB of waiting.
 RawMesh readIsolated(const std::filesystem::path& file, uintmax_t bytes)
 {
     RawMesh raw;
@@ -310,16 +344,12 @@ RawMesh readIsolated(const std::filesystem::path& file, uintmax_t bytes)
         ::_exit(ok ? 0 : 1);
     }
     ::close(fds[1]);
-    const double limit = 5.0 + 2.0 * double(bytes) / 1e6;
-    const auto deadline =
-        std::chrono::steady_clock::now() + std::chrono::milliseconds(long(limit * 1000.0));
-    bool timedOut = false;
+    ReaderBudget budget(child, 5.0 + 2.0 * double(bytes) / 1e6, 60.0 + 10.0 * double(bytes) / 1e6);
     std::vector<char> error;
-    const bool ok = readVector(fds[0], error, deadline, timedOut) &&
-                    readVector(fds[0], raw.positions, deadline, timedOut) &&
-                    readVector(fds[0], raw.colors, deadline, timedOut) &&
-                    readVector(fds[0], raw.uvs, deadline, timedOut) &&
-                    readVector(fds[0], raw.triangles, deadline, timedOut);
+    const bool ok = readVector(fds[0], error, budget) &&
+                    readVector(fds[0], raw.positions, budget) &&
+                    readVector(fds[0], raw.colors, budget) && readVector(fds[0], raw.uvs, budget) &&
+                    readVector(fds[0], raw.triangles, budget);
     ::close(fds[0]);
     if (!ok) ::kill(child, SIGKILL);
     int status = 0;
@@ -329,11 +359,15 @@ RawMesh readIsolated(const std::filesystem::path& file, uintmax_t bytes)
         return raw;
     }
     raw = RawMesh{};
-    if (timedOut) {
-        char text[160];
-        std::snprintf(
-            text, sizeof text,
-            "the mesh reader did not finish within %.0f s; the file is probably malformed", limit);
+    if (budget.exhausted() != ReaderBudget::Limit::None) {
+        const bool cpu = budget.exhausted() == ReaderBudget::Limit::Cpu;
+        char text[200];
+        std::snprintf(text, sizeof text,
+                      cpu ? "the mesh reader did not finish within %.0f s of work; the file is "
+                            "probably malformed"
+                          : "the mesh reader did not finish within %.0f s (it stopped working); "
+                            "the file is probably malformed",
+                      cpu ? budget.cpuSeconds() : budget.wallSeconds());
         raw.error = text;
     } else if (WIFSIGNALED(status)) {
         raw.error = "the mesh reader (Assimp) crashed on this file (signal " +
