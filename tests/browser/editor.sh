@@ -3,7 +3,8 @@
 # take a screenshot of it loaded (compared with tests/browser/editor.png under thresholds: SwiftShader
 # renders the same page alike, not bit for bit), select pair 2, drag its target origin with the
 # gizmo, save. The saved file must differ from the original on that one line alone (every comment
-# and every other byte kept). Screenshots are left in OUT (default: ./browser-out).
+# and every other byte kept). Then a surface-mode scene, and a scene with a timing sweep (its delay's
+# colours, its end dragged). Screenshots are left in OUT (default: ./browser-out).
 # usage: editor.sh VOLMORPH SOURCE_DIR [OUT]
 set -eu
 . "$(dirname "$0")/../cli/lib.sh"
@@ -36,4 +37,17 @@ sed "s|\"meshes/|\"$src/scenes/meshes/|; s|\"skies/|\"$src/scenes/skies/|" \
 start_editor "$out/surface.toml" -q
 node "$src/tests/browser/editor_surface.mjs" "$url" "$shots" || { stop_editor 10; exit 1; }
 stop_editor 10
-echo "editor page: dragged pair 2's target origin and saved; one line changed; screenshot within bounds; a surface scene's landmark snapped"
+# A scene with a sweep: the in-between coloured by its delays, the sweep's end dragged and saved;
+# the sweep's line alone changed, and the file still a valid scene.
+sed "s|\"meshes/|\"$src/scenes/meshes/|; s|\"skies/|\"$src/scenes/skies/|" \
+    "$src/scenes/bunny-to-knot-sweep.toml" >"$out/sweep.toml"
+cp "$out/sweep.toml" "$out/sweep.original.toml"
+start_editor "$out/sweep.toml" --resolution 64 -q
+node "$src/tests/browser/editor_timing.mjs" "$url" "$shots" || { stop_editor 10; exit 1; }
+stop_editor 10
+diff "$out/sweep.original.toml" "$out/sweep.toml" >"$out/sweep.diff" && { echo "the sweep scene was not saved"; exit 1; }
+[ "$(grep -c '^[<>]' "$out/sweep.diff")" = 2 ] || { echo "more than the sweep's line changed:"; cat "$out/sweep.diff"; exit 1; }
+grep -q '^> sweep = { origin = \[0, 0, 0\], direction = \[' "$out/sweep.diff" ||
+    { echo "the changed line is not the sweep's:"; cat "$out/sweep.diff"; exit 1; }
+"$volmorph" check "$out/sweep.toml" >/dev/null
+echo "editor page: dragged pair 2's target origin and saved; one line changed; screenshot within bounds; a surface scene's landmark snapped; a sweep's end dragged and saved"

@@ -180,21 +180,73 @@ bool parseKey(const std::string& key, long& pair, std::string& field)
     return false;
 }
 
-} // namespace
-
-void EditDocument::set(const json& body, SceneDocument& next) const
+/// The [timing] keys the page sets (the sweep it drags), as TOML text; empty for any other key.
+std::string timingValue(const std::string& key, const json& value)
 {
-    const std::string& key = action(body, "key");
+    if (key == "timing.spread" || key == "timing.sweep.length")
+        return tomlNumber(number(value, key.c_str()));
+    if (key == "timing.sweep.origin" || key == "timing.sweep.direction")
+        return tomlArray(numbers(vec3(value, key.c_str())));
+    return "";
+}
+
+/// One key set in `next`: a pair's value, or a timing key the file already has.
+void setKey(const std::string& key, const json& value, SceneDocument& next)
+{
+    if (const std::string timing = timingValue(key, value); !timing.empty()) {
+        try {
+            next.set(key, timing);
+        } catch (const std::invalid_argument& e) {
+            throw BadRequest(key + ": the scene's [timing] has no such key to set (" + e.what() +
+                             ")");
+        }
+        return;
+    }
     long pair = 0;
     std::string field;
     if (!parseKey(key, pair, field))
         throw BadRequest("key \"" + key.substr(0, 80) +
-                         "\": expected pair[N].type or pair[N].source|target.origin|axes|scale");
+                         "\": expected pair[N].type, pair[N].source|target.origin|axes|scale, "
+                         "timing.spread or timing.sweep.origin|direction|length");
     if (const int count = next.pairCount(); pair > count)
         throw BadRequest("no pair " + std::to_string(pair) + " (the scene has " +
                          std::to_string(count) + ")");
+    next.set(key, tomlValue(field, value));
+}
+
+bool sameTiming(const TimingSettings& a, const TimingSettings& b)
+{
+    if (a.spread != b.spread || a.sweep.has_value() != b.sweep.has_value()) return false;
+    return !a.sweep ||
+           (a.sweep->origin == b.sweep->origin && a.sweep->direction == b.sweep->direction &&
+            a.sweep->length == b.sweep->length);
+}
+
+json timingJson(const Scene& scene)
+{
+    const TimingSettings& t = scene.timing;
+    json sweep = nullptr;
+    if (t.sweep)
+        sweep = {{"origin", numbers(t.sweep->origin)},
+                 {"direction", numbers(t.sweep->direction)},
+                 {"length", t.sweep->length}};
+    return {{"spread", t.spread}, {"sweep", sweep}, {"regions", scene.timingRegions.size()}};
+}
+
+} // namespace
+
+void EditDocument::set(const json& body, SceneDocument& next) const
+{
+    if (body.is_object() && body.contains("values")) { // several keys, one step of undo
+        const json& values = body["values"];
+        if (!values.is_object() || values.empty() || values.size() > 16)
+            throw BadRequest("values: expected {\"key\": value, ...}");
+        for (const auto& [key, value] : values.items()) setKey(key, value, next);
+        return;
+    }
+    const std::string& key = action(body, "key");
     if (!body.contains("value")) throw BadRequest("expected a \"value\"");
-    next.set(key, tomlValue(field, body["value"]));
+    setKey(key, body["value"], next);
 }
 
 void EditDocument::apply(const std::string& name, const json& body)
@@ -257,6 +309,7 @@ void EditDocument::revalidate()
             scene.pairs.size() == mScene.pairs.size() &&
             std::equal(scene.pairs.begin(), scene.pairs.end(), mScene.pairs.begin(), samePair);
         if (!same) ++mPairsVersion;
+        if (!sameTiming(scene.timing, mScene.timing)) ++mTimingVersion;
         mScene = std::move(scene);
     } catch (const UserError& e) {
         mErrors = place(e, mDocument.pairLines());
@@ -296,7 +349,8 @@ json EditDocument::state() const
             {"pairs", std::move(pairs)},
             {"errors", std::move(errors)},
             {"camera", cameraJson(mScene.render)},
-            {"landmarks", mScene.blend.mode == BlendMode::Surface}};
+            {"landmarks", mScene.blend.mode == BlendMode::Surface},
+            {"timing", timingJson(mScene)}};
 }
 
 } // namespace volmorph::editor

@@ -2,8 +2,9 @@
 // stays as written), the edits the page asks for as JSON, undo and redo, and what the validator
 // says about the result, each error placed at the pair and the side it concerns.
 //
-// The page edits feature pairs only: a value of a pair (`pair[2].target.origin`), a new pair, a
-// copy of one, a deletion, the suggested pairs. Every edit is one step of undo. An edit that leaves
+// The page edits feature pairs (a value of a pair, `pair[2].target.origin`, a new pair, a copy of
+// one, a deletion, the suggested pairs) and the timing's sweep it drags (`timing.sweep.origin`).
+// Every edit is one step of undo. An edit that leaves
 // the scene invalid (a scale of 0 typed in) is kept, with its errors, as a text editor keeps a
 // typo: the last valid scene stays what the in-between is made from until the errors are fixed
 // or undone. Saving an invalid scene is refused.
@@ -50,7 +51,9 @@ public:
     /// Applies one edit, `action` with its JSON `body`:
     ///  - "set"       {"key": "pair[2].target.origin", "value": [x, y, z]}; keys pair[N].type,
     ///                pair[N].source|target.origin|axes|scale; values as the scene writes them
-    ///                (axes [[x], [y]]; scale a number or three);
+    ///                (axes [[x], [y]]; scale a number or three); timing.spread and
+    ///                timing.sweep.origin|direction|length where the file has them; or
+    ///                {"values": {key: value, ...}}: several keys in one step;
     ///  - "add"       {"type": "point", "source": {"origin": [...], "axes": ..., "scale": ...},
     ///                "target": {...}} (axes and scale optional);
     ///  - "duplicate" {"index": N}: a copy of pair N appended;
@@ -75,12 +78,15 @@ public:
     const std::string& text() const { return mDocument.text(); }
     /// The file's text as read or last saved.
     const std::string& savedText() const { return mSaved; }
-    /// Counts the changes to the last valid scene's pairs (what the in-between depends on).
+    /// Counts the changes to the last valid scene's pairs, and to its timing (spread and sweep):
+    /// what the in-between depends on.
     uint64_t pairsVersion() const { return mPairsVersion; }
+    uint64_t timingVersion() const { return mTimingVersion; }
 
     /// {"scene", "dirty", "canUndo", "canRedo", "valid", "pairs": [...], "errors": [...],
-    /// "camera": {...}, "landmarks"}: what the page draws; "landmarks" is true in surface mode
-    /// (the pairs are landmarks: points only, no suggestions).
+    /// "camera": {...}, "landmarks", "timing"}: what the page draws; "landmarks" is true in surface
+    /// mode (the pairs are landmarks: points only, no suggestions); "timing": {"spread", "sweep":
+    /// {"origin", "direction", "length"} or null, "regions": how many}.
     nlohmann::json state() const;
 
 private:
@@ -95,7 +101,7 @@ private:
     Scene mScene;
     std::vector<PlacedError> mErrors;
     std::vector<std::string> mUndo, mRedo; ///< texts
-    uint64_t mPairsVersion = 0;
+    uint64_t mPairsVersion = 0, mTimingVersion = 0;
 };
 
 /// A feature element from the page's JSON ({"origin", "axes"?, "scale"?}); BadRequest when it is

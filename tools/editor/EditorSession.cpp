@@ -49,14 +49,14 @@ json parseBody(const std::string& body)
 
 std::string encodeMesh(const std::vector<openvdb::Vec3s>& points,
                        const std::vector<openvdb::Vec3I>& triangles,
-                       const std::vector<openvdb::Vec4I>& quads)
+                       const std::vector<openvdb::Vec4I>& quads, const std::vector<float>* delays)
 {
     static_assert(sizeof(float) == 4 && sizeof(uint32_t) == 4, "32-bit floats and indices");
     openvdb::Vec3s lo(std::numeric_limits<float>::max()), hi(-std::numeric_limits<float>::max());
     for (const openvdb::Vec3s& p : points) lo = minComponent(lo, p), hi = maxComponent(hi, p);
     if (points.empty()) lo = hi = openvdb::Vec3s(0.0f);
     const uint32_t triangleCount = uint32_t(triangles.size() + 2 * quads.size());
-    std::string out = "VMM1";
+    std::string out = delays ? "VMM2" : "VMM1";
     out.reserve(32 + points.size() * 6 + 4 + size_t(triangleCount) * 12);
     put(out, uint32_t(points.size()));
     put(out, triangleCount);
@@ -75,10 +75,13 @@ std::string encodeMesh(const std::vector<openvdb::Vec3s>& points,
         put(out, q[0]), put(out, q[2]), put(out, q[1]);
         put(out, q[0]), put(out, q[3]), put(out, q[2]);
     }
+    if (delays)
+        for (size_t i = 0; i < points.size(); ++i)
+            put(out, i < delays->size() ? (*delays)[i] : 0.0f);
     return out;
 }
 
-std::string surfaceOf(const VolumeSet& volumes)
+std::string surfaceOf(const VolumeSet& volumes, const LocalTime* timing)
 {
     std::vector<openvdb::Vec3s> points;
     std::vector<openvdb::Vec3I> triangles;
@@ -87,7 +90,10 @@ std::string surfaceOf(const VolumeSet& volumes)
         openvdb::tools::volumeToMesh(*volumes.sdf, points, triangles, quads, 0.0, 0.0);
     else if (volumes.density)
         openvdb::tools::volumeToMesh(*volumes.density, points, triangles, quads, 0.5, 0.0);
-    return encodeMesh(points, triangles, quads);
+    if (!timing || !timing->active()) return encodeMesh(points, triangles, quads);
+    std::vector<float> delays(points.size());
+    for (size_t i = 0; i < points.size(); ++i) delays[i] = float(timing->delay(Vec3d(points[i])).d);
+    return encodeMesh(points, triangles, quads, &delays);
 }
 
 std::string encodeTriangles(const std::vector<Vec3d>& points, const std::vector<Vec3I>& triangles)
@@ -122,9 +128,10 @@ EditorSession::EditorSession(const std::filesystem::path& scene, int resolution,
     mSource = std::move(volumes.source);
     mTarget = std::move(volumes.target);
     mInfluences = std::move(volumes.influences);
+    mTimingRegions = std::move(volumes.timingRegions);
     if (preview.timing.spread > 0.0)
-        mLocalTime =
-            std::make_shared<const LocalTime>(preview.timing, std::move(volumes.timingRegions));
+        mLocalTime = std::make_shared<const LocalTime>(preview.timing, mTimingRegions);
+    mMorpherTiming = mDocument.timingVersion();
     mSourceMesh = surfaceOf(mSource);
     mTargetMesh = surfaceOf(mTarget);
 }
@@ -152,35 +159,48 @@ Reply EditorSession::morphMesh(double t)
     if (mSurfaceSides) return surfaceMesh(t);
     std::lock_guard<std::mutex> one(mMorphMutex);
     std::shared_ptr<const Morpher> last;
+    std::shared_ptr<const LocalTime> local;
     std::vector<FeaturePairSpec> pairs;
     WarpSpec warp;
     BlendSpec blend;
-    uint64_t version = 0, lastVersion = 0;
+    TimingSettings timing;
+    uint64_t version = 0, lastVersion = 0, timingVersion = 0, lastTiming = 0;
     {
         std::lock_guard<std::mutex> lock(mMutex);
         version = mDocument.pairsVersion();
-        if (mMorphVersion == version && mMorphT == t)
+        timingVersion = mDocument.timingVersion();
+        if (mMorphVersion == version + timingVersion && mMorphT == t)
             return {200, "application/octet-stream", mMorphMesh};
         const Scene& scene = mDocument.scene();
-        pairs = scene.pairs, warp = scene.warp, blend = scene.blend;
+        pairs = scene.pairs, warp = scene.warp, blend = scene.blend, timing = scene.timing;
         last = mMorpher;
+        local = mLocalTime;
         lastVersion = mMorpherVersion;
+        lastTiming = mMorpherTiming;
     }
+    if (timingVersion != lastTiming) // the sweep was dragged: the same regions, read once
+        local = timing.spread > 0.0 ? std::make_shared<const LocalTime>(timing, mTimingRegions)
+                                    : nullptr;
     std::shared_ptr<const Morpher> morpher = last;
     if (!last) {
         MorphOptions options;
         options.influences = mInfluences;
-        options.localTime = mLocalTime;
+        options.localTime = local;
         options.setupInterrupter = mInterrupter;
         morpher = std::make_shared<const Morpher>(mSource, mTarget, pairs, warp, blend, options);
-    } else if (lastVersion != version) {
-        morpher = std::make_shared<const Morpher>(last->withPairs(pairs));
+    } else {
+        if (lastVersion != version)
+            morpher = std::make_shared<const Morpher>(morpher->withPairs(pairs));
+        if (lastTiming != timingVersion)
+            morpher = std::make_shared<const Morpher>(morpher->withTiming(local));
     }
-    std::string surface = surfaceOf(morpher->frame(t, nullptr, mInterrupter));
+    std::string surface = surfaceOf(morpher->frame(t, nullptr, mInterrupter), local.get());
     std::lock_guard<std::mutex> lock(mMutex);
     mMorpher = morpher;
+    mLocalTime = local;
     mMorpherVersion = version;
-    keepMorphMesh(surface, version, t);
+    mMorpherTiming = timingVersion;
+    keepMorphMesh(surface, version + timingVersion, t);
     return {200, "application/octet-stream", std::move(surface)};
 }
 

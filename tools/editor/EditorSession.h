@@ -19,7 +19,8 @@
 // morph fails, 503 when the editor is stopping):
 //   GET  /api/state                       EditDocument::state()
 //   GET  /api/mesh?of=source|target       a side's surface (encodeMesh)
-//   GET  /api/mesh?of=morph&t=T           the in-between's surface at t in [0, 1]
+//   GET  /api/mesh?of=morph&t=T           the in-between's surface at t in [0, 1], with each
+//                                         vertex's delay under a timing (the page's colours)
 //   POST /api/set|add|duplicate|delete|undo|redo   an edit (EditDocument::apply); the new state
 //   POST /api/suggest                     `pairs suggest`'s pairs appended; the new state (400
 //                                         in surface mode: landmarks are placed by hand)
@@ -54,14 +55,17 @@ struct Reply {
 /// A surface for the page, compact: "VMM1", the vertex and triangle counts (uint32), the bounding
 /// box (6 float32, world units), each vertex's position quantized to uint16 over the box (a
 /// 65535th of it: far below a voxel), zero padding to 4 bytes, then the triangles (3 uint32
-/// each). Little-endian. A quad is two triangles.
+/// each). Little-endian. A quad is two triangles. With `delays` (one per vertex: the timing's
+/// delay there, in t), "VMM2", and the delays as float32 after the triangles.
 std::string encodeMesh(const std::vector<openvdb::Vec3s>& points,
                        const std::vector<openvdb::Vec3I>& triangles,
-                       const std::vector<openvdb::Vec4I>& quads);
+                       const std::vector<openvdb::Vec4I>& quads,
+                       const std::vector<float>* delays = nullptr);
 
 /// The surface of a side or an in-between: the sdf's zero level set, or the density's 0.5 level
-/// where it has no sdf (a fog volume), by OpenVDB's volumeToMesh; encoded.
-std::string surfaceOf(const VolumeSet& volumes);
+/// where it has no sdf (a fog volume), by OpenVDB's volumeToMesh; encoded, with each vertex's
+/// delay under `timing` when it is active.
+std::string surfaceOf(const VolumeSet& volumes, const LocalTime* timing = nullptr);
 
 /// A mesh (world units, triangles wound as the file has them) encoded as above.
 std::string encodeTriangles(const std::vector<Vec3d>& points, const std::vector<Vec3I>& triangles);
@@ -88,7 +92,7 @@ private:
     Reply morphMesh(double t);
     /// The same in surface mode: the in-between mesh of the pairs' correspondence.
     Reply surfaceMesh(double t);
-    /// Stores the in-between's mesh of pairs version `version` at t (under mMutex).
+    /// Stores the in-between's mesh of version `version` (pairs and timing) at t (under mMutex).
     void keepMorphMesh(const std::string& mesh, uint64_t version, double t);
 
     std::mutex mMutex;      ///< the document and the caches below
@@ -98,12 +102,14 @@ private:
     // Set once by the constructor, read without a lock afterwards.
     VolumeSet mSource, mTarget;
     std::vector<TimedVolume> mInfluences;               ///< variational mode's
-    std::shared_ptr<const LocalTime> mLocalTime;        ///< the scene's timing (null: none)
+    std::vector<TimingRegion> mTimingRegions;           ///< the timing's regions, read once
     std::optional<std::pair<Mesh, Mesh>> mSurfaceSides; ///< surface mode's meshes, placed
     std::string mSourceMesh, mTargetMesh;
-    /// The last Morpher, for the pairs of version mMorpherVersion (its blend setup is reused).
+    /// The last Morpher, for the pairs of version mMorpherVersion and the timing of version
+    /// mMorpherTiming (its blend setup is reused), and that timing (null: none).
     std::shared_ptr<const Morpher> mMorpher;
-    uint64_t mMorpherVersion = 0;
+    std::shared_ptr<const LocalTime> mLocalTime;
+    uint64_t mMorpherVersion = 0, mMorpherTiming = 0;
     /// Surface mode: the correspondence of the pairs of version mSurfaceVersion.
     std::shared_ptr<const SurfaceMorpher> mSurfaceMorpher;
     uint64_t mSurfaceVersion = ~uint64_t(0);

@@ -90,6 +90,10 @@ public:
     /// after each change to the pairs: frames are bit for bit those of a Morpher built with them.
     Morpher withPairs(std::vector<FeaturePairSpec> pairs) const;
 
+    /// The same morph under another timing (null: everywhere at once), sharing this one's blend
+    /// setup (which does not depend on it): what an editor does after the sweep is dragged.
+    Morpher withTiming(std::shared_ptr<const LocalTime> localTime) const;
+
     /// The in-between at t in [0, 1]: grids `density` and `Cd` on the shared transform.
     VolumeSet frame(double t, MorphStats* stats = nullptr,
                     Interrupter* interrupter = nullptr) const;

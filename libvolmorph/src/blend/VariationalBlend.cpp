@@ -1,6 +1,7 @@
 #include "blend/VariationalBlend.h"
 
 #include "blend/ExtendedDistance.h"
+#include "blend/BlendTime.h"
 #include "blend/Redistance.h"
 #include "blend/variational/Constraints.h"
 #include "blend/variational/PartitionOfUnity.h"
@@ -33,6 +34,7 @@ using variational::Constraint;
 using variational::Interpolant;
 using variational::PartitionOfUnity;
 using variational::Point4;
+using variational::SliceFunction;
 using Sampler = openvdb::tools::BoxSampler;
 
 /// The frame's exact values lie on a lattice this many voxels apart, tricubic between: within
@@ -53,6 +55,8 @@ constexpr int kExterior = 9;
 /// |grad f| is taken no smaller than this (world units of f per world unit) in the velocity: where
 /// the topology changes the zero set's normal speed has no bound.
 constexpr double kLeastGradient = 0.05;
+/// A reach along w that takes in every centre (splitByTime's "near" part is then the whole).
+constexpr double kEverywhere = std::numeric_limits<double>::infinity();
 
 struct Shape {
     const VolumeSet* volume;
@@ -114,6 +118,19 @@ void checkMemory(const VariationalSpec& spec, size_t shapes, uint64_t limit)
                               text, resident + need, limit);
 }
 
+/// f read at each place's own local time: g(x) = f(x, scale tau(x, t)), and as its rate dg/dw
+/// along the frame's w = t * scale, f_w d tau / d t (0 where tau is clamped); the zero set of g is
+/// the in-between, and -g_t grad g / |grad g|^2 its normal motion, grad g taking grad tau in.
+SliceFunction atLocalTime(SliceFunction f, const LocalTime& local, double t, double scale)
+{
+    return [f = std::move(f), &local, t, scale](const Point4& p, double* rate) {
+        const LocalTau tau = local.at(Vec3d(p[0], p[1], p[2]), t);
+        const double value = f(Point4(p[0], p[1], p[2], scale * tau.tau), rate);
+        if (rate) *rate *= tau.dt;
+        return value;
+    };
+}
+
 class VariationalBlend final : public TwoSidedBlend {
 public:
     explicit VariationalBlend(const BlendSetup& setup) : TwoSidedBlend(setup)
@@ -154,22 +171,30 @@ public:
     {
         const bool velocity = r.velocityScale > 0.0;
         // The coarse level's centres far from the frame's time read from lattices; the nearest
-        // ones and the balls' level exact.
+        // ones and the balls' level exact. Under a timing each place is the slice at its own
+        // local time, which has kinks where a place starts or ends (tau clamped): every part is
+        // taken exactly there (read from a lattice 8 voxels apart across a kink, the top of a
+        // swept sphere moved by 0.2 voxel).
         const double w = r.t * mTimeScale, step = kSmoothReach * mVoxel;
-        const auto [near, rest] = mFunction.coarse().splitByTime(w, 4 * step);
+        const LocalTime* local = r.localTime && r.localTime->active() ? r.localTime : nullptr;
+        const auto [near, rest] = mFunction.coarse().splitByTime(w, local ? kEverywhere : 4 * step);
         const auto [middle, far] = rest.splitByTime(w, 8 * step);
         const auto part = [](const Interpolant& i) {
             return [&i](const Point4& p, double* rate) { return i.evaluateWithRate(p, rate); };
         };
-        variational::SplitFunction f{{{part(far), 8}}, nullptr};
+        variational::SplitFunction f{{}, nullptr};
+        if (!local) f.smooth.push_back({part(far), 8});
         if (middle.size() > 0) f.smooth.push_back({part(middle), 4});
-        f.detail = [this, &near = near](const Point4& p, double* rate) {
-            double nearRate = 0.0;
-            const double value = near.evaluateWithRate(p, rate ? &nearRate : nullptr) +
-                                 mFunction.evaluateLocal(p, rate);
-            if (rate) *rate += nearRate;
+        SliceFunction detail = [this, &near = near, &far = far, local](const Point4& p,
+                                                                       double* rate) {
+            double nearRate = 0.0, farRate = 0.0;
+            double value = near.evaluateWithRate(p, rate ? &nearRate : nullptr) +
+                           mFunction.evaluateLocal(p, rate);
+            if (local) value += far.evaluateWithRate(p, rate ? &farRate : nullptr); // polynomial
+            if (rate) *rate += nearRate + farRate;
             return value;
         };
+        f.detail = local ? atLocalTime(std::move(detail), *local, r.t, mTimeScale) : detail;
         variational::NearZeroSlice slice =
             variational::sliceNearZero(f, w, mSource.density->transformPtr(), mBox, kStride,
                                        mWidth / mVoxel + 1.0, velocity, r.interrupter);
@@ -265,7 +290,8 @@ private:
         const RedistanceBands bands{float(mVoxel), mWidth,
                                     [](const Coord&) { return std::numeric_limits<float>::max(); }};
         out.grids.density = redistance(*values, bands, kSdfRampVoxels * float(mVoxel));
-        colorBand(*values, float(scheduleValue(mSpec.color, r.t)), *out.grids.color);
+        colorBand(*values, BlendTime(mSpec.color, r.t, r.localTime, values->transform()),
+                  *out.grids.color);
         if (velocity) {
             motion->tree().topologyIntersection(values->tree());
             out.grids.velocity = motion;
@@ -276,8 +302,9 @@ private:
     }
 
     /// Each side's colour at its surface point nearest the voxel (p - d grad d / |grad d| on its
-    /// extended distance), mixed by tauColor, at the band's voxels.
-    void colorBand(const openvdb::FloatGrid& sdf, float tauColor, openvdb::Vec3SGrid& color) const
+    /// extended distance), mixed by the colour schedule at each voxel's tau, at the band's voxels.
+    void colorBand(const openvdb::FloatGrid& sdf, const BlendTime& tauColor,
+                   openvdb::Vec3SGrid& color) const
     {
         openvdb::tree::LeafManager<openvdb::Vec3STree> manager(color.tree());
         manager.foreach ([&](openvdb::Vec3STree::LeafNodeType& leaf, size_t) {
@@ -295,7 +322,7 @@ private:
                 const Coord c = it.getCoord();
                 const openvdb::Vec3s s = Sampler::sample(cS, nearestSurfacePoint(dS, c));
                 const openvdb::Vec3s t = Sampler::sample(cT, nearestSurfacePoint(dT, c));
-                it.setValue(s + tauColor * (t - s));
+                it.setValue(s + tauColor.at(c).tau * (t - s));
             }
         });
     }

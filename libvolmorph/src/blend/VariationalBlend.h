@@ -13,6 +13,11 @@
 // ExtendedDistance.h: p - d grad d), mixed by the colour schedule; `vel` is the zero set's normal
 // motion, -f_t grad f / |grad f|^2, on the band (the interior has none: its fog does not move).
 // The carried grids of volume inputs (blend.grids) are not blended in this mode.
+//
+// Under a timing (LocalTime.h) each place takes the function at its own local time: the in-between
+// is the zero set of g(x) = f(x, tau(x, t) * time_scale), one closed surface as a slice is (g is
+// continuous and positive far from the shapes), and its motion -g_t grad g / |grad g|^2 takes grad
+// tau in through grad g.
 #pragma once
 
 #include "blend/BlendMethod.h"

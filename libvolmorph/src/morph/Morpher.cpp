@@ -94,8 +94,6 @@ Morpher::Morpher(VolumeSet source, VolumeSet target, std::vector<FeaturePairSpec
         throw std::invalid_argument("Morpher: source and target must share one transform");
     if (!mOptions.memoryLimitBytes) mOptions.memoryLimitBytes = defaultMemoryLimitBytes();
     detail::ExtraGrids::check(mSource, mTarget, mBlend);
-    if (timed() && mBlend.mode == BlendMode::Variational)
-        throw std::invalid_argument("Morpher: a timing is applied in density and sdf modes only");
     mSourceBlocks = std::make_shared<const detail::Occupancy>(mSource.density->tree());
     mTargetBlocks = std::make_shared<const detail::Occupancy>(mTarget.density->tree());
     const detail::BlendSetup setup{mSource,
@@ -137,6 +135,14 @@ Morpher Morpher::withPairs(std::vector<FeaturePairSpec> pairs) const
         return Morpher(mSource, mTarget, std::move(pairs), mWarp, mBlend, mOptions);
     Morpher other(*this);
     other.mPairs = std::move(pairs);
+    other.tabulate();
+    return other;
+}
+
+Morpher Morpher::withTiming(std::shared_ptr<const LocalTime> localTime) const
+{
+    Morpher other(*this);
+    other.mOptions.localTime = std::move(localTime);
     other.tabulate();
     return other;
 }

@@ -72,10 +72,10 @@ public:
         if (const toml::node* n = root.get("timing")) {
             detail::parseTiming(r, *n, mScene.folder, mScene.timing, mScene.timingRegions);
             const BlendMode mode = mScene.blend.mode;
-            if (mode == BlendMode::Variational || mode == BlendMode::Surface)
+            if (mode == BlendMode::Surface)
                 r.error(mScene.timing.where,
-                        "[timing]: not yet applied in variational mode or to surface morphs; "
-                        "density and sdf modes take it");
+                        "[timing]: not yet applied to surface morphs; density, sdf and "
+                        "variational modes take it");
         }
         if (const toml::node* n = root.get("render"))
             detail::parseRender(r, *n, mScene.folder, mScene.render);

@@ -1,9 +1,11 @@
 // The editor's API from C++ (tools/editor/EditorSession.h, EditDocument.h): load, edits and their
 // undo, the validator's errors placed at the element they concern, save and re-read, malformed
-// requests answered 400 with nothing changed, and the in-between's mesh after an edit equal byte
-// for byte to the one a Morpher built anew with the edited pairs gives.
+// requests answered 400 with nothing changed, and the in-between's mesh after an edit (of the
+// pairs, of the timing's sweep) equal byte for byte to the one a Morpher built anew with the edit
+// gives.
 #include "editor/EditorSession.h"
 
+#include <volmorph/LocalTime.h>
 #include <volmorph/SceneVolumes.h>
 #include <volmorph/SurfaceMorph.h>
 
@@ -275,6 +277,62 @@ TEST(EditApi, SessionAnswersAndTheInBetweenFollowsTheEdits)
     const json suggested = post(session, "suggest", "{}");
     EXPECT_GE(suggested["pairs"].size(), 2u);
     EXPECT_EQ(post(session, "undo", "{}")["pairs"].size(), 1u);
+}
+
+TEST(EditApi, TheSweepIsDraggedAndTheInBetweenCarriesItsDelays)
+{
+    const auto scene = copyScene("bunny-to-knot-sweep.toml");
+    const std::string original = readText(scene);
+    EditorSession session(scene, 32, nullptr);
+    const json state = json::parse(session.handle("GET", "/api/state", {}, "").body);
+    EXPECT_EQ(state["timing"]["spread"], 0.5);
+    EXPECT_EQ(state["timing"]["sweep"]["direction"], json::parse("[0, 1, 0]"));
+    // Direction and length in one step, as the page sends a dragged end handle.
+    const json turned = post(session, "set",
+                             R"({"values": {"timing.sweep.direction": [0.6, 0.8, 0],
+                                            "timing.sweep.length": 0.8}})");
+    EXPECT_EQ(turned["timing"]["sweep"]["direction"], json::parse("[0.6, 0.8, 0]"));
+    EXPECT_EQ(turned["timing"]["sweep"]["length"], 0.8);
+    EXPECT_EQ(changedLines(original, session.document().text()), 1);
+    // The in-between under the turned sweep, each vertex with its delay ("VMM2"): byte for byte
+    // what a Morpher built anew with the edited scene gives, its delays from the same timing.
+    const std::string mesh =
+        session.handle("GET", "/api/mesh", {{"of", "morph"}, {"t", "0.5"}}, "").body;
+    ASSERT_EQ(mesh.substr(0, 4), "VMM2");
+    Scene fresh = parseScene(session.document().text(), scene);
+    fresh.volume.voxelSize.reset();
+    fresh.volume.resolution = 32;
+    SceneVolumes volumes = voxelizeScene(fresh);
+    MorphOptions options;
+    options.localTime = std::make_shared<const LocalTime>(fresh.timing, volumes.timingRegions);
+    const Morpher morpher(volumes.source, volumes.target, fresh.pairs, fresh.warp, fresh.blend,
+                          options);
+    EXPECT_EQ(mesh, surfaceOf(morpher.frame(0.5), options.localTime.get()));
+    uint32_t vertices = 0, triangles = 0;
+    std::memcpy(&vertices, mesh.data() + 4, 4);
+    std::memcpy(&triangles, mesh.data() + 8, 4);
+    const size_t delaysAt = ((36 + 6 * size_t(vertices) + 3) & ~size_t(3)) + 12 * size_t(triangles);
+    ASSERT_EQ(mesh.size(), delaysAt + 4 * size_t(vertices));
+    float lo = 1.0f, hi = 0.0f;
+    for (uint32_t i = 0; i < vertices; ++i) {
+        float d;
+        std::memcpy(&d, mesh.data() + delaysAt + 4 * i, 4);
+        lo = std::min(lo, d), hi = std::max(hi, d);
+    }
+    EXPECT_GE(lo, 0.0f);
+    EXPECT_LE(hi, 0.5f);
+    EXPECT_GT(hi - lo, 0.25f); // the sweep crosses the shapes
+    // One step of undo; keys the page may not set, or a sweep the file lacks: 400.
+    post(session, "undo", "{}");
+    EXPECT_EQ(session.document().text(), original);
+    post(session, "set", R"({"key": "timing.region", "value": 1})", 400);
+    post(session, "set", R"({"values": {"timing.sweep.origin": [0, 0]}})", 400);
+    EXPECT_EQ(session.document().text(), original);
+    const auto plain = copyScene("sphere-to-box.toml");
+    EditorSession none(plain, 32, nullptr);
+    post(none, "set", R"({"key": "timing.sweep.origin", "value": [0, 0, 0]})", 400);
+    EXPECT_EQ(json::parse(none.handle("GET", "/api/state", {}, "").body)["timing"]["sweep"],
+              nullptr);
 }
 
 TEST(EditApi, SurfaceModeShowsTheMeshesAndItsLandmarksMoveTheInBetween)

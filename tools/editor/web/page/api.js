@@ -24,11 +24,12 @@ export async function post(action, body = {}) {
   return (await call('POST', `/api/${action}`, body)).json();
 }
 
-/** "VMM1", counts, the box, uint16 positions over the box, padding, uint32 triangles. */
+/** "VMM1", counts, the box, uint16 positions over the box, padding, uint32 triangles; "VMM2" adds
+ * each vertex's delay under the scene's timing (float32, in t): geometry.userData.delays. */
 export function decodeMesh(buffer) {
   const view = new DataView(buffer);
   const magic = String.fromCharCode(...new Uint8Array(buffer, 0, 4));
-  if (magic !== 'VMM1') throw new Error('not a volmorph mesh');
+  if (magic !== 'VMM1' && magic !== 'VMM2') throw new Error('not a volmorph mesh');
   const vertices = view.getUint32(4, true), triangles = view.getUint32(8, true);
   const lo = [0, 1, 2].map((i) => view.getFloat32(12 + 4 * i, true));
   const hi = [0, 1, 2].map((i) => view.getFloat32(24 + 4 * i, true));
@@ -43,6 +44,7 @@ export function decodeMesh(buffer) {
   const geometry = new THREE.BufferGeometry();
   geometry.setAttribute('position', new THREE.BufferAttribute(positions, 3));
   geometry.setIndex(new THREE.BufferAttribute(indices, 1));
+  if (magic === 'VMM2') geometry.userData.delays = new Float32Array(buffer, indexStart + 12 * triangles, vertices);
   geometry.computeVertexNormals();
   geometry.computeBoundingBox();
   geometry.computeBoundingSphere();

@@ -1,6 +1,6 @@
 // volmorph edit's page: the state from the API, edits sent back one at a time, the in-between
-// fetched anew after each edit that changes the pairs, and the hooks the browser test reads
-// (window.volmorphEditor).
+// fetched anew after each edit that changes the pairs or the timing's sweep, and the hooks the
+// browser test reads (window.volmorphEditor).
 import * as api from './api.js';
 import { View } from './view.js';
 import { elementOf, interpolate, round4 } from './features.js';
@@ -11,6 +11,7 @@ const view = new View($('view'));
 let state = null;
 let selected = 0;
 let side = 'target';
+let sweepHandle = null; // 'origin' or 'end' while the sweep's handle is selected
 let t = 0.5;
 let meshRequest = 0;
 let editStart = 0;
@@ -22,6 +23,21 @@ const hooks = {
   lastUpdateMs: 0,
   state: () => state,
   screenPosition: (pair, s) => view.toScreen(state.pairs[pair - 1][s].origin),
+  /** Where the sweep's handle `which` ('origin' or 'end') is on the page. */
+  sweepScreenPosition: (which) => {
+    const handle = view.sweep.handles.find((h) => h.userData.pick.sweep === which);
+    return handle ? view.toScreen(handle.position.toArray()) : null;
+  },
+  /** The sweep's handle the gizmo holds ('origin', 'end'), or null. */
+  sweepHandle: () => sweepHandle,
+  /** The in-between's delays as received and whether they colour it: {count, min, max, colored}. */
+  morphDelays: () => {
+    const mesh = view.surfaces.morph;
+    const d = mesh && mesh.geometry.userData.delays;
+    if (!d) return { count: 0, colored: false };
+    return { count: d.length, min: d.reduce((a, b) => Math.min(a, b)), max: d.reduce((a, b) => Math.max(a, b)),
+             colored: mesh.material.vertexColors };
+  },
   /** A whole pixel near the view's centre where surface `name` is under the cursor, and its point. */
   surfacePixel: (name) => {
     const r = view.renderer.domElement.getBoundingClientRect();
@@ -54,6 +70,9 @@ function status(text) { $('status').textContent = text; }
 
 function redraw() {
   view.setPairs(state.pairs, t, selected, side);
+  view.setTiming(state.timing);
+  if (sweepHandle) view.selectSweep(sweepHandle);
+  $('delay-legend').hidden = !(state.timing && state.timing.spread > 0);
   showPairs(state, selected, select);
   showFields(state, selected, (key, value) => edit('set', { key, value }));
   showErrors(state);
@@ -88,6 +107,7 @@ function labels() {
 
 function select(index) {
   selected = index;
+  sweepHandle = null;
   redraw();
 }
 
@@ -124,12 +144,13 @@ function edit(action, body = {}) {
 async function sendEdit(action, body) {
   editStart = performance.now();
   try {
-    const before = JSON.stringify(state.pairs);
+    const morphed = (s) => JSON.stringify([s.pairs, s.timing]);
+    const before = morphed(state);
     state = await api.post(action, body);
     if (selected > state.pairs.length) selected = state.pairs.length;
-    if (action === 'add' || action === 'duplicate' || action === 'suggest') selected = state.pairs.length;
+    if (action === 'add' || action === 'duplicate' || action === 'suggest') { selected = state.pairs.length; sweepHandle = null; }
     redraw();
-    if (JSON.stringify(state.pairs) !== before) await refreshMorph();
+    if (morphed(state) !== before) await refreshMorph();
     else status(action === 'save' ? `saved ${state.scene}` : state.valid ? 'no change to the pairs' : 'the scene has problems (right)');
   } catch (e) {
     status(`${action}: ${e.message}`);
@@ -154,6 +175,11 @@ function addPair() {
 function gizmoEdited() {
   const group = view.gizmo.object;
   if (!group || !group.userData.pick) return;
+  if (group.userData.pick.sweep) {
+    const values = view.sweep.edited(group, round4);
+    if (values) edit('set', { values });
+    return;
+  }
   const { pair, side: s } = group.userData.pick;
   const field = { translate: 'origin', rotate: 'axes', scale: 'scale' }[view.gizmo.getMode()];
   const round = (v) => JSON.stringify(v, (k, x) => (typeof x === 'number' ? round4(x) : x));
@@ -176,6 +202,7 @@ function pointerUp(event) {
     return;
   }
   const hit = view.pick(event);
+  if (hit && hit.sweep) { sweepHandle = hit.sweep; setMode('translate'); view.selectSweep(sweepHandle); return; }
   if (hit) { side = hit.side; document.querySelector(`input[name=side][value=${side}]`).checked = true; select(hit.pair); }
 }
 
@@ -212,7 +239,11 @@ function wire() {
   $('t').oninput = () => { t = Number($('t').value); $('t-value').textContent = t.toFixed(2); view.setTime(state.pairs, t); labels(); };
   $('t').onchange = () => refreshMorph();
   view.gizmo.addEventListener('dragging-changed', (e) => { if (!e.value) gizmoEdited(); });
-  view.gizmo.addEventListener('objectChange', labels);
+  view.gizmo.addEventListener('objectChange', () => {
+    if (view.gizmo.object && view.gizmo.object.userData.pick.sweep) view.sweep.follow(view.gizmo.object);
+    labels();
+  });
+  $('show-delay').onchange = (e) => view.showDelay(e.target.checked);
   view.orbit.addEventListener('change', labels);
   const canvas = view.renderer.domElement;
   canvas.addEventListener('pointerdown', pointerDown);

@@ -1,9 +1,11 @@
-// The 3D view: the two sides' surfaces and the in-between, the feature elements, the camera of the
-// scene's shot (orbit from there), the gizmo, picking and snapping.
+// The 3D view: the two sides' surfaces and the in-between (coloured by the timing's delay), the
+// feature elements, the timing's sweep, the camera of the scene's shot (orbit from there), the
+// gizmo, picking and snapping.
 import * as THREE from 'three';
 import { OrbitControls } from 'three/addons/OrbitControls.js';
 import { TransformControls } from 'three/addons/TransformControls.js';
 import { COLORS, makeElement, placeElement, interpolate, keepMarkerSize, highlight } from './features.js';
+import { SweepView, delayColors } from './timing.js';
 
 /** Whether WebGL runs on the CPU (SwiftShader, llvmpipe): then no multisampling, which would cost
  * it several times the drawing. */
@@ -37,6 +39,9 @@ export class View {
     this.scene.add(this.gizmo.getHelper ? this.gizmo.getHelper() : this.gizmo);
     this.surfaces = {};
     this.pairs = []; // [{source, target, at}] groups
+    this.sweep = new SweepView(this.scene);
+    this.timing = null; // the state's
+    this.delayShown = true;
     this.afterRender = [];
     new ResizeObserver(() => this.resize()).observe(container);
   }
@@ -76,9 +81,48 @@ export class View {
     const mesh = new THREE.Mesh(geometry, material);
     mesh.visible = old ? old.visible : true;
     mesh.renderOrder = style.opacity < 1 ? 1 : 0;
+    mesh.userData.color = style.color;
     if (old) { this.scene.remove(old); old.geometry.dispose(); old.material.dispose(); }
     this.surfaces[name] = mesh;
     this.scene.add(mesh);
+    if (name === 'morph') this.colorByDelay();
+    this.render();
+  }
+
+  /** The in-between coloured by each vertex's delay when the scene has a timing and the colours
+   * are shown; its plain colour otherwise. */
+  colorByDelay() {
+    const mesh = this.surfaces.morph;
+    if (!mesh) return;
+    const delays = mesh.geometry.userData.delays, spread = this.timing ? this.timing.spread : 0;
+    const on = this.delayShown && delays && spread > 0;
+    if (on) mesh.geometry.setAttribute('color', new THREE.BufferAttribute(delayColors(delays, spread), 3));
+    mesh.material.vertexColors = Boolean(on);
+    mesh.material.color.setHex(on ? 0xffffff : mesh.userData.color);
+    mesh.material.needsUpdate = true;
+    this.render();
+  }
+
+  showDelay(on) {
+    this.delayShown = on;
+    this.colorByDelay();
+  }
+
+  /** The state's timing: the delay's colours over [0, spread] and the sweep, if any. */
+  setTiming(timing) {
+    this.timing = timing;
+    const box = new THREE.Box3();
+    for (const name of ['source', 'target']) if (this.surfaces[name]) box.expandByObject(this.surfaces[name]);
+    const half = box.isEmpty() ? 1 : 0.35 * box.getSize(new THREE.Vector3()).length();
+    this.sweep.set(timing && timing.spread > 0 ? timing.sweep : null, half, 1.6 * this.markerSize());
+    this.colorByDelay();
+  }
+
+  /** Attaches the gizmo to the sweep's handle `which` ('origin' or 'end'), the pairs unselected. */
+  selectSweep(which) {
+    this.pairs.forEach((p) => { for (const s of ['source', 'target']) highlight(p[s], false); });
+    const handle = this.sweep.handles.find((h) => h.userData.pick.sweep === which);
+    if (handle) this.gizmo.attach(handle); else this.gizmo.detach();
     this.render();
   }
 
@@ -135,10 +179,14 @@ export class View {
     this.render();
   }
 
-  /** The element (pair, side) under a pointer event, if any. */
+  /** The element ({pair, side}) or the sweep's handle ({sweep}) under a pointer event, if any. */
   pick(event) {
     const ray = this.rayAt(event);
     ray.params.Line.threshold = this.markerSize();
+    // The sweep's handles first: small, and often on an element's outline (an edge's pick reaches
+    // a marker's size from the line).
+    const handle = ray.intersectObjects(this.sweep.handles, false)[0];
+    if (handle) return handle.object.userData.pick;
     const objects = this.pairs.flatMap((p) => [p.source, p.target]);
     for (const hit of ray.intersectObjects(objects, true)) {
       let o = hit.object;
