@@ -14,6 +14,7 @@
 #include <array>
 #include <atomic>
 #include <cmath>
+#include <limits>
 #include <map>
 
 namespace volmorph::detail {
@@ -135,6 +136,12 @@ TimedWarp::TimedWarp(const std::vector<FeaturePairSpec>& pairs, const WarpSpec& 
     for (const double tau : table.levels) {
         mWarps.push_back(std::make_shared<const InverseWarp>(pairs, spec, tau, unit));
         // The table's estimate takes a quarter of the tolerance (TauTable::make).
+        std::vector<InverseWarp::Affine> source, target;
+        for (size_t i = 0; i < pairs.size(); ++i) {
+            source.push_back(mWarps.back()->sourceAffine(i));
+            target.push_back(mWarps.back()->targetAffine(i));
+        }
+        mAffines.emplace_back(std::move(source), std::move(target));
         if (mTolerance > 0.0) {
             mAdaptive.push_back(std::make_unique<AdaptiveWarp>(*mWarps.back(), 0.75 * mTolerance));
             mKernels.push_back(
@@ -263,22 +270,59 @@ void TimedWarp::velocities(const Vec3d* p, size_t n, Vec3d* source, Vec3d* targe
     }
 }
 
-std::vector<Coord> TimedWarp::candidates(const CoordBBox& box,
+bool TimedWarp::mayTouch(const CoordBBox& cube, const Occupancy* source,
+                         const Occupancy* target) const
+{
+    if (!source && !target) return true;
+    // The local times the cube's places can have: the delay at its centre, give or take the
+    // steepest delay gradient over its half diagonal.
+    const Vec3d centre = 0.5 * (cube.min().asVec3d() + cube.max().asVec3d());
+    const double reach =
+        mLocal.maxDelayGradient() * 0.5 * double(cube.dim().x()) * std::sqrt(3.0) * mVoxel;
+    const double d = mLocal.delay(mXform.indexToWorld(centre)).d, s = mLocal.spread();
+    const auto tau = [&](double delay) { return std::clamp((mT - delay) / (1.0 - s), 0.0, 1.0); };
+    double f;
+    const size_t first = mTable.interval(tau(d + reach), f);
+    size_t last = mTable.interval(tau(d - reach), f);
+    if (f > 0.0) ++last;
+    // Each level's map at a point is a convex combination of its pairs' affine maps, and the
+    // table's a convex combination of two levels': the image lies in the box of all their images.
+    Vec3d lo[2], hi[2];
+    lo[0] = lo[1] = Vec3d(std::numeric_limits<double>::max());
+    hi[0] = hi[1] = -lo[0];
+    for (size_t k = first; k <= last; ++k)
+        for (int side = 0; side < 2; ++side)
+            for (const InverseWarp::Affine& a :
+                 side == 0 ? mAffines[k].first : mAffines[k].second) {
+                Vec3d a0, a1;
+                affineImage(a, cube.min().asVec3d(), double(cube.dim().x()), a0, a1);
+                lo[side] = minComponent(lo[side], a0);
+                hi[side] = maxComponent(hi[side], a1);
+            }
+    return touches(source, lo[0], hi[0], kSamplerReach) ||
+           touches(target, lo[1], hi[1], kSamplerReach);
+}
+
+std::vector<Coord> TimedWarp::candidates(const CoordBBox& box, const Occupancy* source,
+                                         const Occupancy* target,
                                          const AdaptiveWarp::CellFilter* wanted) const
 {
     std::vector<Coord> out;
     if (box.empty()) return out;
     const Coord lo(box.min().x() & -8, box.min().y() & -8, box.min().z() & -8);
     constexpr int kTop = AdaptiveWarp::kTopCell;
+    const auto keep = [&](const CoordBBox& cube) {
+        return (!wanted || (*wanted)(cube)) && mayTouch(cube, source, target);
+    };
     for (int x = lo.x() & -kTop; x <= box.max().x(); x += kTop)
         for (int y = lo.y() & -kTop; y <= box.max().y(); y += kTop)
             for (int z = lo.z() & -kTop; z <= box.max().z(); z += kTop) {
-                if (wanted && !(*wanted)(CoordBBox::createCube(Coord(x, y, z), kTop))) continue;
+                if (!keep(CoordBBox::createCube(Coord(x, y, z), kTop))) continue;
                 for (int i = std::max(x, lo.x()); i < x + kTop && i <= box.max().x(); i += 8)
                     for (int j = std::max(y, lo.y()); j < y + kTop && j <= box.max().y(); j += 8)
                         for (int k = std::max(z, lo.z()); k < z + kTop && k <= box.max().z();
                              k += 8)
-                            if (!wanted || (*wanted)(CoordBBox::createCube(Coord(i, j, k), 8)))
+                            if (keep(CoordBBox::createCube(Coord(i, j, k), 8)))
                                 out.emplace_back(i, j, k);
             }
     std::sort(out.begin(), out.end());
@@ -395,7 +439,7 @@ void TimedWarp::forEachLeaf(const CoordBBox& box, const Occupancy* source, const
                             const AdaptiveWarp::LeafFunction& fn, AdaptiveWarpStats* stats,
                             Interrupter* interrupter, const AdaptiveWarp::CellFilter* wanted) const
 {
-    const std::vector<Coord> all = candidates(box, wanted);
+    const std::vector<Coord> all = candidates(box, source, target, wanted);
     constexpr size_t kChunk = 2048;
     AdaptiveWarpStats levels; // the levels' traversals
     std::atomic<uint64_t> visited{0};

@@ -15,8 +15,12 @@
 // elsewhere), and the frame's stats add it to the warp's bound. A leaf is filled at every level its
 // voxels' taus reach (one where they all sit at a level, as before a place begins or after it ends;
 // about two to five across the ramp), each level through its own traversal of a list of leaves, a
-// chunk of leaves at a time, and its voxels blended. With tolerance 0 every voxel is mapped exactly
-// at its own tau (the tests' reference).
+// chunk of leaves at a time, and its voxels blended. Before any of that, a cube of 64 and then each
+// leaf is dropped when its image, at every level its places' local times can reach, misses both
+// sides' occupied blocks (the box of the pairs' affine images: a level's map is a convex
+// combination of them, the table's of two levels'): in density mode most of the candidate box is
+// empty (dino-to-eight swept: 2,020 of 76,670 leaves used, the frame 1.67 s -> 0.72 s). With
+// tolerance 0 every voxel is mapped exactly at its own tau (the tests' reference).
 //
 // The velocity is that of the map as made: with the slope S = (W_k+1 - W_k) / h_k,
 //   dW~/dp = (1 - f) J_k + f J_k+1 + S (grad tau)^T,   dW~/dt = S tau_t,
@@ -80,9 +84,15 @@ private:
                          Vec3d* target, bool* regular) const;
     /// The exact warp at tau (a level's when tau is one).
     std::shared_ptr<const InverseWarp> warpAt(double tau) const;
-    /// The leaves of `box` that `wanted` accepts, in order.
-    std::vector<openvdb::Coord> candidates(const openvdb::CoordBBox& box,
+    /// The leaves of `box` that `wanted` accepts and whose image may come near an occupied block
+    /// of either side (mayTouch; every leaf when both are null), in order.
+    std::vector<openvdb::Coord> candidates(const openvdb::CoordBBox& box, const Occupancy* source,
+                                           const Occupancy* target,
                                            const AdaptiveWarp::CellFilter* wanted) const;
+    /// Whether the cube's image, at any local time its places can have, may come near an
+    /// occupied block (the box of the pairs' affine images at the levels those times reach).
+    bool mayTouch(const openvdb::CoordBBox& cube, const Occupancy* source,
+                  const Occupancy* target) const;
     struct Chunk;
     /// Fills a chunk's leaves: at their levels and blended, or exactly.
     void fillChunk(Chunk& chunk, AdaptiveWarpStats& stats, Interrupter* interrupter) const;
@@ -96,8 +106,11 @@ private:
     const openvdb::math::Transform& mXform;
     double mT, mTolerance, mVoxel;
     std::vector<std::shared_ptr<const InverseWarp>> mWarps; ///< at each level
-    std::vector<std::unique_ptr<AdaptiveWarp>> mAdaptive;   ///< each level's, approximated
-    std::vector<std::unique_ptr<VelocityKernel>> mKernels;  ///< each level's jets
+    /// Each level's pairs' affine maps, source and target (for the domain test).
+    std::vector<std::pair<std::vector<InverseWarp::Affine>, std::vector<InverseWarp::Affine>>>
+        mAffines;
+    std::vector<std::unique_ptr<AdaptiveWarp>> mAdaptive;  ///< each level's, approximated
+    std::vector<std::unique_ptr<VelocityKernel>> mKernels; ///< each level's jets
 };
 
 } // namespace volmorph::detail

@@ -1,10 +1,12 @@
 // The warp under a timing (warp/TimedWarp.h): its table's leaves against the exact warp at each
 // voxel's own local time, a place that has not begun against the warp at 0 bit for bit, and the
 // velocity against central differences of the map itself, in space and in t, with a sweep and
-// with a region, both for the table and for the exact warp at tau.
+// with a region, both for the table and for the exact warp at tau; its domain test keeps every leaf
+// whose points reach a side.
 #include "support/WarpFixtures.h"
 
 #include "warp/TimedWarp.h"
+#include "warp/adaptive/DomainTest.h"
 
 #include <volmorph/LocalTime.h>
 
@@ -59,13 +61,17 @@ struct Warps {
     }
 };
 
-/// Every leaf of [0, 47]^3 from forEachLeaf, by origin.
-std::map<openvdb::Coord, detail::WarpLeaf> leaves(const TimedWarp& warp)
+/// Every leaf of `box` (default [0, 47]^3) from forEachLeaf, by origin; with `source`, those its
+/// domain test keeps.
+std::map<openvdb::Coord, detail::WarpLeaf>
+leaves(const TimedWarp& warp,
+       const openvdb::CoordBBox& box = openvdb::CoordBBox(openvdb::Coord(0), openvdb::Coord(47)),
+       const detail::Occupancy* source = nullptr)
 {
     std::map<openvdb::Coord, detail::WarpLeaf> out;
     std::mutex m;
     warp.forEachLeaf(
-        openvdb::CoordBBox(openvdb::Coord(0), openvdb::Coord(47)), nullptr, nullptr,
+        box, source, nullptr,
         [&](const detail::WarpLeaf& leaf) {
             std::lock_guard<std::mutex> lock(m);
             out[leaf.origin] = leaf;
@@ -149,6 +155,35 @@ TEST(TimedWarp, APlaceNotBegunIsTheWarpAtZeroBitForBit)
                           ++compared;
                       });
     EXPECT_GT(compared, 0u);
+}
+
+TEST(TimedWarp, ItsDomainTestKeepsEveryLeafWhosePointsReachASide)
+{
+    // A source occupied in one block-aligned cube; over a box three times the pairs' cube, the
+    // leaves kept are a few of all, and every leaf with a voxel whose source point comes within a
+    // sampler's reach of an occupied block is among them.
+    const Warps s(5);
+    const LocalTime time = sweep();
+    openvdb::FloatGrid::Ptr occupied = openvdb::FloatGrid::create(0.0f);
+    occupied->fill(openvdb::CoordBBox(openvdb::Coord(16), openvdb::Coord(31)), 1.0f, true);
+    const detail::Occupancy source(occupied->tree());
+    const openvdb::CoordBBox box(openvdb::Coord(-48), openvdb::Coord(95));
+    for (const double t : {0.2, 0.5, 0.8}) {
+        const TimedWarp warp = s.at(time, t, 0.25);
+        const auto all = leaves(warp, box), kept = leaves(warp, box, &source);
+        size_t reaching = 0;
+        for (const auto& [origin, leaf] : all) {
+            bool reaches = false;
+            for (int n = 0; n < 512 && !reaches; ++n)
+                reaches = detail::touches(&source, Vec3d(leaf.source(n)), Vec3d(leaf.source(n)),
+                                          detail::kSamplerReach);
+            if (!reaches) continue;
+            ++reaching;
+            EXPECT_TRUE(kept.count(origin)) << "t " << t << " leaf " << origin;
+        }
+        EXPECT_GT(reaching, 0u) << "t " << t;
+        EXPECT_LT(kept.size(), all.size() / 4) << "t " << t;
+    }
 }
 
 TEST(TimedWarp, TheVelocityIsTheMapsOwnDerivativeUnderASweepAndARegion)
