@@ -1,6 +1,7 @@
 #include "EditorSession.h"
 
 #include <volmorph/PairSuggest.h>
+#include <volmorph/SceneSurface.h>
 #include <volmorph/SceneVolumes.h>
 #include <volmorph/Schedule.h>
 #include <volmorph/core/Diagnostics.h>
@@ -96,14 +97,18 @@ std::string surfaceOf(const VolumeSet& volumes, const LocalTime* timing)
     return encodeMesh(points, triangles, quads, &delays);
 }
 
-std::string encodeTriangles(const std::vector<Vec3d>& points, const std::vector<Vec3I>& triangles)
+std::string encodeTriangles(const std::vector<Vec3d>& points, const std::vector<Vec3I>& triangles,
+                            const LocalTime* timing)
 {
     std::vector<openvdb::Vec3s> p(points.begin(), points.end());
     // encodeMesh turns volumeToMesh's winding round: turned here first, the file's is kept.
     std::vector<openvdb::Vec3I> t;
     t.reserve(triangles.size());
     for (const Vec3I& f : triangles) t.emplace_back(f[0], f[2], f[1]);
-    return encodeMesh(p, t, {});
+    if (!timing || !timing->active()) return encodeMesh(p, t, {});
+    std::vector<float> delays(points.size());
+    for (size_t i = 0; i < points.size(); ++i) delays[i] = float(timing->delay(points[i]).d);
+    return encodeMesh(p, t, {}, &delays);
 }
 
 EditorSession::EditorSession(const std::filesystem::path& scene, int resolution,
@@ -119,6 +124,18 @@ EditorSession::EditorSession(const std::filesystem::path& scene, int resolution,
         };
         mSourceMesh = encode(meshes.source);
         mTargetMesh = encode(meshes.target);
+        if (preview.timing.spread > 0.0) { // its regions at the voxel size a morph would take
+            const auto extent = [](const Mesh& m) {
+                const auto [lo, hi] = m.bounds();
+                return SideExtent{lo, hi, std::nullopt};
+            };
+            mTimingRegions = loadTimingRegions(
+                preview,
+                sceneVoxelSize(preview.volume, extent(meshes.source), extent(meshes.target)),
+                interrupter);
+            mLocalTime = std::make_shared<const LocalTime>(preview.timing, mTimingRegions);
+        }
+        mMorpherTiming = mDocument.timingVersion();
         mSurfaceSides.emplace(std::move(meshes.source), std::move(meshes.target));
         return;
     }
@@ -209,17 +226,26 @@ Reply EditorSession::surfaceMesh(double t)
     std::lock_guard<std::mutex> one(mMorphMutex);
     SurfaceSpec spec;
     BlendSpec blend;
-    uint64_t version = 0;
+    TimingSettings timing;
+    uint64_t version = 0, timingVersion = 0, lastTiming = 0;
     std::shared_ptr<const SurfaceMorpher> morpher;
+    std::shared_ptr<const LocalTime> local;
     {
         std::lock_guard<std::mutex> lock(mMutex);
         version = mDocument.pairsVersion();
-        if (mMorphVersion == version && mMorphT == t)
+        timingVersion = mDocument.timingVersion();
+        if (mMorphVersion == version + timingVersion && mMorphT == t)
             return {200, "application/octet-stream", mMorphMesh};
         spec = mDocument.scene().surface;
         blend = mDocument.scene().blend;
+        timing = mDocument.scene().timing;
         if (mSurfaceVersion == version) morpher = mSurfaceMorpher;
+        local = mLocalTime;
+        lastTiming = mMorpherTiming;
     }
+    if (timingVersion != lastTiming) // the sweep was dragged: the same regions, read once
+        local = timing.spread > 0.0 ? std::make_shared<const LocalTime>(timing, mTimingRegions)
+                                    : nullptr;
     if (!morpher) {
         try {
             morpher = std::make_shared<const SurfaceMorpher>(
@@ -228,13 +254,14 @@ Reply EditorSession::surfaceMesh(double t)
             throw Conflict(e.what());
         }
     }
-    const SurfaceFrame frame =
-        morpher->frame(scheduleValue(blend.sdf, t), scheduleValue(blend.color, t));
-    std::string mesh = encodeTriangles(frame.points, frame.triangles);
+    const SurfaceFrame frame = surfaceFrameAt(*morpher, blend, local.get(), t, 0.0);
+    std::string mesh = encodeTriangles(frame.points, frame.triangles, local.get());
     std::lock_guard<std::mutex> lock(mMutex);
     mSurfaceMorpher = morpher;
     mSurfaceVersion = version;
-    keepMorphMesh(mesh, version, t);
+    mLocalTime = local;
+    mMorpherTiming = timingVersion;
+    keepMorphMesh(mesh, version + timingVersion, t);
     return {200, "application/octet-stream", std::move(mesh)};
 }
 

@@ -67,8 +67,10 @@ std::string encodeMesh(const std::vector<openvdb::Vec3s>& points,
 /// delay under `timing` when it is active.
 std::string surfaceOf(const VolumeSet& volumes, const LocalTime* timing = nullptr);
 
-/// A mesh (world units, triangles wound as the file has them) encoded as above.
-std::string encodeTriangles(const std::vector<Vec3d>& points, const std::vector<Vec3I>& triangles);
+/// A mesh (world units, triangles wound as the file has them) encoded as above, with each vertex's
+/// delay under `timing` when it is active.
+std::string encodeTriangles(const std::vector<Vec3d>& points, const std::vector<Vec3I>& triangles,
+                            const LocalTime* timing = nullptr);
 
 class EditorSession {
 public:

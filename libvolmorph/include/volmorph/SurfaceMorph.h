@@ -13,6 +13,7 @@
 #include <volmorph/core/Interrupter.h>
 #include <volmorph/SurfaceSettings.h>
 
+#include <functional>
 #include <memory>
 #include <optional>
 #include <utility>
@@ -40,6 +41,15 @@ struct SurfaceFrame {
     Mesh mesh() const;
 };
 
+/// Under a timing (LocalTime.h), a place's time as the caller's schedule makes it: tau there in
+/// [0, 1], d tau / d t, and grad tau per world unit.
+struct PlaceTau {
+    double tau = 0.0;
+    double dt = 0.0;
+    Vec3d gradient{0.0};
+};
+using PlaceTime = std::function<PlaceTau(const Vec3d& place)>;
+
 class SurfaceMorpher {
 public:
     /// Puts `source` and `target` (world units) into correspondence as `spec` says and prepares
@@ -55,6 +65,14 @@ public:
     /// The in-between at `shapeTau` (positions) and `colorTau` (colours), each in [0, 1]: the
     /// source's at 0 and the target's at 1.
     SurfaceFrame frame(double shapeTau, double colorTau) const;
+    /// The in-between under a timing: each vertex at the shape's tau of its own place, the point
+    /// of its straight path x(s) = a + s (b - a) where the place's tau is s itself (one exists, s
+    /// in [0, 1]; Newton's steps kept in a bisection's bracket), and with "arap" each triangle at
+    /// its corners' mean tau; each vertex's colour at the colour's tau where it is. `velocity` is
+    /// then d position / d t, world units per unit t, exact: d s / d t = tau_t / (1 - grad tau .
+    /// (b - a)), 0 where that denominator is not positive (the place's time runs back along the
+    /// path faster than the vertex moves: a fold).
+    SurfaceFrame frame(const PlaceTime& shape, const PlaceTime& color) const;
 
     Correspondence correspondence() const; ///< the one used ("auto" resolved)
     size_t vertexCount() const;

@@ -71,11 +71,6 @@ public:
         if (mScene.blend.mode == BlendMode::Surface) checkSurfaceMode(root);
         if (const toml::node* n = root.get("timing")) {
             detail::parseTiming(r, *n, mScene.folder, mScene.timing, mScene.timingRegions);
-            const BlendMode mode = mScene.blend.mode;
-            if (mode == BlendMode::Surface)
-                r.error(mScene.timing.where,
-                        "[timing]: not yet applied to surface morphs; density, sdf and "
-                        "variational modes take it");
         }
         if (const toml::node* n = root.get("render"))
             detail::parseRender(r, *n, mScene.folder, mScene.render);

@@ -1,5 +1,6 @@
 #include <volmorph/SceneSurface.h>
 
+#include <volmorph/LocalTime.h>
 #include <volmorph/SceneVolumes.h>
 #include <volmorph/Schedule.h>
 #include <volmorph/Voxelize.h>
@@ -27,7 +28,36 @@ std::pair<Mesh, Mesh> sceneMeshes(const Scene& scene)
             coloured(std::move(meshes.target), scene.target)};
 }
 
+/// A place's time under `timing` with `schedule` applied (the chain rule through it).
+PlaceTime placeTime(const LocalTime& timing, const ScheduleSpec& schedule, double t)
+{
+    return [&timing, &schedule, t](const Vec3d& x) {
+        const LocalTau local = timing.at(x, t);
+        const double slope = scheduleSlope(schedule, local.tau);
+        return PlaceTau{scheduleValue(schedule, local.tau), slope * local.dt,
+                        local.gradient * slope};
+    };
+}
+
 } // namespace
+
+SurfaceFrame surfaceFrameAt(const SurfaceMorpher& morpher, const BlendSpec& blend,
+                            const LocalTime* timing, double t, double secondsPerUnitT)
+{
+    if (timing && timing->active()) {
+        SurfaceFrame f =
+            morpher.frame(placeTime(*timing, blend.sdf, t), placeTime(*timing, blend.color, t));
+        const double scale = secondsPerUnitT > 0.0 ? 1.0 / secondsPerUnitT : 0.0;
+        for (Vec3d& v : f.velocity) v *= scale;
+        return f;
+    }
+    SurfaceFrame f = morpher.frame(scheduleValue(blend.sdf, t), scheduleValue(blend.color, t));
+    // d x / d second = d x / d tau * d tau / d t / (seconds per unit of t)
+    const double scale =
+        secondsPerUnitT > 0.0 ? scheduleSlope(blend.sdf, t) / secondsPerUnitT : 0.0;
+    for (Vec3d& v : f.velocity) v *= scale;
+    return f;
+}
 
 SceneSurface::SceneSurface(const Scene& scene, Interrupter* interrupter)
     : SceneSurface(scene, sceneMeshes(scene), interrupter)
@@ -40,17 +70,15 @@ SceneSurface::SceneSurface(const Scene& scene, std::pair<Mesh, Mesh> meshes,
       mVoxelSize(sceneVoxelSize(scene.volume, extentOf(meshes.first), extentOf(meshes.second))),
       mMorpher(std::move(meshes.first), std::move(meshes.second), scene.surface, interrupter)
 {
+    if (scene.timing.spread > 0.0)
+        mLocalTime = std::make_shared<const LocalTime>(
+            scene.timing, loadTimingRegions(scene, mVoxelSize, interrupter));
 }
 
 SurfaceFrame SceneSurface::frame(int frame) const
 {
-    const double t = mFrames.t(frame);
-    SurfaceFrame f = mMorpher.frame(scheduleValue(mBlend.sdf, t), scheduleValue(mBlend.color, t));
-    // d x / d second = d x / d tau * d tau / d t / (seconds per unit of t)
-    const double seconds = mFrames.secondsPerUnitT();
-    const double scale = seconds > 0.0 ? scheduleSlope(mBlend.sdf, t) / seconds : 0.0;
-    for (Vec3d& v : f.velocity) v *= scale;
-    return f;
+    return surfaceFrameAt(mMorpher, mBlend, mLocalTime.get(), mFrames.t(frame),
+                          mFrames.secondsPerUnitT());
 }
 
 VolumeSet SceneSurface::voxels(const SurfaceFrame& frame, Interrupter* interrupter,

@@ -84,6 +84,9 @@ RigidInterpolation::RigidInterpolation(const std::vector<Vec3d>& source,
                                        const std::vector<Vec3I>& triangles)
 {
     findPieces(source, target, triangles);
+    mSource = source;
+    mTarget = target;
+    mCorners = triangles;
     mTriangles.resize(triangles.size());
     tbb::parallel_for(size_t(0), triangles.size(),
                       [&](size_t j) { mTriangles[j] = decompose(source, target, triangles[j]); });
@@ -114,8 +117,8 @@ RigidInterpolation::RigidInterpolation(const std::vector<Vec3d>& source,
     // What the fit misses of each end (rounding, and triangles too thin to have a frame): taken
     // out along the straight line, so that tau = 0 and 1 are the inputs.
     std::vector<Vec3d> velocity;
-    solve(0.0, mMissed0, velocity);
-    solve(1.0, mMissed1, velocity);
+    solveAt(0.0, mMissed0, velocity);
+    solveAt(1.0, mMissed1, velocity);
     for (size_t v = 0; v < source.size(); ++v) {
         mMissed0[v] -= source[v];
         mMissed1[v] -= target[v];
@@ -157,16 +160,18 @@ void RigidInterpolation::findPieces(const std::vector<Vec3d>& source,
     }
 }
 
-void RigidInterpolation::rightHandSide(double tau, Eigen::MatrixXd& rhs) const
+void RigidInterpolation::rightHandSide(const Times& times, Eigen::MatrixXd& rhs) const
 {
-    // Per triangle G(tau) and dG/dtau, from one rotation and one stretch.
+    // Per triangle G(tau) and dG/dtau times its rate, from one rotation and one stretch.
     std::vector<Eigen::Matrix3d> g(mTriangles.size()), dg(mTriangles.size());
     tbb::parallel_for(size_t(0), mTriangles.size(), [&](size_t j) {
         const Triangle& t = mTriangles[j];
+        const double tau = times.tau[j];
         const Eigen::Matrix3d turn = Eigen::AngleAxisd(tau * t.angle, t.axis).toRotationMatrix();
         const Eigen::Matrix3d stretch = (1.0 - tau) * Eigen::Matrix3d::Identity() + tau * t.stretch;
         g[j] = turn * stretch;
         dg[j] = t.angle * cross(t.axis) * g[j] + turn * (t.stretch - Eigen::Matrix3d::Identity());
+        if (times.rate[j] != 1.0) dg[j] *= times.rate[j];
     });
     rhs.setZero(mRows, 6);
     for (const Edge& e : mEdges) {
@@ -181,14 +186,57 @@ void RigidInterpolation::rightHandSide(double tau, Eigen::MatrixXd& rhs) const
 void RigidInterpolation::positions(double tau, std::vector<Vec3d>& out,
                                    std::vector<Vec3d>& velocity) const
 {
-    solve(tau, out, velocity);
+    solveAt(tau, out, velocity);
     for (size_t v = 0; v < out.size(); ++v) {
         out[v] -= (1.0 - tau) * mMissed0[v] + tau * mMissed1[v];
         velocity[v] -= mMissed1[v] - mMissed0[v];
     }
 }
 
-void RigidInterpolation::solve(double tau, std::vector<Vec3d>& out,
+void RigidInterpolation::positions(const std::vector<double>& vertexTau,
+                                   const std::vector<double>& vertexRate, std::vector<Vec3d>& out,
+                                   std::vector<Vec3d>& velocity) const
+{
+    // Each triangle at its corners' mean tau; each piece's mean on the mean of its vertices'
+    // straight lines, each at its own tau.
+    Times times;
+    times.tau.resize(mCorners.size());
+    times.rate.resize(mCorners.size());
+    for (size_t j = 0; j < mCorners.size(); ++j) {
+        const Vec3I& c = mCorners[j];
+        times.tau[j] = (vertexTau[c[0]] + vertexTau[c[1]] + vertexTau[c[2]]) / 3.0;
+        times.rate[j] = (vertexRate[c[0]] + vertexRate[c[1]] + vertexRate[c[2]]) / 3.0;
+    }
+    times.centre.assign(mPieceSize.size(), Eigen::Vector3d::Zero());
+    times.drift.assign(mPieceSize.size(), Eigen::Vector3d::Zero());
+    for (size_t v = 0; v < mSource.size(); ++v) {
+        const Eigen::Vector3d a = toEigen(mSource[v]), b = toEigen(mTarget[v]);
+        times.centre[mPiece[v]] += (a + vertexTau[v] * (b - a)) / mPieceSize[mPiece[v]];
+        times.drift[mPiece[v]] += (b - a) * (vertexRate[v] / mPieceSize[mPiece[v]]);
+    }
+    solve(times, out, velocity);
+    for (size_t v = 0; v < out.size(); ++v) {
+        out[v] -= (1.0 - vertexTau[v]) * mMissed0[v] + vertexTau[v] * mMissed1[v];
+        velocity[v] -= (mMissed1[v] - mMissed0[v]) * vertexRate[v];
+    }
+}
+
+void RigidInterpolation::solveAt(double tau, std::vector<Vec3d>& out,
+                                 std::vector<Vec3d>& velocity) const
+{
+    Times times;
+    times.tau.assign(mTriangles.size(), tau);
+    times.rate.assign(mTriangles.size(), 1.0);
+    times.centre.resize(mPieceSize.size());
+    times.drift.resize(mPieceSize.size());
+    for (size_t p = 0; p < mPieceSize.size(); ++p) {
+        times.centre[p] = (1.0 - tau) * mSourceMean[p] + tau * mTargetMean[p];
+        times.drift[p] = mTargetMean[p] - mSourceMean[p];
+    }
+    solve(times, out, velocity);
+}
+
+void RigidInterpolation::solve(const Times& times, std::vector<Vec3d>& out,
                                std::vector<Vec3d>& velocity) const
 {
     const size_t n = mFree.size();
@@ -209,7 +257,7 @@ void RigidInterpolation::solve(double tau, std::vector<Vec3d>& out,
         }
     };
     Eigen::MatrixXd rhs;
-    rightHandSide(tau, rhs);
+    rightHandSide(times, rhs);
     // The six columns are independent solves with one factor (read-only): one per task.
     Eigen::MatrixXd solved = rhs;
     if (mRows)
@@ -217,13 +265,8 @@ void RigidInterpolation::solve(double tau, std::vector<Vec3d>& out,
             const Eigen::VectorXd column = rhs.col(c);
             solved.col(c) = mSolver.solve(column);
         });
-    std::vector<Eigen::Vector3d> centre(mPieceSize.size()), drift(mPieceSize.size());
-    for (size_t p = 0; p < centre.size(); ++p) {
-        centre[p] = (1.0 - tau) * mSourceMean[p] + tau * mTargetMean[p];
-        drift[p] = mTargetMean[p] - mSourceMean[p];
-    }
-    assemble(solved, 0, centre, out);
-    assemble(solved, 3, drift, velocity);
+    assemble(solved, 0, times.centre, out);
+    assemble(solved, 3, times.drift, velocity);
 }
 
 } // namespace volmorph::detail

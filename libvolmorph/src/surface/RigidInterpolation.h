@@ -43,6 +43,12 @@ public:
 
     /// Positions at `tau` and d position / d tau (one solve for both).
     void positions(double tau, std::vector<Vec3d>& out, std::vector<Vec3d>& velocity) const;
+    /// Positions with each vertex at its own tau (under a timing) and d position / d t, from each
+    /// vertex's d tau / d t (`vertexRate`): each triangle asks for G at its corners' mean tau, and
+    /// each piece's vertex mean follows the mean of its vertices' straight lines, each at its own
+    /// tau. With every tau equal and every rate 1, what positions(tau) gives.
+    void positions(const std::vector<double>& vertexTau, const std::vector<double>& vertexRate,
+                   std::vector<Vec3d>& out, std::vector<Vec3d>& velocity) const;
 
     /// One triangle's map from source to target, A = rotation * stretch.
     struct Triangle {
@@ -57,13 +63,20 @@ private:
         double weight;        ///< cot(opposite angle) / 2
         Eigen::Vector3d edge; ///< source p_a - p_b
     };
+    /// Each triangle's tau and d tau / d t (or 1: the derivative along tau), and each piece's
+    /// vertex mean and its rate.
+    struct Times {
+        std::vector<double> tau, rate;
+        std::vector<Eigen::Vector3d> centre, drift;
+    };
     void findPieces(const std::vector<Vec3d>& source, const std::vector<Vec3d>& target,
                     const std::vector<Vec3I>& triangles);
-    /// The fit at tau, before the ends' misses are taken out.
-    void solve(double tau, std::vector<Vec3d>& out, std::vector<Vec3d>& velocity) const;
-    /// The reduced system's right-hand sides at tau: columns 0-2 for the positions, 3-5 for
-    /// their derivative.
-    void rightHandSide(double tau, Eigen::MatrixXd& rhs) const;
+    /// The fit at `times` (or everywhere at tau), before the ends' misses are taken out.
+    void solve(const Times& times, std::vector<Vec3d>& out, std::vector<Vec3d>& velocity) const;
+    void solveAt(double tau, std::vector<Vec3d>& out, std::vector<Vec3d>& velocity) const;
+    /// The reduced system's right-hand sides: columns 0-2 for the positions, 3-5 for their
+    /// derivative.
+    void rightHandSide(const Times& times, Eigen::MatrixXd& rhs) const;
 
     std::vector<Triangle> mTriangles;
     std::vector<Edge> mEdges;
@@ -74,6 +87,8 @@ private:
     std::vector<double> mPieceSize;
     Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> mSolver;
     std::vector<Vec3d> mMissed0, mMissed1; ///< the fit's positions minus the inputs at 0 and 1
+    std::vector<Vec3d> mSource, mTarget;   ///< the inputs (each vertex's straight line)
+    std::vector<Vec3I> mCorners;           ///< the triangles
 };
 
 } // namespace volmorph::detail
