@@ -321,8 +321,9 @@ bool readVector(int fd, std::vector<T>& v, ReaderBudget& budget)
 
 /// readWithAssimp() in a child process, so that a parser that aborts, crashes or never returns on
 /// a malformed file (Assimp 5.2 does all three; fuzzing found them) becomes an error message, not
-/// a dead or hung volmorph. The limits grow with the file: 5 s of the reader's CPU time plus 2 s
-/// per MB, and 60 s plus 10 s per MB of waiting.
+/// a dead or hung volmorph. The limits grow with the file: 2 s of the reader's CPU time plus 1 s
+/// per MB (Assimp reads tens of MB a second; a parser in an endless loop is stopped within the
+/// 10 s a bad input may take even with a third of a core), and 60 s plus 10 s per MB of waiting.
 RawMesh readIsolated(const std::filesystem::path& file, uintmax_t bytes)
 {
     RawMesh raw;
@@ -344,7 +345,7 @@ RawMesh readIsolated(const std::filesystem::path& file, uintmax_t bytes)
         ::_exit(ok ? 0 : 1);
     }
     ::close(fds[1]);
-    ReaderBudget budget(child, 5.0 + 2.0 * double(bytes) / 1e6, 60.0 + 10.0 * double(bytes) / 1e6);
+    ReaderBudget budget(child, 2.0 + 1.0 * double(bytes) / 1e6, 60.0 + 10.0 * double(bytes) / 1e6);
     std::vector<char> error;
     const bool ok = readVector(fds[0], error, budget) &&
                     readVector(fds[0], raw.positions, budget) &&
