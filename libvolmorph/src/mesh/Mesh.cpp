@@ -254,41 +254,66 @@ bool writeVector(int fd, const std::vector<T>& v)
     return writeAll(fd, &n, sizeof n) && writeAll(fd, v.data(), v.size() * sizeof(T));
 }
 
+/// True when process `pid` is asleep (blocked, not waiting for a core): /proc/pid/stat's state.
+bool asleep(pid_t pid)
+{
+    char path[64];
+    std::snprintf(path, sizeof path, "/proc/%d/stat", int(pid));
+    std::FILE* f = std::fopen(path, "r");
+    if (!f) return false;
+    char text[512];
+    const size_t n = std::fread(text, 1, sizeof text - 1, f);
+    std::fclose(f);
+    text[n] = '\0';
+    const char* close = std::strrchr(text, ')'); // the name may hold anything but this
+    return close && close[1] == ' ' && close[2] == 'S';
+}
+
 /// How long the reader in the child may take: `cpuSeconds` of its own work (a parser in an endless
-/// loop spends it) and at most `wallSeconds` of waiting (a reader stuck without working). Work is
-/// measured, not the wall clock, so that a child starved of a core on a loaded machine is not taken
-/// for a hung one (a 5 s wall-clock limit failed a cube's import under CI's load).
+/// loop spends it) and at most `wallSeconds` of waiting. Work is measured, not the wall clock, so
+/// that a child starved of a core on a loaded machine is not taken for a hung one. A child asleep
+/// with no work done for kStallSeconds is stalled: fork() copies one thread of a process whose
+/// other threads (TBB's) may hold a lock at that instant, and the child then waits for it forever
+/// (seen: a sphere's import under ASan, and a cube's in CI; the caller forks again).
 class ReaderBudget {
 public:
+    static constexpr double kStallSeconds = 2.0;
+
     ReaderBudget(pid_t child, double cpuSeconds, double wallSeconds)
-        : mCpu(cpuSeconds), mWall(wallSeconds), mStart(std::chrono::steady_clock::now())
+        : mChild(child), mCpu(cpuSeconds), mWall(wallSeconds),
+          mStart(std::chrono::steady_clock::now()), mLastWork(mStart)
     {
         mHasCpuClock = ::clock_getcpuclockid(child, &mClock) == 0;
     }
 
-    /// True once either limit is spent; `exhausted()` then says which.
+    /// True once a limit is spent or the child stalled; `exhausted()` then says which.
     bool spent()
     {
-        const double waited =
-            std::chrono::duration<double>(std::chrono::steady_clock::now() - mStart).count();
+        const auto now = std::chrono::steady_clock::now();
+        const double waited = std::chrono::duration<double>(now - mStart).count();
         timespec used{};
         const bool cpuKnown = mHasCpuClock && ::clock_gettime(mClock, &used) == 0;
         const double worked = cpuKnown ? double(used.tv_sec) + 1e-9 * double(used.tv_nsec) : waited;
+        if (worked > mWorked) mWorked = worked, mLastWork = now;
+        const double idle = std::chrono::duration<double>(now - mLastWork).count();
         if (worked >= mCpu)
             mExhausted = Limit::Cpu;
         else if (waited >= mWall)
             mExhausted = Limit::Wall;
+        else if (cpuKnown && idle >= kStallSeconds && asleep(mChild))
+            mExhausted = Limit::Stalled;
         return mExhausted != Limit::None;
     }
 
-    enum class Limit { None, Cpu, Wall };
+    enum class Limit { None, Cpu, Wall, Stalled };
     Limit exhausted() const { return mExhausted; }
     double cpuSeconds() const { return mCpu; }
     double wallSeconds() const { return mWall; }
 
 private:
-    double mCpu, mWall;
-    std::chrono::steady_clock::time_point mStart;
+    pid_t mChild;
+    double mCpu, mWall, mWorked = -1.0;
+    std::chrono::steady_clock::time_point mStart, mLastWork;
     clockid_t mClock{};
     bool mHasCpuClock = false;
     Limit mExhausted = Limit::None;
@@ -321,10 +346,11 @@ bool readVector(int fd, std::vector<T>& v, ReaderBudget& budget)
 
 /// readWithAssimp() in a child process, so that a parser that aborts, crashes or never returns on
 /// a malformed file (Assimp 5.2 does all three; fuzzing found them) becomes an error message, not
-/// a dead or hung volmorph. The limits grow with the file: 2 s of the reader's CPU time plus 1 s
-/// per MB (Assimp reads tens of MB a second; a parser in an endless loop is stopped within the
-/// 10 s a bad input may take even with a third of a core), and 60 s plus 10 s per MB of waiting.
-RawMesh readIsolated(const std::filesystem::path& file, uintmax_t bytes)
+/// a dead or hung volmorph; a child that stalled (ReaderBudget) is tried again, three times in
+/// all. The limits grow with the file: 2 s of the reader's CPU time plus 1 s per MB (Assimp reads
+/// tens of MB a second; a parser in an endless loop is stopped within the 10 s a bad input may
+/// take even with a third of a core), and 60 s plus 10 s per MB of waiting.
+RawMesh readInChild(const std::filesystem::path& file, uintmax_t bytes, bool& stalled)
 {
     RawMesh raw;
     int fds[2];
@@ -360,7 +386,10 @@ RawMesh readIsolated(const std::filesystem::path& file, uintmax_t bytes)
         return raw;
     }
     raw = RawMesh{};
-    if (budget.exhausted() != ReaderBudget::Limit::None) {
+    stalled = budget.exhausted() == ReaderBudget::Limit::Stalled;
+    if (stalled) {
+        raw.error = "the mesh reader stopped working three times (a fork of a busy process)";
+    } else if (budget.exhausted() != ReaderBudget::Limit::None) {
         const bool cpu = budget.exhausted() == ReaderBudget::Limit::Cpu;
         char text[200];
         std::snprintf(text, sizeof text,
@@ -377,6 +406,15 @@ RawMesh readIsolated(const std::filesystem::path& file, uintmax_t bytes)
         raw.error = "the mesh reader (Assimp) failed on this file; it is probably malformed";
     }
     return raw;
+}
+
+RawMesh readIsolated(const std::filesystem::path& file, uintmax_t bytes)
+{
+    for (int attempt = 1;; ++attempt) {
+        bool stalled = false;
+        RawMesh raw = readInChild(file, bytes, stalled);
+        if (!stalled || attempt == 3) return raw;
+    }
 }
 
 } // namespace
