@@ -46,6 +46,28 @@ json parseBody(const std::string& body)
     return value;
 }
 
+/// Each point's delay under `timing`, for the page's colours; null when there is no timing.
+template <typename Point>
+std::unique_ptr<std::vector<float>> delaysOf(const std::vector<Point>& points,
+                                             const LocalTime* timing)
+{
+    if (!timing || !timing->active()) return nullptr;
+    auto delays = std::make_unique<std::vector<float>>(points.size());
+    for (size_t i = 0; i < points.size(); ++i)
+        (*delays)[i] = float(timing->delay(Vec3d(points[i])).d);
+    return delays;
+}
+
+/// The timing an in-between is made under: `current` while the scene's timing is at the version
+/// it was made for, else a new one from `timing` (the sweep was dragged) and the regions read once.
+std::shared_ptr<const LocalTime> timingAt(std::shared_ptr<const LocalTime> current, bool changed,
+                                          const TimingSettings& timing,
+                                          const std::vector<TimingRegion>& regions)
+{
+    if (!changed) return current;
+    return timing.spread > 0.0 ? std::make_shared<const LocalTime>(timing, regions) : nullptr;
+}
+
 } // namespace
 
 std::string encodeMesh(const std::vector<openvdb::Vec3s>& points,
@@ -91,10 +113,7 @@ std::string surfaceOf(const VolumeSet& volumes, const LocalTime* timing)
         openvdb::tools::volumeToMesh(*volumes.sdf, points, triangles, quads, 0.0, 0.0);
     else if (volumes.density)
         openvdb::tools::volumeToMesh(*volumes.density, points, triangles, quads, 0.5, 0.0);
-    if (!timing || !timing->active()) return encodeMesh(points, triangles, quads);
-    std::vector<float> delays(points.size());
-    for (size_t i = 0; i < points.size(); ++i) delays[i] = float(timing->delay(Vec3d(points[i])).d);
-    return encodeMesh(points, triangles, quads, &delays);
+    return encodeMesh(points, triangles, quads, delaysOf(points, timing).get());
 }
 
 std::string encodeTriangles(const std::vector<Vec3d>& points, const std::vector<Vec3I>& triangles,
@@ -105,10 +124,7 @@ std::string encodeTriangles(const std::vector<Vec3d>& points, const std::vector<
     std::vector<openvdb::Vec3I> t;
     t.reserve(triangles.size());
     for (const Vec3I& f : triangles) t.emplace_back(f[0], f[2], f[1]);
-    if (!timing || !timing->active()) return encodeMesh(p, t, {});
-    std::vector<float> delays(points.size());
-    for (size_t i = 0; i < points.size(); ++i) delays[i] = float(timing->delay(points[i]).d);
-    return encodeMesh(p, t, {}, &delays);
+    return encodeMesh(p, t, {}, delaysOf(points, timing).get());
 }
 
 EditorSession::EditorSession(const std::filesystem::path& scene, int resolution,
@@ -195,9 +211,7 @@ Reply EditorSession::morphMesh(double t)
         lastVersion = mMorpherVersion;
         lastTiming = mMorpherTiming;
     }
-    if (timingVersion != lastTiming) // the sweep was dragged: the same regions, read once
-        local = timing.spread > 0.0 ? std::make_shared<const LocalTime>(timing, mTimingRegions)
-                                    : nullptr;
+    local = timingAt(local, timingVersion != lastTiming, timing, mTimingRegions);
     std::shared_ptr<const Morpher> morpher = last;
     if (!last) {
         MorphOptions options;
@@ -243,9 +257,7 @@ Reply EditorSession::surfaceMesh(double t)
         local = mLocalTime;
         lastTiming = mMorpherTiming;
     }
-    if (timingVersion != lastTiming) // the sweep was dragged: the same regions, read once
-        local = timing.spread > 0.0 ? std::make_shared<const LocalTime>(timing, mTimingRegions)
-                                    : nullptr;
+    local = timingAt(local, timingVersion != lastTiming, timing, mTimingRegions);
     if (!morpher) {
         try {
             morpher = std::make_shared<const SurfaceMorpher>(

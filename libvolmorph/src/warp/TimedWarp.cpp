@@ -279,8 +279,10 @@ bool TimedWarp::mayTouch(const CoordBBox& cube, const Occupancy* source,
     const Vec3d centre = 0.5 * (cube.min().asVec3d() + cube.max().asVec3d());
     const double reach =
         mLocal.maxDelayGradient() * 0.5 * double(cube.dim().x()) * std::sqrt(3.0) * mVoxel;
-    const double d = mLocal.delay(mXform.indexToWorld(centre)).d, s = mLocal.spread();
-    const auto tau = [&](double delay) { return std::clamp((mT - delay) / (1.0 - s), 0.0, 1.0); };
+    const double d = mLocal.delay(mXform.indexToWorld(centre)).d;
+    const auto tau = [&](double delay) {
+        return mLocal.fromDelay(Delay{delay, Vec3d(0.0)}, mT).tau;
+    };
     double f;
     const size_t first = mTable.interval(tau(d + reach), f);
     size_t last = mTable.interval(tau(d - reach), f);
