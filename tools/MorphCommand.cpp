@@ -8,7 +8,6 @@
 #include <volmorph/Frames.h>
 #include <volmorph/Morph.h>
 #include <volmorph/SceneSurface.h>
-#include <volmorph/core/Version.h>
 #include <volmorph/Voxelize.h>
 
 #include <unistd.h>
@@ -29,22 +28,15 @@ struct MorphArgs {
 
 /// Writes one in-between as a .vdb at `file` (and its surface, with --mesh).
 void writeFrame(const VolumeSet& v, const std::filesystem::path& file, const MorphArgs& args,
-                const FrameStep& step, double fps)
+                const Scene& scene, int frame)
 {
     if (file.has_parent_path()) std::filesystem::create_directories(file.parent_path());
-    VdbWriteOptions write;
-    write.names = args.preset == "houdini"   ? GridNames::Houdini
-                  : args.preset == "blender" ? GridNames::Blender
-                                             : GridNames::Volmorph;
-    write.half = args.half;
-    write.metadata = {{"volmorph_scene", std::filesystem::absolute(args.scene).string()},
-                      {"volmorph_frame", std::to_string(step.frame)},
-                      {"volmorph_t", fmt(step.t)},
-                      {"volmorph_fps", fmt(fps)},
-                      {"volmorph_version", versionString()}};
-    writeVolumeSet(v, file, write);
+    const GridNames names = args.preset == "houdini"   ? GridNames::Houdini
+                            : args.preset == "blender" ? GridNames::Blender
+                                                       : GridNames::Volmorph;
+    writeVolumeSet(v, file, frameVdbOptions(scene, args.scene, frame, names, args.half));
     if (!args.mesh.empty()) {
-        const std::filesystem::path meshFile = frameFileName(args.mesh, step.frame);
+        const std::filesystem::path meshFile = frameFileName(args.mesh, frame);
         if (meshFile.has_parent_path()) std::filesystem::create_directories(meshFile.parent_path());
         writeMesh(surfaceMesh(v), meshFile);
     }
@@ -133,12 +125,9 @@ int runMorph(const MorphArgs& args)
 
     Interrupter interrupter(false, args.verbose);
     StopSignals signals(interrupter);
-    MorphOptions options;
+    MorphOptions options = morphCommandOptions(scene);
     if (args.sampling == "triquadratic") options.sampling = MorphOptions::Sampling::Triquadratic;
     options.memoryLimitBytes = memoryLimitBytes(args.memoryLimitGiB);
-    options.secondsPerUnitT = scene.frames.secondsPerUnitT(); // the vel grid
-    // covering half a frame either way: Blender's and Houdini's default shutters, centred
-    options.velocityReachSeconds = 0.5 / scene.frames.fps;
     SceneMorph morph(scene, args.cache, interrupter, options, args.quiet);
 
     FrameLoop loop(scene, frames, 1, args.quiet, true, interrupter);
@@ -146,7 +135,7 @@ int runMorph(const MorphArgs& args)
         MorphStats stats;
         const VolumeSet v = morph.frame(step.frame, &stats);
         const std::filesystem::path file = frameFileName(pattern, step.frame);
-        writeFrame(v, file, args, step, scene.frames.fps);
+        writeFrame(v, file, args, scene, step.frame);
         char detail[160];
         std::snprintf(detail, sizeof detail, "%llu active voxels, warp error <= %.3f voxels",
                       (unsigned long long)stats.activeVoxels, stats.maxWarpErrorVoxels);

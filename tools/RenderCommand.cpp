@@ -271,16 +271,8 @@ std::string writeFrameImage(const render::Image& image, const SceneRender& rende
                             const std::filesystem::path& file, const RenderSceneArgs& args,
                             const Scene& scene, const FrameStep& step, double seconds)
 {
-    render::ExrOptions exr;
-    exr.frame = step.frame;
-    exr.samples = scene.render.samples;
-    exr.noiseTarget = renderer.settings.noise;
-    exr.renderSeconds = seconds;
-    exr.metadata["volmorph:scene"] = std::filesystem::absolute(args.scene).string();
-    exr.metadata["volmorph:t"] = fmt(step.t);
     try {
-        if (file.has_parent_path()) std::filesystem::create_directories(file.parent_path());
-        render::writeExr(image, renderer.camera(step.frame), file, exr);
+        writeFrameExr(image, renderer, scene, args.scene, step.frame, file, seconds);
     } catch (const std::exception& e) {
         return file.string() + ": cannot write frame " + std::to_string(step.frame) + " (" +
                e.what() + ")";
@@ -303,12 +295,8 @@ int runRenderScene(const RenderSceneArgs& args)
                     scene.render.layers);
     SceneRender renderer(scene, args.threads);
     if (args.noise >= 0.0) renderer.settings.noise = args.noise;
-    MorphOptions morphOptions;
+    MorphOptions morphOptions = renderMorphOptions(scene, renderer);
     morphOptions.memoryLimitBytes = memoryLimitBytes(args.memoryLimitGiB);
-    if (scene.render.motionBlur()) { // the vel grid, over the shutter's reach
-        morphOptions.secondsPerUnitT = scene.frames.secondsPerUnitT();
-        morphOptions.velocityReachSeconds = renderer.shutterReachSeconds();
-    }
     SceneMorph morph(scene, args.cache, interrupter, morphOptions, args.quiet);
     renderer.settings.interrupter = &interrupter;
 

@@ -1,5 +1,7 @@
 #include "SceneMorph.h"
 
+#include <volmorph/core/Version.h>
+
 #include <string>
 
 namespace volmorph::cli {
@@ -11,6 +13,28 @@ bool hasSequence(const Scene& scene)
 }
 
 } // namespace
+
+MorphOptions morphCommandOptions(const Scene& scene)
+{
+    MorphOptions options;
+    options.secondsPerUnitT = scene.frames.secondsPerUnitT();
+    options.velocityReachSeconds = 0.5 / scene.frames.fps;
+    return options;
+}
+
+VdbWriteOptions frameVdbOptions(const Scene& scene, const std::filesystem::path& scenePath,
+                                int frame, GridNames names, bool half)
+{
+    VdbWriteOptions write;
+    write.names = names;
+    write.half = half;
+    write.metadata = {{"volmorph_scene", std::filesystem::absolute(scenePath).string()},
+                      {"volmorph_frame", std::to_string(frame)},
+                      {"volmorph_t", fmt(scene.frames.t(frame))},
+                      {"volmorph_fps", fmt(scene.frames.fps)},
+                      {"volmorph_version", versionString()}};
+    return write;
+}
 
 SceneMorph::SceneMorph(const Scene& scene, const CacheArgs& cache, Interrupter& interrupter,
                        const MorphOptions& options, bool quiet)

@@ -20,6 +20,15 @@ namespace volmorph::cli {
 /// or 1 (`target`): the morph then shows that side alone, warped at each frame's t.
 void keepOneSide(BlendSpec& blend, bool target);
 
+/// `volmorph morph`'s options: the vel grid (world units per second) over half a frame either
+/// way, Blender's and Houdini's default shutters, centred.
+MorphOptions morphCommandOptions(const Scene& scene);
+
+/// How `volmorph morph` writes frame `frame` (at `t`) of the scene file `scenePath`: the grid
+/// names of `names`, its metadata (volmorph_scene, _frame, _t, _fps, _version).
+VdbWriteOptions frameVdbOptions(const Scene& scene, const std::filesystem::path& scenePath,
+                                int frame, GridNames names, bool half);
+
 class SceneMorph {
 public:
     /// Voxelizes (or reads from the cache) the scene's source and target, and builds the Morpher.

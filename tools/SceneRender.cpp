@@ -5,6 +5,7 @@
 #include <volmorph/Mesh.h>
 #include <volmorph/core/Diagnostics.h>
 #include <volmorph/render/EnvironmentMap.h>
+#include <volmorph/render/Output.h>
 
 #include <algorithm>
 #include <cmath>
@@ -170,6 +171,31 @@ double SceneRender::shutterReachSeconds() const
 {
     if (!mSpec.motionBlur()) return 0.0;
     return std::max(std::abs(mSpec.shutter.first), std::abs(mSpec.shutter.second)) / mFps;
+}
+
+MorphOptions renderMorphOptions(const Scene& scene, const SceneRender& view)
+{
+    MorphOptions options;
+    if (scene.render.motionBlur()) { // the vel grid, over the shutter's reach
+        options.secondsPerUnitT = scene.frames.secondsPerUnitT();
+        options.velocityReachSeconds = view.shutterReachSeconds();
+    }
+    return options;
+}
+
+void writeFrameExr(const render::Image& image, const SceneRender& view, const Scene& scene,
+                   const std::filesystem::path& scenePath, int frame,
+                   const std::filesystem::path& file, double seconds)
+{
+    render::ExrOptions exr;
+    exr.frame = frame;
+    exr.samples = scene.render.samples;
+    exr.noiseTarget = view.settings.noise;
+    exr.renderSeconds = seconds;
+    exr.metadata["volmorph:scene"] = std::filesystem::absolute(scenePath).string();
+    exr.metadata["volmorph:t"] = fmt(scene.frames.t(frame));
+    if (file.has_parent_path()) std::filesystem::create_directories(file.parent_path());
+    render::writeExr(image, view.camera(frame), file, exr);
 }
 
 render::Image renderMorphFrame(const SceneRender& view, SceneMorph& morph, int frame,

@@ -70,6 +70,16 @@ private:
     int mWidth;
 };
 
+/// `volmorph render`'s morph options: the vel grid over the shutter's reach when the scene blurs.
+MorphOptions renderMorphOptions(const Scene& scene, const SceneRender& view);
+
+/// Writes frame `frame`'s image to `file` as `volmorph render` does (its folders made, the file
+/// whole or not at all; the samples, noise target, seconds, scene and t in the header). Throws
+/// std::exception when it cannot.
+void writeFrameExr(const render::Image& image, const SceneRender& view, const Scene& scene,
+                   const std::filesystem::path& scenePath, int frame,
+                   const std::filesystem::path& file, double seconds);
+
 /// Frame `frame` of `morph` rendered by `view`: as a surface in surface mode, else its volume;
 /// `morphed` (may be empty) is called between the morph and the render.
 render::Image renderMorphFrame(const SceneRender& view, SceneMorph& morph, int frame,

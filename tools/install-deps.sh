@@ -7,7 +7,7 @@ set -eu
 PACKAGES="build-essential cmake ninja-build pkg-config ccache
 libopenvdb-dev libboost-iostreams-dev libembree-dev libopenimageio-dev openimageio-tools
 libopenexr-dev libtbb-dev libassimp-dev libtomlplusplus-dev libcli11-dev libnifti2-dev
-libeigen3-dev libopenmesh-dev libgtest-dev libgmock-dev libbenchmark-dev libopenvdb-tools python3-openvdb
+libeigen3-dev libopenmesh-dev python3-dev libboost-python-dev python3-numpy python3-openimageio libgtest-dev libgmock-dev libbenchmark-dev libopenvdb-tools python3-openvdb
 nlohmann-json3-dev libcpp-httplib-dev chromium curl
 fonts-dejavu-core clang libclang-rt-14-dev clang-tidy clang-format"
 

@@ -77,6 +77,11 @@ struct VdbWriteOptions {
 /// The name `grid` (one of volmorph's names, or a carried grid's) is written with under `names`.
 std::string presetName(const std::string& grid, GridNames names);
 
+/// The grids that are set, extras included, as a file of `options` holds them: shallow copies (the
+/// trees shared) named by the preset (a carried grid whose name a part takes gets "_carried"),
+/// stored as half when asked, with the metadata.
+openvdb::GridPtrVec namedGrids(const VolumeSet& volumes, const VdbWriteOptions& options = {});
+
 /// Writes the grids that are set, extras included, named and stored as `options` says. The file
 /// appears at `path` only when complete (written to a temporary name, then renamed). Throws
 /// UserError naming the path when it cannot be written.

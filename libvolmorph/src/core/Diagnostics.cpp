@@ -42,9 +42,9 @@ UserError::UserError(SourceLocation where, std::string message)
 {
 }
 
-void DiagnosticList::error(SourceLocation where, std::string message)
+void DiagnosticList::error(SourceLocation where, std::string message, std::string missingFile)
 {
-    mItems.push_back(Diagnostic{std::move(where), std::move(message)});
+    mItems.push_back(Diagnostic{std::move(where), std::move(message), std::move(missingFile)});
 }
 
 void DiagnosticList::throwIfAny() const

@@ -39,10 +39,8 @@ std::string presetName(const std::string& grid, GridNames names)
     return grid;
 }
 
-void writeVolumeSet(const VolumeSet& volumes, const std::filesystem::path& path,
-                    const VdbWriteOptions& options)
+openvdb::GridPtrVec namedGrids(const VolumeSet& volumes, const VdbWriteOptions& options)
 {
-    initializeOpenVdb();
     openvdb::GridPtrVec all = {volumes.sdf, volumes.density, volumes.color, volumes.velocity};
     for (const auto& [name, grid] : volumes.extras) all.push_back(grid);
     openvdb::GridPtrVec grids;
@@ -61,6 +59,14 @@ void writeVolumeSet(const VolumeSet& volumes, const std::filesystem::path& path,
             out->insertMeta(key, openvdb::StringMetadata(value));
         grids.push_back(out);
     }
+    return grids;
+}
+
+void writeVolumeSet(const VolumeSet& volumes, const std::filesystem::path& path,
+                    const VdbWriteOptions& options)
+{
+    initializeOpenVdb();
+    const openvdb::GridPtrVec grids = namedGrids(volumes, options);
     writeAtomically(path, "volume file", [&grids](const std::filesystem::path& temporary) {
         detail::writeVdbChecked(temporary, openvdb::GridCPtrVec(grids.begin(), grids.end()),
                                 openvdb::MetaMap());

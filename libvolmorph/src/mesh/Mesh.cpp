@@ -426,7 +426,8 @@ Mesh importMesh(const std::filesystem::path& file, const ObjectTransform& transf
     const std::string pre = prefix(file, where);
     std::error_code ec;
     if (!std::filesystem::is_regular_file(file, ec))
-        throw UserError(place, pre + "mesh file not found or not a regular file");
+        throw UserError(
+            {{place, pre + "mesh file not found or not a regular file", file.string()}});
     const uintmax_t bytes = std::filesystem::file_size(file, ec);
     if (bytes == 0) throw UserError(place, pre + "mesh file is empty");
 

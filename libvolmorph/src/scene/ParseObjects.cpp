@@ -20,8 +20,8 @@ void parseFile(Reader& r, const toml::node& n, const std::string& path,
     if (s->empty())
         r.error(r.at(n), path + ": expected a file name");
     else if (!std::filesystem::is_regular_file(file, ec))
-        r.error(r.at(n),
-                path + ": file not found: '" + *s + "' (looked for " + file.string() + ")");
+        r.error(r.at(n), path + ": file not found: '" + *s + "' (looked for " + file.string() + ")",
+                file.string());
 }
 
 namespace {
@@ -72,8 +72,10 @@ void parseVolumeFile(Reader& r, const toml::node& n, const std::string& path,
     }
     object.volumeFrames = sequenceFrames(object.volume.string());
     if (object.volumeFrames.empty())
-        r.error(r.at(n), path + ": no file of the sequence '" + *s + "' exists (looked for " +
-                             object.volume.string() + ")");
+        r.error(r.at(n),
+                path + ": no file of the sequence '" + *s + "' exists (looked for " +
+                    object.volume.string() + ")",
+                object.volume.string());
 }
 
 /// grids = { density = "...", sdf = "...", color = "..." }: grid names in the volume file.

@@ -55,9 +55,9 @@ public:
     }
     SourceLocation at(const toml::node& n) const { return at(n.source()); }
 
-    void error(const SourceLocation& where, std::string message)
+    void error(const SourceLocation& where, std::string message, std::string missingFile = {})
     {
-        mDiagnostics.error(where, std::move(message));
+        mDiagnostics.error(where, std::move(message), std::move(missingFile));
     }
 
     /// Reports keys of `table` that are not in `allowed`. `path` names the table ("render.camera").

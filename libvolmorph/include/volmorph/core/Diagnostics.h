@@ -24,6 +24,9 @@ struct SourceLocation {
 struct Diagnostic {
     SourceLocation where;
     std::string message;
+    /// The user's file the problem is that it does not exist (a scene's mesh or volume), when it
+    /// is: front ends that report a missing file as such (Python's FileNotFoundError) read it.
+    std::string missingFile{};
 
     /// "file:line:col: message"
     std::string str() const;
@@ -45,7 +48,7 @@ private:
 /// Collects diagnostics while a parser or validator keeps going after the first problem.
 class DiagnosticList {
 public:
-    void error(SourceLocation where, std::string message);
+    void error(SourceLocation where, std::string message, std::string missingFile = {});
     bool empty() const { return mItems.empty(); }
     size_t size() const { return mItems.size(); }
     const std::vector<Diagnostic>& items() const { return mItems; }
