@@ -35,6 +35,7 @@ shutil.copy(SOURCE / "scenes" / "sphere-to-box.toml", scene_path)
 before = scene_path.read_text()
 
 bpy.ops.wm.read_factory_settings(use_empty=True)  # no default cube in the shot
+bpy.ops.preferences.addon_install(filepath=os.environ["VOLMORPH_ADDON_ZIP"])
 addon_utils.enable("volmorph_blender", default_set=True, handle_error=None)
 check("volmorph_blender" in bpy.context.preferences.addons, "the add-on is enabled")
 
@@ -73,6 +74,12 @@ check(abs(now[0] - was.x - 0.1) < 1e-6 and abs(now[1] - was.y) < 1e-6,
       "pair 1's target moved 0.1 along x: {} -> {}".format(tuple(was), now))
 checked = subprocess.run([EXE, "check", str(scene_path)], capture_output=True, text=True)
 check(checked.returncode == 0, "volmorph check accepts the written scene " + checked.stderr)
+
+check(hasattr(bpy.types, "VOLMORPH_PT_scene"), "the sidebar panel is registered")
+first = pathlib.Path(volumes[0].data.filepath)
+stamp = first.stat().st_mtime_ns
+check(bpy.ops.volmorph.remorph() == {"FINISHED"} and first.stat().st_mtime_ns > stamp,
+      "remorph writes the sequence again")
 
 # render the middle frame with Cycles, motion blur on, from a camera framing the volume
 scene = bpy.context.scene
