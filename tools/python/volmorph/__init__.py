@@ -67,7 +67,7 @@ def _wait(job, progress):
         while not job.wait(0.05):
             if progress is not None:
                 now = (job.stage(), job.percent())
-                if now != seen:
+                if now != seen and now[0]:  # nothing to tell before the first stage
                     seen = now
                     progress(*now)
     except BaseException:
