@@ -236,19 +236,14 @@ class Interrupt(unittest.TestCase):
                 "samples = 6 ", "samples = 4096 "))
             scene = volmorph.Scene(path)
             out = os.path.join(tmp, "frame.exr")
-            sent = []
 
             def interrupt():
-                time.sleep(4.0)
-                sent.append(time.monotonic())
+                time.sleep(4.0)  # into the render; a hang is CTest's timeout, the latency a benchmark's
                 os.kill(os.getpid(), signal.SIGINT)
 
             threading.Thread(target=interrupt, daemon=True).start()
             with self.assertRaises(KeyboardInterrupt):
                 scene.render(12, path=out)
-            seconds = time.monotonic() - sent[0]
-            print("render interrupted: control back {:.2f} s after SIGINT".format(seconds))
-            self.assertLess(seconds, 10.0)  # a hang, not a timing: BENCHMARKS has the figure
             self.assertFalse(os.path.exists(out))
             grids = volmorph.Scene(SCENES / "sphere-to-box.toml").morph(1)
             self.assertGreater(grids["density"].activeVoxelCount(), 0)
